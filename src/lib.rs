@@ -1,0 +1,9 @@
+//! geartherm: gearbox thermal simulator.
+//!
+//! Layers (an arrow = "may use"): `cli` → `report` → `solve` → `scene` → `model` → `physics`.
+//! `physics` is pure (SI units, no I/O); `model` reads and validates model files; the CLI lives in
+//! `src/main.rs` and `src/cli/`.
+
+pub mod model;
+pub mod physics;
+pub mod report;

@@ -1,0 +1,79 @@
+//! The oil catalogue `models/oils.toml`, compiled into the binary so a model file can name an oil
+//! without any other file present.
+
+use serde::Deserialize;
+
+/// The catalogue text (kept in the repository as `models/oils.toml`, with each oil's source).
+pub const OILS_TOML: &str = include_str!("../../models/oils.toml");
+
+/// One catalogue entry (units in the keys).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CatalogueOil {
+    /// Short key, e.g. `fva_3a`.
+    pub key: String,
+    /// Full name.
+    pub name: String,
+    /// ν at 40 °C, cSt.
+    pub nu40_cst: f64,
+    /// ν at 100 °C, cSt.
+    pub nu100_cst: f64,
+    /// Density at 15 °C, kg/m³.
+    pub rho15_kg_m3: f64,
+    /// α_T, 1/K.
+    pub thermal_expansion_per_k: f64,
+    /// True when the source gave no density and a value was assumed.
+    #[serde(default)]
+    pub density_assumed: bool,
+    /// Why the density is what it is, when assumed.
+    #[serde(default)]
+    pub density_note: Option<String>,
+    /// Where the data come from.
+    pub source: String,
+}
+
+#[derive(Deserialize)]
+struct CatalogueFile {
+    oil: Vec<CatalogueOil>,
+}
+
+/// All catalogue oils. The embedded file is checked by a unit test, so a parse failure here is a
+/// build defect, reported as an empty catalogue rather than a panic.
+pub fn oils() -> Vec<CatalogueOil> {
+    toml::from_str::<CatalogueFile>(OILS_TOML)
+        .map(|c| c.oil)
+        .unwrap_or_default()
+}
+
+/// Find an oil by key or by name (case-insensitive; a name prefix up to its first parenthesis,
+/// e.g. "FVA 3A reference oil", also matches).
+pub fn find(name: &str) -> Option<CatalogueOil> {
+    let want = name.trim().to_lowercase();
+    oils().into_iter().find(|o| {
+        o.key.to_lowercase() == want
+            || o.name.to_lowercase() == want
+            || o.name
+                .split('(')
+                .next()
+                .is_some_and(|short| short.trim().to_lowercase() == want)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn catalogue_parses_and_has_every_oil() {
+        let all: Vec<CatalogueOil> = toml::from_str::<CatalogueFile>(OILS_TOML).unwrap().oil;
+        assert_eq!(all.len(), 19);
+        for o in &all {
+            assert!(o.nu40_cst > o.nu100_cst && o.nu100_cst > 0.0, "{}", o.key);
+            assert!((700.0..1100.0).contains(&o.rho15_kg_m3), "{}", o.key);
+            assert!(!o.source.is_empty());
+        }
+        assert!(find("w211").is_some() && find("W326").is_some());
+        assert!(find("FVA 3A reference oil").is_some());
+        assert!(find("no such oil").is_none());
+    }
+}

@@ -1,0 +1,259 @@
+//! TOML text → [`ModelFile`], reporting every section's type errors at once.
+//!
+//! The text is first parsed as plain TOML (syntax errors carry line and column). Then each
+//! top-level section, and each entry of an array of tables, is deserialized on its own, so one bad
+//! gear does not hide the problems of the next; each error carries its key path
+//! (`gears[3].module_mm`).
+
+use serde::de::DeserializeOwned;
+use toml::{Table, Value};
+
+use super::problems::Problems;
+use super::schema::*;
+
+const SECTIONS: &[&str] = &[
+    "model",
+    "oil",
+    "members",
+    "gears",
+    "meshes",
+    "planetary_sets",
+    "shift_elements",
+    "gear_states",
+    "train",
+    "lubrication",
+    "losses",
+    "thermal",
+    "vehicle",
+];
+
+/// Line and column (1-based) of a byte offset.
+pub fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let upto = &text[..offset.min(text.len())];
+    let line = upto.matches('\n').count() + 1;
+    let col = upto.rfind('\n').map_or(upto.len(), |p| upto.len() - p - 1) + 1;
+    (line, col)
+}
+
+fn describe(v: &Value) -> String {
+    match v {
+        Value::String(s) => format!("\"{s}\""),
+        Value::Table(_) => "{table}".into(),
+        Value::Array(a) => format!("[array of {}]", a.len()),
+        other => other.to_string(),
+    }
+}
+
+fn de<T: DeserializeOwned>(value: Value, path: &str, problems: &mut Problems) -> Option<T> {
+    match serde_path_to_error::deserialize::<_, T>(value.clone()) {
+        Ok(t) => Some(t),
+        Err(e) => {
+            let inner = e.path().to_string();
+            let full = if inner == "." || inner.is_empty() {
+                path.to_string()
+            } else if inner.starts_with('[') {
+                format!("{path}{inner}")
+            } else {
+                format!("{path}.{inner}")
+            };
+            // Find the offending value for the message when the path resolves.
+            let found = lookup(&value, &inner).map(describe).unwrap_or_default();
+            let msg = e.into_inner().to_string();
+            let first = msg.lines().next().unwrap_or("").trim().to_string();
+            problems.push(full, found, first);
+            None
+        }
+    }
+}
+
+/// Resolve a serde_path_to_error path (`a.b[2].c`) inside a value.
+fn lookup<'a>(value: &'a Value, path: &str) -> Option<&'a Value> {
+    let mut cur = value;
+    if path == "." || path.is_empty() {
+        return Some(cur);
+    }
+    for part in path.split('.') {
+        let (key, idx) = match part.find('[') {
+            Some(p) => (&part[..p], Some(&part[p..])),
+            None => (part, None),
+        };
+        if !key.is_empty() {
+            cur = cur.as_table()?.get(key)?;
+        }
+        if let Some(mut rest) = idx {
+            while let Some(end) = rest.find(']') {
+                let i: usize = rest[1..end].parse().ok()?;
+                cur = cur.as_array()?.get(i)?;
+                rest = &rest[end + 1..];
+            }
+        }
+    }
+    Some(cur)
+}
+
+fn section<T: DeserializeOwned>(
+    table: &mut Table,
+    key: &str,
+    required: bool,
+    problems: &mut Problems,
+) -> Option<T> {
+    match table.remove(key) {
+        Some(v) => de(v, key, problems),
+        None => {
+            if required {
+                problems.push(key, "", format!("required section [{key}] is missing"));
+            }
+            None
+        }
+    }
+}
+
+fn array<T: DeserializeOwned>(
+    table: &mut Table,
+    key: &str,
+    required: bool,
+    problems: &mut Problems,
+) -> Vec<T> {
+    match table.remove(key) {
+        Some(Value::Array(items)) => items
+            .into_iter()
+            .enumerate()
+            .filter_map(|(i, v)| de(v, &format!("{key}[{i}]"), problems))
+            .collect(),
+        Some(other) => {
+            problems.push(
+                key,
+                describe(&other),
+                format!("must be an array of tables ([[{key}]])"),
+            );
+            Vec::new()
+        }
+        None => {
+            if required {
+                problems.push(key, "", format!("required section [[{key}]] is missing"));
+            }
+            Vec::new()
+        }
+    }
+}
+
+/// Parse model-file text. Returns the file when every section deserialized, else `None`, with all
+/// problems found recorded in `problems`.
+pub fn parse_model(text: &str, problems: &mut Problems) -> Option<ModelFile> {
+    let mut table: Table = match text.parse() {
+        Ok(t) => t,
+        Err(e) => {
+            let e: toml::de::Error = e;
+            let where_ = e
+                .span()
+                .map(|s| {
+                    let (l, c) = line_col(text, s.start);
+                    format!("line {l}, column {c}")
+                })
+                .unwrap_or_else(|| "unknown position".into());
+            problems.push("", "", format!("TOML syntax error at {where_}: {}", e.message()));
+            return None;
+        }
+    };
+    let unknown: Vec<String> = table
+        .keys()
+        .filter(|k| !SECTIONS.contains(&k.as_str()))
+        .cloned()
+        .collect();
+    for k in unknown {
+        problems.push(
+            k.clone(),
+            "",
+            format!("unknown top-level key; allowed sections: {}", SECTIONS.join(", ")),
+        );
+    }
+    let before = problems.len();
+    let model = section::<ModelMeta>(&mut table, "model", true, problems);
+    let oil = section::<OilSpec>(&mut table, "oil", true, problems);
+    let members = array::<MemberSpec>(&mut table, "members", false, problems);
+    let gears = array::<GearSpecFile>(&mut table, "gears", true, problems);
+    let meshes = array::<MeshSpec>(&mut table, "meshes", false, problems);
+    let planetary_sets = array::<PlanetarySetSpec>(&mut table, "planetary_sets", false, problems);
+    let shift_elements = array::<ShiftElementSpec>(&mut table, "shift_elements", false, problems);
+    let gear_states = array::<GearStateSpec>(&mut table, "gear_states", false, problems);
+    let train = section::<TrainSpec>(&mut table, "train", true, problems);
+    let lubrication = section::<LubricationSpec>(&mut table, "lubrication", true, problems);
+    let losses = section::<LossesSpec>(&mut table, "losses", false, problems);
+    let thermal = section::<Table>(&mut table, "thermal", false, problems);
+    let vehicle = section::<Table>(&mut table, "vehicle", false, problems);
+    if problems.len() > before || !problems.is_empty() {
+        return None;
+    }
+    Some(ModelFile {
+        model: model?,
+        oil: oil?,
+        members,
+        gears,
+        meshes,
+        planetary_sets,
+        shift_elements,
+        gear_states,
+        train: train?,
+        lubrication: lubrication?,
+        losses,
+        thermal,
+        vehicle,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn syntax_error_has_line_and_column() {
+        let mut p = Problems::default();
+        assert!(parse_model("[model]\nname = \"x\"\nbad = = 3\n", &mut p).is_none());
+        let msg = p.as_slice()[0].to_string();
+        assert!(msg.contains("line 3"), "{msg}");
+        assert!(msg.contains("column"), "{msg}");
+    }
+
+    #[test]
+    fn reports_every_bad_gear_with_its_path() {
+        let text = r#"
+[model]
+name = "t"
+[oil]
+catalogue = "FVA 3A"
+[[gears]]
+name = "a"
+member = "m"
+teeth = "sixteen"
+module_mm = 4.5
+face_width_mm = 14
+[[gears]]
+name = "b"
+member = "m"
+teeth = 24
+modul_mm = 4.5
+face_width_mm = 14
+[train]
+input = "m"
+output = "m"
+[lubrication]
+oil_level_mm = 0
+centre_height_mm = {}
+"#;
+        let mut p = Problems::default();
+        assert!(parse_model(text, &mut p).is_none());
+        let all: Vec<String> = p.as_slice().iter().map(|x| x.to_string()).collect();
+        assert!(all.iter().any(|m| m.starts_with("gears[0].teeth")), "{all:?}");
+        assert!(
+            all.iter()
+                .any(|m| m.starts_with("gears[1]") && m.contains("modul_mm")),
+            "{all:?}"
+        );
+    }
+
+    #[test]
+    fn line_col_counts_from_one() {
+        assert_eq!(line_col("ab\ncd", 0), (1, 1));
+        assert_eq!(line_col("ab\ncd", 4), (2, 2));
+    }
+}

@@ -1,0 +1,1 @@
+//! churning losses (placeholder, being written).

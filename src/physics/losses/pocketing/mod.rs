@@ -1,0 +1,1 @@
+//! pocketing losses (placeholder, being written).

@@ -1,0 +1,1 @@
+//! sliding losses (placeholder, being written).

@@ -1,0 +1,2 @@
+//! Reports: text/JSON summaries and (later) CSV and PNG outputs.
+pub mod info;
