@@ -460,7 +460,7 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
                 if let Some(prev) = centre.insert(pg, geo.a_w) {
                     if (prev - geo.a_w).abs() > 1e-3 * file.gears[pg].module_mm * MM {
                         problems.push(
-                            format!("{p}"),
+                            p.to_string(),
                             format!("{:.4} mm vs {:.4} mm", prev / MM, geo.a_w / MM),
                             format!(
                                 "planet \"{}\": its centre distances to the sun and to the ring must be equal (coaxial set); adjust profile shifts or tooth counts",
@@ -655,7 +655,7 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
                 engaged,
                 solution,
             }),
-            Err(e) => problems.push(format!("{p}"), q(&st.name), kinematics_message(&e, &st.engaged)),
+            Err(e) => problems.push(p.clone(), q(&st.name), kinematics_message(&e, &st.engaged)),
         }
     }
 
@@ -1090,7 +1090,38 @@ fn mesh_geometry(
                 );
                 return None;
             }
-            Some(m)
+            let interference = [
+                (
+                    m.interference1,
+                    format!(
+                        "the tip of {} reaches {} below its form circle (involute interference)",
+                        s2.name, s1.name
+                    ),
+                ),
+                (
+                    m.interference2,
+                    format!(
+                        "the tip of {} reaches {} beyond its form circle (involute interference)",
+                        s1.name, s2.name
+                    ),
+                ),
+                (
+                    m.tip_interference,
+                    format!("tip interference between pinion {} and ring {}", s1.name, s2.name),
+                ),
+            ];
+            let mut clean = true;
+            for (flag, what) in interference {
+                if flag {
+                    problems.push(
+                        p.to_string(),
+                        format!("{}/{}", s1.name, s2.name),
+                        format!("{what}; shorten the tip (tip_diameter_mm) or change the profile shifts"),
+                    );
+                    clean = false;
+                }
+            }
+            clean.then_some(m)
         }
         Err(e) => {
             problems.push(

@@ -92,10 +92,10 @@ const GL_X: [f64; 10] = [
     0.227_785_851_141_645_08,
     0.373_706_088_715_419_56,
     0.510_867_001_950_827_1,
-    0.636_053_680_726_515_0,
+    0.636_053_680_726_515,
     0.746_331_906_460_150_8,
     0.839_116_971_822_218_8,
-    0.912_234_428_251_326_0,
+    0.912_234_428_251_326,
     0.963_971_927_277_913_8,
     0.993_128_599_185_094_9,
 ];
@@ -199,6 +199,14 @@ mod tests {
         let exact = inv_r_antiderivative(r2, rb) - inv_r_antiderivative(r1, rb);
         let num = gauss_legendre(|r| inv(pressure_angle_at(r, rb)) * r, r1, r2, 8);
         assert_relative_eq!(exact, num, max_relative = 1e-12);
+    }
+
+    #[test]
+    fn gauss_legendre_is_exact_for_degree_39() {
+        for k in [0, 1, 7, 20, 39] {
+            let num = gauss_legendre(|x| x.powi(k), 0.0, 1.0, 1);
+            assert_relative_eq!(num, 1.0 / f64::from(k + 1), max_relative = 1e-13);
+        }
     }
 
     #[test]

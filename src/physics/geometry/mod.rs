@@ -14,6 +14,9 @@
 //! written next to each formula ([derived]); the internal-gear tip-interference criterion is
 //! [recalled] from the KHK gear technical reference and checked by a brute-force test.
 
+// `!(a > b)` is used on purpose: it also rejects NaN, which `a <= b` would let through.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod error;
 pub mod gear;
 pub mod involute;
