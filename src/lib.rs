@@ -7,3 +7,4 @@
 pub mod model;
 pub mod physics;
 pub mod report;
+pub mod scene;

@@ -5,8 +5,10 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 
-use geartherm::model::{self, ModelError};
-use geartherm::report::info;
+use geartherm::model::{self, Gearbox, ModelError};
+use geartherm::physics::oil::KELVIN_OFFSET;
+use geartherm::report::{info, losses};
+use geartherm::scene::{LossScene, OperatingPoint};
 
 /// Exit code: invalid input (nothing written).
 pub const EXIT_INVALID: i32 = 1;
@@ -41,6 +43,26 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Every loss item (churning, pocketing, sliding) at one operating point, totals, efficiency.
+    Losses {
+        /// Model file (TOML).
+        model: PathBuf,
+        /// Gear state name (e.g. 3, R).
+        #[arg(long)]
+        gear: String,
+        /// Input speed, rpm (≥ 0).
+        #[arg(long, allow_negative_numbers = true)]
+        speed_rpm: f64,
+        /// Input torque, N m (≥ 0: drive).
+        #[arg(long, allow_negative_numbers = true)]
+        torque_nm: f64,
+        /// Oil temperature, °C.
+        #[arg(long, allow_negative_numbers = true)]
+        oil_temp_c: f64,
+        /// Print one JSON document instead of tables.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 /// A failure with its exit code and message.
@@ -57,6 +79,40 @@ impl From<ModelError> for Failure {
             code: EXIT_INVALID,
             message: e.report(),
         }
+    }
+}
+
+fn invalid(message: String) -> Failure {
+    Failure {
+        code: EXIT_INVALID,
+        message,
+    }
+}
+
+fn print_json<T: serde::Serialize>(value: &T) -> Result<(), Failure> {
+    let text = serde_json::to_string_pretty(value).map_err(|e| Failure {
+        code: EXIT_IO,
+        message: format!("cannot serialise the report: {e}"),
+    })?;
+    println!("{text}");
+    Ok(())
+}
+
+fn state_index(gb: &Gearbox, gear: &str) -> Result<usize, Failure> {
+    gb.state_index(gear).ok_or_else(|| {
+        let names: Vec<&str> = gb.gear_states.iter().map(|s| s.name.as_str()).collect();
+        invalid(format!(
+            "--gear {gear}: unknown gear state; the model has: {}",
+            names.join(", ")
+        ))
+    })
+}
+
+fn check_range(flag: &str, v: f64, lo: f64, hi: f64, unit: &str) -> Result<(), Failure> {
+    if v.is_finite() && (lo..=hi).contains(&v) {
+        Ok(())
+    } else {
+        Err(invalid(format!("{flag} {v}: must lie in [{lo}, {hi}]{unit}")))
     }
 }
 
@@ -78,13 +134,37 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             let gb = model::load(&model)?;
             let report = info::info(&gb);
             if json {
-                let text = serde_json::to_string_pretty(&report).map_err(|e| Failure {
-                    code: EXIT_IO,
-                    message: format!("cannot serialise the report: {e}"),
-                })?;
-                println!("{text}");
+                print_json(&report)?;
             } else {
                 print!("{}", info::to_text(&report, &gb));
+            }
+            Ok(())
+        }
+        Command::Losses {
+            model,
+            gear,
+            speed_rpm,
+            torque_nm,
+            oil_temp_c,
+            json,
+        } => {
+            let gb = model::load(&model)?;
+            let state = state_index(&gb, &gear)?;
+            check_range("--speed-rpm", speed_rpm, 0.0, 50_000.0, " rpm")?;
+            check_range("--torque-nm", torque_nm, 0.0, 1e6, " N m")?;
+            check_range("--oil-temp-c", oil_temp_c, -60.0, 250.0, " °C")?;
+            let scene = LossScene::compile(&gb).map_err(|e| invalid(format!("{}: {e}", model.display())))?;
+            let op = OperatingPoint {
+                state,
+                input_speed: speed_rpm * std::f64::consts::PI / 30.0,
+                input_torque: torque_nm,
+                oil: gb.oil.properties(oil_temp_c + KELVIN_OFFSET),
+            };
+            let report = losses::losses(&gb, &scene, &op, oil_temp_c);
+            if json {
+                print_json(&report)?;
+            } else {
+                print!("{}", losses::to_text(&report));
             }
             Ok(())
         }

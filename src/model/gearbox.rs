@@ -5,7 +5,40 @@ use crate::physics::geometry::{GearGeometry, MeshGeometry};
 use crate::physics::kinematics::{planet_spin, ring_pinion_spin, GearTrain, StateSolution};
 use crate::physics::oil::Oil;
 
-pub use super::schema::{LossesSpec, MemberKind, PlanetarySetKind, ShiftElementKind};
+pub use super::schema::{MemberKind, PlanetarySetKind, ShiftElementKind};
+use crate::physics::losses::churning::ChurningConfig;
+use crate::physics::losses::sliding::{friction::Schlenk, SlidingOptions};
+
+/// Pocketing options (resolved from `[losses]`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PocketingOptions {
+    /// Discharge coefficient C_d.
+    pub discharge_coefficient: f64,
+    /// Density of the oil–air mixture pumped by a mesh above the oil level, kg/m³.
+    pub mixture_density: f64,
+}
+
+/// Sliding-loss model choice.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SlidingChoice {
+    /// No sliding loss.
+    Off,
+    /// Contact-path model (load sharing, local friction law, Niemann–Richer for helical meshes).
+    Detailed(SlidingOptions),
+    /// ISO/TR 14179-2 closed form `P_in μ_mz H_V` with the Schlenk mean friction coefficient.
+    Iso14179(Schlenk, f64),
+}
+
+/// Loss models selected by the model file (`[losses]`), with their coefficients.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LossModels {
+    /// Churning model and coefficients (None: churning off).
+    pub churning: Option<ChurningConfig>,
+    /// Pocketing (None: off).
+    pub pocketing: Option<PocketingOptions>,
+    /// Sliding.
+    pub sliding: SlidingChoice,
+}
 
 /// A rotating member (shaft, carrier, drum).
 #[derive(Debug, Clone)]
@@ -175,8 +208,8 @@ pub struct Gearbox {
     pub oil_level: f64,
     /// Sump oil volume, m³ (if given).
     pub sump_volume: Option<f64>,
-    /// Loss-model choices as written (defaults applied by the loss layer).
-    pub losses: LossesSpec,
+    /// Loss models with their coefficients.
+    pub losses: LossModels,
     /// `[thermal]` section as written (reserved).
     pub thermal: Option<toml::Table>,
     /// `[vehicle]` section as written (reserved).

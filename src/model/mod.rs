@@ -5,6 +5,7 @@
 
 pub mod catalogue;
 pub mod gearbox;
+pub mod losses;
 pub mod parse;
 pub mod problems;
 pub mod schema;

@@ -757,21 +757,11 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         });
     }
 
-    if let Some(l) = &file.losses {
-        check_choice(
-            problems,
-            "losses.churning",
-            &l.churning,
-            &["seetharaman", "stavytskyi", "changenet", "off"],
-        );
-        check_choice(problems, "losses.pocketing", &l.pocketing, &["on", "off"]);
-        check_choice(
-            problems,
-            "losses.sliding",
-            &l.sliding,
-            &["detailed", "iso14179", "off"],
-        );
-    }
+    let losses = super::losses::validate_losses(
+        &file.losses.clone().unwrap_or_default(),
+        lub.sump_volume_l,
+        problems,
+    );
 
     if problems.len() > start {
         return None;
@@ -799,18 +789,10 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         output: output?,
         oil_level: level,
         sump_volume: lub.sump_volume_l.map(|v| v * 1e-3),
-        losses: file.losses.clone().unwrap_or_default(),
+        losses: losses?,
         thermal: file.thermal.clone(),
         vehicle: file.vehicle.clone(),
     })
-}
-
-fn check_choice(problems: &mut Problems, path: &str, v: &Option<String>, allowed: &[&str]) {
-    if let Some(v) = v {
-        if !allowed.contains(&v.as_str()) {
-            problems.push(path, q(v), format!("must be one of: {}", allowed.join(", ")));
-        }
-    }
 }
 
 fn kind_name(k: PlanetarySetKind) -> &'static str {

@@ -1,2 +1,3 @@
 //! Reports: text/JSON summaries and (later) CSV and PNG outputs.
 pub mod info;
+pub mod losses;

@@ -1,0 +1,146 @@
+//! `geartherm losses`: every loss item at one operating point, per-source totals, efficiency.
+
+use std::fmt::Write as _;
+
+use serde::Serialize;
+
+use crate::model::Gearbox;
+use crate::scene::{LossScene, OperatingPoint, Skipped, Source};
+
+/// Per-source totals, W.
+#[derive(Debug, Serialize, Default)]
+pub struct BySource {
+    /// Churning, W.
+    pub churning_w: f64,
+    /// Pocketing, W.
+    pub pocketing_w: f64,
+    /// Sliding, W.
+    pub sliding_w: f64,
+}
+
+/// One loss item.
+#[derive(Debug, Serialize)]
+pub struct ItemReport {
+    /// `churning`, `pocketing` or `sliding`.
+    pub source: Source,
+    /// Gear or mesh name.
+    pub name: String,
+    /// Power, W.
+    pub w: f64,
+}
+
+/// The `losses` report.
+#[derive(Debug, Serialize)]
+pub struct LossReport {
+    /// Model name.
+    pub model: String,
+    /// Gear state.
+    pub gear: String,
+    /// Input speed, rpm.
+    pub input_speed_rpm: f64,
+    /// Input torque, N·m.
+    pub input_torque_nm: f64,
+    /// Oil temperature, °C.
+    pub oil_temp_c: f64,
+    /// Kinematic viscosity at that temperature, cSt.
+    pub oil_viscosity_cst: f64,
+    /// Density at that temperature, kg/m³.
+    pub oil_density_kg_m3: f64,
+    /// Input power T·ω, W.
+    pub input_power_w: f64,
+    /// Output speed, rpm.
+    pub output_speed_rpm: f64,
+    /// Sum of all loss items, W.
+    pub total_w: f64,
+    /// (P_in − P_loss)/P_in (1 when P_in = 0 and no loss; 0 when P_in = 0 with losses).
+    pub efficiency: f64,
+    /// Totals per source.
+    pub by_source: BySource,
+    /// Every item.
+    pub items: Vec<ItemReport>,
+    /// What the scene left out.
+    pub skipped: Vec<Skipped>,
+}
+
+/// Evaluate the scene at `op` and build the report.
+pub fn losses(gb: &Gearbox, scene: &LossScene, op: &OperatingPoint, oil_temp_c: f64) -> LossReport {
+    let mut out = vec![0.0; scene.len()];
+    scene.evaluate(op, &mut out);
+    let mut by = BySource::default();
+    for (it, w) in scene.items.iter().zip(&out) {
+        match it.source {
+            Source::Churning => by.churning_w += w,
+            Source::Pocketing => by.pocketing_w += w,
+            Source::Sliding => by.sliding_w += w,
+        }
+    }
+    let total: f64 = out.iter().sum();
+    let p_in = op.input_torque * op.input_speed;
+    let efficiency = if p_in > 0.0 {
+        (p_in - total) / p_in
+    } else if total == 0.0 {
+        1.0
+    } else {
+        0.0
+    };
+    let st = &gb.gear_states[op.state];
+    let rpm = 60.0 / (2.0 * std::f64::consts::PI);
+    LossReport {
+        model: gb.name.clone(),
+        gear: st.name.clone(),
+        input_speed_rpm: op.input_speed * rpm,
+        input_torque_nm: op.input_torque,
+        oil_temp_c,
+        oil_viscosity_cst: op.oil.nu * 1e6,
+        oil_density_kg_m3: op.oil.rho,
+        input_power_w: p_in,
+        output_speed_rpm: op.input_speed / st.ratio() * rpm,
+        total_w: total,
+        efficiency,
+        by_source: by,
+        items: scene
+            .items
+            .iter()
+            .zip(&out)
+            .map(|(it, w)| ItemReport {
+                source: it.source,
+                name: it.name.clone(),
+                w: *w,
+            })
+            .collect(),
+        skipped: scene.skipped.clone(),
+    }
+}
+
+/// Text table.
+pub fn to_text(r: &LossReport) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "model: {}   gear {}", r.model, r.gear);
+    let _ = writeln!(
+        s,
+        "input {:.0} rpm, {:.1} N m ({:.2} kW); output {:.0} rpm; oil {:.1} °C ({:.2} cSt, {:.1} kg/m3)\n",
+        r.input_speed_rpm,
+        r.input_torque_nm,
+        r.input_power_w / 1e3,
+        r.output_speed_rpm,
+        r.oil_temp_c,
+        r.oil_viscosity_cst,
+        r.oil_density_kg_m3
+    );
+    let _ = writeln!(s, "  {:<10} {:<32} {:>12}", "source", "item", "loss [W]");
+    for it in &r.items {
+        let _ = writeln!(s, "  {:<10} {:<32} {:>12.3}", it.source.as_str(), it.name, it.w);
+    }
+    let _ = writeln!(s, "\n  churning  {:>12.3} W", r.by_source.churning_w);
+    let _ = writeln!(s, "  pocketing {:>12.3} W", r.by_source.pocketing_w);
+    let _ = writeln!(s, "  sliding   {:>12.3} W", r.by_source.sliding_w);
+    let _ = writeln!(s, "  total     {:>12.3} W", r.total_w);
+    let _ = writeln!(s, "  efficiency {:.5}", r.efficiency);
+    if !r.skipped.is_empty() {
+        let _ = writeln!(s, "\nskipped:");
+        for k in &r.skipped {
+            let _ = writeln!(s, "  {}: {}", k.what, k.why);
+        }
+    }
+    s
+}

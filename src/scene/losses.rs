@@ -1,0 +1,490 @@
+//! The loss part of a compiled scene: every loss item of a gearbox with its precomputed model,
+//! per-gear-state kinematic factors, and an allocation-free evaluation at an operating point.
+//!
+//! Compile once (`LossScene::compile`): churning models only for gears that reach the oil,
+//! pocketing integrals K per external mesh, sliding contact-path tables per mesh, and for every
+//! gear state the gear speeds and mesh torques per unit input. Evaluating all losses at an
+//! operating point (`LossScene::evaluate`) is then a loop over flat arrays with no allocation.
+
+use crate::model::gearbox::{GearMount, Gearbox, SlidingChoice};
+use crate::physics::geometry::MeshKind;
+use crate::physics::losses::churning::{ChurningGear, GearChurning, OilState as ChurnOil};
+use crate::physics::losses::pocketing::{PocketMeshInput, PocketingMesh};
+use crate::physics::losses::sliding::friction::Schlenk;
+use crate::physics::losses::sliding::{OilState as SlideOil, SlidingMesh, SlidingMeshInput};
+use crate::physics::oil::OilProperties;
+
+/// Heat source kind.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Source {
+    /// Oil drag on an immersed gear (load-independent).
+    Churning,
+    /// Oil squeezed out of closing tooth spaces (load-independent).
+    Pocketing,
+    /// Mesh friction (load-dependent).
+    Sliding,
+}
+
+impl Source {
+    /// Lower-case name.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Source::Churning => "churning",
+            Source::Pocketing => "pocketing",
+            Source::Sliding => "sliding",
+        }
+    }
+}
+
+/// One loss item: what it is, where its heat goes.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct LossItem {
+    /// Source kind.
+    pub source: Source,
+    /// Gear name (churning) or mesh name (pocketing, sliding).
+    pub name: String,
+    /// Gears heated and the fraction each receives (sliding: split between the two gears;
+    /// churning and pocketing: the gear(s) concerned, whose heat goes to the oil by default).
+    pub gears: Vec<(usize, f64)>,
+}
+
+/// A part of the model the scene left out, and why.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Skipped {
+    /// What (e.g. "churning of gear s1_sun").
+    pub what: String,
+    /// Why.
+    pub why: String,
+}
+
+/// Kinematic factors of one gear state (per unit input speed / torque).
+#[derive(Debug, Clone)]
+struct StateFactors {
+    /// |absolute speed| of each churning entry's gear.
+    churn_speed: Vec<f64>,
+    /// Carrier-frame speed of gear 1 of each pocketing entry's mesh.
+    pocket_speed: Vec<f64>,
+    /// Per sliding entry: torque on gear 1 (one mesh), carrier-frame ω1, ω2.
+    slide: Vec<[f64; 3]>,
+}
+
+#[derive(Debug, Clone)]
+struct ChurnEntry {
+    item: usize,
+    model: GearChurning,
+}
+
+#[derive(Debug, Clone)]
+struct PocketEntry {
+    item: usize,
+    model: PocketingMesh,
+    multiplicity: f64,
+    /// Fraction of the time the mesh zone is below the oil level (0..1).
+    wet_fraction: f64,
+}
+
+#[derive(Debug, Clone)]
+enum SlideModel {
+    Detailed(SlidingMesh),
+    Iso14179(SlidingMesh, Schlenk),
+}
+
+#[derive(Debug, Clone)]
+struct SlideEntry {
+    item: usize,
+    model: SlideModel,
+    multiplicity: f64,
+}
+
+/// Operating point of the whole gearbox.
+#[derive(Debug, Clone, Copy)]
+pub struct OperatingPoint {
+    /// Gear-state index.
+    pub state: usize,
+    /// Input speed, rad/s.
+    pub input_speed: f64,
+    /// Input torque, N·m (drive torque the input delivers to the train, losses excluded).
+    pub input_torque: f64,
+    /// Oil properties at the oil temperature.
+    pub oil: OilProperties,
+}
+
+/// Compiled loss models of a gearbox.
+#[derive(Debug, Clone)]
+pub struct LossScene {
+    /// Loss items in output order (churning per immersed gear, pocketing per mesh, sliding per mesh).
+    pub items: Vec<LossItem>,
+    /// What was left out and why.
+    pub skipped: Vec<Skipped>,
+    churn: Vec<ChurnEntry>,
+    pocket: Vec<PocketEntry>,
+    slide: Vec<SlideEntry>,
+    states: Vec<StateFactors>,
+    mixture_density: f64,
+}
+
+/// A loss model could not be built for a part of the model.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("{what}: {why}")]
+pub struct SceneError {
+    /// Which item.
+    pub what: String,
+    /// Why.
+    pub why: String,
+}
+
+fn churning_gear(gb: &Gearbox, gi: usize) -> ChurningGear {
+    let g = &gb.gears[gi];
+    let geo = &g.geometry;
+    let (tip, root) = if geo.is_internal() {
+        // A ring's outer rim dips: treated as an external gear of the same tooth count and module
+        // whose tip circle is the ring's root circle (docs/physics.md §5, "ring gears").
+        let h = (geo.d_f - geo.d_a).abs() / 2.0;
+        (geo.d_f / 2.0, geo.d_f / 2.0 - h)
+    } else {
+        (geo.d_a / 2.0, geo.d_f / 2.0)
+    };
+    let space_tip = if geo.is_internal() {
+        (geo.p_t - geo.s_t).max(0.0)
+    } else {
+        geo.e_at.max(0.0)
+    };
+    ChurningGear {
+        tip_radius: tip,
+        root_radius: root,
+        pitch_radius: geo.d / 2.0,
+        face_width: geo.spec.b,
+        teeth: geo.z(),
+        normal_module: geo.spec.mn,
+        helix_angle: geo.spec.beta,
+        normal_pressure_angle: geo.spec.alpha_n,
+        profile_shift: if geo.is_internal() { 0.0 } else { geo.spec.x },
+        space_width_tip: space_tip,
+        tooth_height: tip - root,
+        immersion_depth: g.immersion,
+    }
+}
+
+/// Fraction of a circle of radius `r` around height `yc` lying below the level `level`.
+fn wet_fraction(yc: f64, r: f64, level: f64) -> f64 {
+    if r <= 0.0 {
+        return if yc < level { 1.0 } else { 0.0 };
+    }
+    let c = ((yc - level) / r).clamp(-1.0, 1.0);
+    // Points y = yc + r cos t below the level: cos t < −(yc − level)/r … fraction acos(c)/π.
+    (c.acos() / std::f64::consts::PI).clamp(0.0, 1.0)
+}
+
+impl LossScene {
+    /// Build every loss model of `gb` once.
+    pub fn compile(gb: &Gearbox) -> Result<LossScene, SceneError> {
+        let mut items = Vec::new();
+        let mut skipped = Vec::new();
+        let mut churn = Vec::new();
+        let mut pocket = Vec::new();
+        let mut slide = Vec::new();
+        let models = &gb.losses;
+
+        // Churning: one item per gear that reaches the oil.
+        let mut churn_gears = Vec::new();
+        match &models.churning {
+            None => skipped.push(Skipped {
+                what: "churning".into(),
+                why: "switched off ([losses] churning = \"off\")".into(),
+            }),
+            Some(cfg) => {
+                for (gi, g) in gb.gears.iter().enumerate() {
+                    if !g.is_immersed() {
+                        skipped.push(Skipped {
+                            what: format!("churning of gear {}", g.name),
+                            why: format!(
+                                "does not reach the oil (lowest point {:.1} mm above the level)",
+                                -g.immersion * 1e3
+                            ),
+                        });
+                        continue;
+                    }
+                    let model = GearChurning::new(cfg, &churning_gear(gb, gi)).map_err(|e| SceneError {
+                        what: format!("churning of gear {}", g.name),
+                        why: e.to_string(),
+                    })?;
+                    churn.push(ChurnEntry {
+                        item: items.len(),
+                        model,
+                    });
+                    churn_gears.push(gi);
+                    items.push(LossItem {
+                        source: Source::Churning,
+                        name: g.name.clone(),
+                        gears: vec![(gi, 1.0)],
+                    });
+                }
+            }
+        }
+
+        // Pocketing: external meshes.
+        let mut pocket_meshes = Vec::new();
+        match &models.pocketing {
+            None => skipped.push(Skipped {
+                what: "pocketing".into(),
+                why: "switched off ([losses] pocketing = \"off\")".into(),
+            }),
+            Some(opt) => {
+                for (mi, m) in gb.meshes.iter().enumerate() {
+                    let geo = &m.geometry;
+                    if geo.kind == MeshKind::Internal {
+                        skipped.push(Skipped {
+                            what: format!("pocketing of mesh {}", m.name),
+                            why: "internal mesh: the pocket model (seed 004) covers external meshes only"
+                                .into(),
+                        });
+                        continue;
+                    }
+                    let (g1, g2) = (&gb.gears[m.gear1], &gb.gears[m.gear2]);
+                    let input = PocketMeshInput {
+                        z1: g1.geometry.z(),
+                        z2: g2.geometry.z(),
+                        module: g1.geometry.spec.mn,
+                        pressure_angle: g1.geometry.spec.alpha_n,
+                        x1: g1.geometry.spec.x,
+                        x2: g2.geometry.spec.x,
+                        tip_radius1: g1.geometry.d_a / 2.0,
+                        tip_radius2: g2.geometry.d_a / 2.0,
+                        root_radius1: g1.geometry.d_f / 2.0,
+                        root_radius2: g2.geometry.d_f / 2.0,
+                        centre_distance: geo.a_w,
+                        face_width: g1.geometry.spec.b.min(g2.geometry.spec.b),
+                        helix_angle: g1.geometry.spec.beta,
+                    };
+                    let model =
+                        PocketingMesh::new(&input, opt.discharge_coefficient).map_err(|e| SceneError {
+                            what: format!("pocketing of mesh {}", m.name),
+                            why: e.to_string(),
+                        })?;
+                    // Height of the pitch point; planets orbit, so the mesh point sweeps a circle.
+                    let (wet, _) = mesh_zone(gb, mi);
+                    pocket.push(PocketEntry {
+                        item: items.len(),
+                        model,
+                        multiplicity: m.multiplicity as f64,
+                        wet_fraction: wet,
+                    });
+                    pocket_meshes.push(mi);
+                    items.push(LossItem {
+                        source: Source::Pocketing,
+                        name: m.name.clone(),
+                        gears: vec![(m.gear1, 0.5), (m.gear2, 0.5)],
+                    });
+                }
+            }
+        }
+
+        // Sliding.
+        let mut slide_meshes = Vec::new();
+        let (opts, schlenk) = match &models.sliding {
+            SlidingChoice::Off => {
+                skipped.push(Skipped {
+                    what: "sliding".into(),
+                    why: "switched off ([losses] sliding = \"off\")".into(),
+                });
+                (None, None)
+            }
+            SlidingChoice::Detailed(o) => (Some(*o), None),
+            SlidingChoice::Iso14179(s, split) => (
+                Some(crate::physics::losses::sliding::SlidingOptions {
+                    heat_to_gear1: *split,
+                    ..Default::default()
+                }),
+                Some(*s),
+            ),
+        };
+        if let Some(opts) = opts {
+            for (mi, m) in gb.meshes.iter().enumerate() {
+                let geo = &m.geometry;
+                let (g1, g2) = (&gb.gears[m.gear1], &gb.gears[m.gear2]);
+                let input = SlidingMeshInput {
+                    base_radius1: geo.r_b1,
+                    base_radius2: geo.r_b2,
+                    operating_pressure_angle: geo.alpha_wt,
+                    tip_radius1: geo.r_a1,
+                    tip_radius2: geo.r_a2,
+                    centre_distance: geo.a_w,
+                    face_width: geo.b,
+                    base_helix_angle: geo.beta_b,
+                    transverse_base_pitch: geo.p_bt,
+                    internal: geo.kind == MeshKind::Internal,
+                    z1: geo.z1,
+                    z2: geo.z2,
+                    roughness_ra1: g1.roughness_ra,
+                    roughness_ra2: g2.roughness_ra,
+                };
+                let what = format!("sliding of mesh {}", m.name);
+                let sm = SlidingMesh::new(&input, &opts).map_err(|e| SceneError {
+                    what: what.clone(),
+                    why: e.to_string(),
+                })?;
+                let model = match schlenk {
+                    Some(s) => SlideModel::Iso14179(sm, s),
+                    None => SlideModel::Detailed(sm),
+                };
+                slide.push(SlideEntry {
+                    item: items.len(),
+                    model,
+                    multiplicity: m.multiplicity as f64,
+                });
+                slide_meshes.push(mi);
+                let f1 = opts.heat_to_gear1;
+                items.push(LossItem {
+                    source: Source::Sliding,
+                    name: m.name.clone(),
+                    gears: vec![(m.gear1, f1), (m.gear2, 1.0 - f1)],
+                });
+            }
+        }
+
+        // Per-state kinematic factors. Round-off from the kinematic solve (~1e-16 per unit input)
+        // is snapped to exact zero so a locked set (all members at one speed) has no relative
+        // motion at all.
+        let clean = |v: f64| if v.abs() < 1e-12 { 0.0 } else { v };
+        let states = (0..gb.gear_states.len())
+            .map(|si| {
+                let speeds: Vec<_> = gb
+                    .gear_speeds(si)
+                    .into_iter()
+                    .map(|s| crate::model::gearbox::GearSpeed {
+                        absolute: clean(s.absolute),
+                        relative: clean(s.relative),
+                    })
+                    .collect();
+                let torques: Vec<f64> = gb.mesh_torques(si).into_iter().map(clean).collect();
+                StateFactors {
+                    churn_speed: churn_gears.iter().map(|&gi| speeds[gi].absolute.abs()).collect(),
+                    pocket_speed: pocket_meshes
+                        .iter()
+                        .map(|&mi| speeds[gb.meshes[mi].gear1].relative)
+                        .collect(),
+                    slide: slide_meshes
+                        .iter()
+                        .map(|&mi| {
+                            let m = &gb.meshes[mi];
+                            [torques[mi], speeds[m.gear1].relative, speeds[m.gear2].relative]
+                        })
+                        .collect(),
+                }
+            })
+            .collect();
+
+        let mixture_density = models.pocketing.map_or(0.0, |p| p.mixture_density);
+        Ok(LossScene {
+            items,
+            skipped,
+            churn,
+            pocket,
+            slide,
+            states,
+            mixture_density,
+        })
+    }
+
+    /// Number of loss items.
+    pub fn len(&self) -> usize {
+        self.items.len()
+    }
+
+    /// True when there is no loss item.
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+
+    /// Evaluate every loss item (W) at `op` into `out` (length [`Self::len`]). No allocation.
+    pub fn evaluate(&self, op: &OperatingPoint, out: &mut [f64]) {
+        let st = &self.states[op.state];
+        let w_in = op.input_speed;
+        let churn_oil = ChurnOil {
+            density: op.oil.rho,
+            kinematic_viscosity: op.oil.nu,
+        };
+        for (e, k) in self.churn.iter().zip(&st.churn_speed) {
+            out[e.item] = e.model.power(k * w_in, &churn_oil).total;
+        }
+        for (e, k) in self.pocket.iter().zip(&st.pocket_speed) {
+            let rho = e.wet_fraction * op.oil.rho + (1.0 - e.wet_fraction) * self.mixture_density;
+            out[e.item] = e.multiplicity * e.model.power(k * w_in, rho);
+        }
+        let slide_oil = SlideOil {
+            dynamic_viscosity: op.oil.mu,
+            density: op.oil.rho,
+        };
+        for (e, f) in self.slide.iter().zip(&st.slide) {
+            let t1 = f[0] * op.input_torque;
+            let (w1, w2) = (f[1] * w_in, f[2] * w_in);
+            if t1 == 0.0 || (w1 == 0.0 && w2 == 0.0) {
+                // No load or no relative motion (e.g. a locked planetary set): no sliding loss.
+                out[e.item] = 0.0;
+                continue;
+            }
+            let p = match &e.model {
+                SlideModel::Detailed(m) => m.power(t1, w1, w2, slide_oil).total,
+                SlideModel::Iso14179(m, s) => {
+                    let mu = m.mu_mz(t1, w1, w2, slide_oil, s);
+                    m.closed_form_power(t1, w1, mu).total
+                }
+            };
+            out[e.item] = e.multiplicity * p;
+        }
+    }
+}
+
+/// Wet fraction of a mesh zone and the height of its pitch point (lowest orbit position for
+/// planetary meshes).
+fn mesh_zone(gb: &Gearbox, mi: usize) -> (f64, f64) {
+    let m = &gb.meshes[mi];
+    let (g1, g2) = (&gb.gears[m.gear1], &gb.gears[m.gear2]);
+    let geo = &m.geometry;
+    let level = gb.oil_level;
+    match m.set {
+        None => {
+            // Pitch point on the line of centres at r_w1 from gear 1's axis; the vertical offset
+            // of the axes is known, the horizontal is not needed.
+            let y = g1.centre_height + (g2.centre_height - g1.centre_height) * geo.r_w1 / geo.a_w;
+            // The mesh zone spans about one tooth height above and below the pitch point; its wet
+            // fraction is the share of that band below the oil surface (0.5 with the oil at the
+            // pitch point, as in an FZG box filled to the shaft centres).
+            let band = 2.25 * geo.mn;
+            (((level - (y - band)) / (2.0 * band)).clamp(0.0, 1.0), y)
+        }
+        Some(si) => {
+            // Set axis height and the radius of the circle the pitch point sweeps.
+            let set = &gb.planetary_sets[si];
+            let axis = set
+                .gears
+                .iter()
+                .find(|&&gi| gb.gears[gi].mount == GearMount::OnMember)
+                .map_or(g1.centre_height, |&gi| gb.gears[gi].centre_height);
+            let planet_low = |g: &crate::model::gearbox::Gear| axis - g.centre_height;
+            let r = match (g1.mount, g2.mount) {
+                // sun–planet: pitch point at r_w1 from the axis; planet–ring: at orbit + r_w1.
+                (GearMount::OnMember, _) => geo.r_w1,
+                (_, GearMount::OnMember) => planet_low(g1) + geo.r_w1,
+                // planet–planet: approximate by the mean of the two planets' orbits.
+                _ => 0.5 * (planet_low(g1) + planet_low(g2)),
+            };
+            (wet_fraction(axis, r, level), axis - r)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::wet_fraction;
+
+    #[test]
+    fn wet_fraction_of_a_circle() {
+        assert_eq!(wet_fraction(0.0, 1.0, -2.0), 0.0);
+        assert_eq!(wet_fraction(0.0, 1.0, 2.0), 1.0);
+        assert!((wet_fraction(0.0, 1.0, 0.0) - 0.5).abs() < 1e-15);
+        // level at the bottom quarter: cos t < −0.5 → t ∈ (2π/3, 4π/3): 1/3 of the circle.
+        assert!((wet_fraction(0.0, 1.0, -0.5) - 1.0 / 3.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,5 @@
+//! Scene compile: from a checked model (and a scenario) to flat, precomputed structures the
+//! solvers evaluate without strings, maps or allocation.
+pub mod losses;
+
+pub use losses::{LossItem, LossScene, OperatingPoint, SceneError, Skipped, Source};
