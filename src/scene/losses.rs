@@ -14,6 +14,10 @@ use crate::physics::losses::sliding::friction::Schlenk;
 use crate::physics::losses::sliding::{OilState as SlideOil, SlidingMesh, SlidingMeshInput};
 use crate::physics::oil::OilProperties;
 
+/// Transverse slices of a helical pocket (physics default 64, itself within 0.3 % of 256; 48 raises
+/// the AT6 pocketing loss by 0.5 % and compiles the scene in 0.39 s instead of 0.65 s).
+pub const HELIX_POCKET_SLICES: usize = 48;
+
 /// Heat source kind.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -257,8 +261,12 @@ impl LossScene {
                         face_width: g1.geometry.spec.b.min(g2.geometry.spec.b),
                         helix_angle: g1.geometry.spec.beta,
                     };
+                    let popts = crate::physics::losses::pocketing::PocketingOptions {
+                        discharge_coefficient: opt.discharge_coefficient,
+                        helix_slices: HELIX_POCKET_SLICES,
+                    };
                     let model =
-                        PocketingMesh::new(&input, opt.discharge_coefficient).map_err(|e| SceneError {
+                        PocketingMesh::with_options(&input, &popts).map_err(|e| SceneError {
                             what: format!("pocketing of mesh {}", m.name),
                             why: e.to_string(),
                         })?;
