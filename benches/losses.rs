@@ -44,7 +44,9 @@ fn bench(c: &mut Criterion) {
         });
     }
     let gb = model::load(&root.join("models/at6_lepelletier.toml")).expect("bundled model");
-    c.bench_function("compile loss scene at6_lepelletier", |b| b.iter(|| LossScene::compile(black_box(&gb))));
+    c.bench_function("compile loss scene at6_lepelletier", |b| {
+        b.iter(|| LossScene::compile(black_box(&gb)))
+    });
 }
 
 criterion_group!(benches, bench);

@@ -265,11 +265,10 @@ impl LossScene {
                         discharge_coefficient: opt.discharge_coefficient,
                         helix_slices: HELIX_POCKET_SLICES,
                     };
-                    let model =
-                        PocketingMesh::with_options(&input, &popts).map_err(|e| SceneError {
-                            what: format!("pocketing of mesh {}", m.name),
-                            why: e.to_string(),
-                        })?;
+                    let model = PocketingMesh::with_options(&input, &popts).map_err(|e| SceneError {
+                        what: format!("pocketing of mesh {}", m.name),
+                        why: e.to_string(),
+                    })?;
                     // Height of the pitch point; planets orbit, so the mesh point sweeps a circle.
                     let (wet, _) = mesh_zone(gb, mi);
                     pocket.push(PocketEntry {
