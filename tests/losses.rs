@@ -216,3 +216,49 @@ fn bad_operating_point_is_invalid_input() {
         );
     }
 }
+
+#[test]
+fn planets_are_in_equilibrium_and_the_input_pinion_drives() {
+    let root = root();
+    // FZG: the pinion (input) drives: the mesh torque on it opposes its rotation.
+    let fzg = model::load(&root.join("models/fzg_c.toml")).unwrap();
+    let t = fzg.mesh_torques(0)[0];
+    let w = fzg.gear_speeds(0)[0].relative;
+    assert!(t * w < 0.0, "pinion drives: mesh torque {t} vs speed {w}");
+    // AT6: the torques that all meshes apply to each planet sum to zero, in every gear state.
+    let gb = model::load(&root.join("models/at6_lepelletier.toml")).unwrap();
+    for si in 0..gb.gear_states.len() {
+        let torques = gb.mesh_torques(si);
+        for (pi, planet) in gb.gears.iter().enumerate() {
+            if !matches!(planet.mount, geartherm::model::gearbox::GearMount::Planet { .. }) {
+                continue;
+            }
+            let mut sum = 0.0;
+            let mut scale: f64 = 0.0;
+            for (m, t1) in gb.meshes.iter().zip(&torques) {
+                let z1 = gb.gears[m.gear1].geometry.z() as f64;
+                let z2 = gb.gears[m.gear2].geometry.z() as f64;
+                let internal = m.geometry.kind == geartherm::physics::geometry::MeshKind::Internal;
+                let t = if m.gear1 == pi {
+                    *t1
+                } else if m.gear2 == pi {
+                    if internal {
+                        -t1 * z2 / z1
+                    } else {
+                        t1 * z2 / z1
+                    }
+                } else {
+                    continue;
+                };
+                sum += t;
+                scale = scale.max(t.abs());
+            }
+            assert!(
+                sum.abs() <= 1e-9 * scale.max(1.0),
+                "state {} planet {}: {sum}",
+                gb.gear_states[si].name,
+                planet.name
+            );
+        }
+    }
+}

@@ -97,7 +97,10 @@ impl Gear {
 }
 
 /// Which constraint rows of a gear state carry a mesh's tooth force, and with what sign: the torque
-/// on gear 1 of the mesh (one planet's share) is `z1/planets · Σ sign·λ_row`.
+/// applied to gear 1 by the mesh (one planet's share) is `z1/planets · Σ sign·λ_row`. In the
+/// carrier frame an external mesh applies torques of equal sign to its gears (`T2 = T1·z2/z1`), an
+/// internal mesh opposite signs (`T2 = −T1·z2/z1`); each planet is in equilibrium, which fixes the
+/// signs along a planet chain (sun mesh +1, next mesh −1, ...).
 #[derive(Debug, Clone)]
 pub struct MeshLoadPath {
     /// (row index among the train's fixed rows, sign).
@@ -252,7 +255,8 @@ impl Gearbox {
             .collect()
     }
 
-    /// Torque on gear 1 of each mesh (one planet's mesh), per unit input torque, in a state.
+    /// Torque applied to gear 1 by each mesh (one planet's mesh), per unit input torque, in a state.
+    /// Gear 1 drives when this torque opposes its (carrier-frame) rotation.
     pub fn mesh_torques(&self, state: usize) -> Vec<f64> {
         let sol = &self.gear_states[state].solution;
         self.meshes

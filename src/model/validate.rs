@@ -358,7 +358,9 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
                     zr: z(ring),
                 });
                 gen.push((sun, pl, MeshKind::External, vec![(first_row, 1.0)]));
-                gen.push((pl, ring, MeshKind::Internal, vec![(first_row, 1.0)]));
+                // Signs: torque applied to gear 1 of each mesh (see MeshLoadPath); the planet is in
+                // equilibrium, so its ring mesh carries the opposite of its sun mesh.
+                gen.push((pl, ring, MeshKind::Internal, vec![(first_row, -1.0)]));
                 mounts[pl] = (
                     GearMount::Planet {
                         set: si,
@@ -379,7 +381,7 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
                     zr: z(ring),
                 });
                 gen.push((sun, inner, MeshKind::External, vec![(first_row, 1.0)]));
-                gen.push((inner, outer, MeshKind::External, vec![(first_row, 1.0)]));
+                gen.push((inner, outer, MeshKind::External, vec![(first_row, -1.0)]));
                 gen.push((outer, ring, MeshKind::Internal, vec![(first_row, 1.0)]));
                 mounts[inner] = (
                     GearMount::Planet {
@@ -408,9 +410,9 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
                 let (k1, k2) = (first_row, first_row + 1);
                 gen.push((ls, long, MeshKind::External, vec![(k1, 1.0)]));
                 gen.push((ss, short, MeshKind::External, vec![(k2, 1.0)]));
-                gen.push((short, long, MeshKind::External, vec![(k2, 1.0)]));
+                gen.push((short, long, MeshKind::External, vec![(k2, -1.0)]));
                 // The long pinion–ring mesh carries both rows' ring force: ring torque z_R(λ1 − λ2).
-                gen.push((long, ring, MeshKind::Internal, vec![(k1, 1.0), (k2, -1.0)]));
+                gen.push((long, ring, MeshKind::Internal, vec![(k1, -1.0), (k2, 1.0)]));
                 mounts[long] = (
                     GearMount::Planet {
                         set: si,

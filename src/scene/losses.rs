@@ -424,7 +424,9 @@ impl LossScene {
             density: op.oil.rho,
         };
         for (e, f) in self.slide.iter().zip(&st.slide) {
-            let t1 = f[0] * op.input_torque;
+            // The sliding model takes the torque gear 1 transmits (it drives when t1·ω1 > 0): the
+            // opposite of the torque the mesh applies to it.
+            let t1 = -f[0] * op.input_torque;
             let (w1, w2) = (f[1] * w_in, f[2] * w_in);
             if t1 == 0.0 || (w1 == 0.0 && w2 == 0.0) {
                 // No load or no relative motion (e.g. a locked planetary set): no sliding loss.
