@@ -355,24 +355,7 @@ mod tests {
     use super::*;
 
     fn spur_path(z: f64, m: f64, alpha: f64) -> ContactPath {
-        let rp = 0.5 * m * z;
-        let rb = rp * alpha.cos();
-        let inp = SlidingMeshInput {
-            base_radius1: rb,
-            base_radius2: rb,
-            operating_pressure_angle: alpha,
-            tip_radius1: rp + m,
-            tip_radius2: rp + m,
-            centre_distance: 2.0 * rp,
-            face_width: 0.02,
-            base_helix_angle: 0.0,
-            transverse_base_pitch: std::f64::consts::PI * m * alpha.cos(),
-            internal: false,
-            z1: z as u32,
-            z2: z as u32,
-            roughness_ra1: 0.5e-6,
-            roughness_ra2: 0.5e-6,
-        };
+        let inp = crate::physics::losses::sliding::cases::equal_pair(z as u32, m, alpha, 0.0, 0.5e-6);
         ContactPath::new(&inp).unwrap()
     }
 

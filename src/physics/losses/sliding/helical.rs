@@ -154,26 +154,9 @@ mod tests {
 
     /// Seed 003 helical example: z 30/30, m 3 mm (seed: R_p = m z/2), α 20°, β 33.5°, b 20 mm.
     fn seed_helical(beta: f64) -> (SlidingMeshInput, f64) {
-        let (m, z, alpha) = (0.003, 30.0, 20f64.to_radians());
-        let rp = 0.5 * m * z;
-        let rb = rp * alpha.cos();
-        let beta_b = (beta.tan() * alpha.cos()).atan();
-        let inp = SlidingMeshInput {
-            base_radius1: rb,
-            base_radius2: rb,
-            operating_pressure_angle: alpha,
-            tip_radius1: rp + m,
-            tip_radius2: rp + m,
-            centre_distance: 2.0 * rp,
-            face_width: 0.02,
-            base_helix_angle: beta_b,
-            transverse_base_pitch: std::f64::consts::PI * m * alpha.cos(),
-            internal: false,
-            z1: 30,
-            z2: 30,
-            roughness_ra1: 0.825e-6,
-            roughness_ra2: 0.825e-6,
-        };
+        let inp =
+            crate::physics::losses::sliding::cases::equal_pair(30, 0.003, 20f64.to_radians(), beta, 0.825e-6);
+        let beta_b = inp.base_helix_angle;
         (inp, beta_b)
     }
 

@@ -312,25 +312,7 @@ mod tests {
     /// Seed 003 example gear: z 30/30, m 3 mm (assumed for the spur case, given for the helical
     /// case), α 20°, standard addendum, b 20 mm, Ra 0.825 µm; β = helix angle at the pitch circle.
     fn seed_input(beta: f64) -> SlidingMeshInput {
-        let (m, z, alpha) = (0.003, 30.0, 20f64.to_radians());
-        let rp = 0.5 * m * z;
-        let rb = rp * alpha.cos();
-        SlidingMeshInput {
-            base_radius1: rb,
-            base_radius2: rb,
-            operating_pressure_angle: alpha,
-            tip_radius1: rp + m,
-            tip_radius2: rp + m,
-            centre_distance: 2.0 * rp,
-            face_width: 0.02,
-            base_helix_angle: (beta.tan() * alpha.cos()).atan(),
-            transverse_base_pitch: PI * m * alpha.cos(),
-            internal: false,
-            z1: 30,
-            z2: 30,
-            roughness_ra1: 0.825e-6,
-            roughness_ra2: 0.825e-6,
-        }
+        super::super::cases::equal_pair(30, 0.003, 20f64.to_radians(), beta, 0.825e-6)
     }
 
     /// Gear pair from (z, normal module, α_n, β, x, tip diameters), lengths in `unit` (1e-3 for mm).

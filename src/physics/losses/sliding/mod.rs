@@ -276,6 +276,36 @@ pub struct SlidingPower {
     pub mean_mu: f64,
 }
 
+/// Test fixtures shared by the sliding modules' tests.
+#[cfg(test)]
+pub(crate) mod cases {
+    use super::SlidingMeshInput;
+
+    /// Two equal gears, standard addendum, at the reference centre distance: z teeth, transverse
+    /// module `m`, pressure angle `alpha`, pitch-circle helix angle `beta`, b 20 mm, roughness `ra`.
+    /// Seed 003's example is `equal_pair(30, 0.003, 20°, β, 0.825e-6)`.
+    pub(crate) fn equal_pair(z: u32, m: f64, alpha: f64, beta: f64, ra: f64) -> SlidingMeshInput {
+        let rp = 0.5 * m * z as f64;
+        let rb = rp * alpha.cos();
+        SlidingMeshInput {
+            base_radius1: rb,
+            base_radius2: rb,
+            operating_pressure_angle: alpha,
+            tip_radius1: rp + m,
+            tip_radius2: rp + m,
+            centre_distance: 2.0 * rp,
+            face_width: 0.02,
+            base_helix_angle: (beta.tan() * alpha.cos()).atan(),
+            transverse_base_pitch: std::f64::consts::PI * m * alpha.cos(),
+            internal: false,
+            z1: z,
+            z2: z,
+            roughness_ra1: ra,
+            roughness_ra2: ra,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
