@@ -4,7 +4,9 @@
 //! `physics` is pure (SI units, no I/O); `model` reads and validates model files; the CLI lives in
 //! `src/main.rs` and `src/cli/`.
 
+pub mod cycle;
 pub mod model;
 pub mod physics;
 pub mod report;
 pub mod scene;
+pub mod solve;

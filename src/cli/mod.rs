@@ -5,6 +5,8 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 
+mod run;
+
 use geartherm::model::{self, Gearbox, ModelError};
 use geartherm::physics::oil::KELVIN_OFFSET;
 use geartherm::report::{info, losses};
@@ -13,7 +15,6 @@ use geartherm::scene::{LossScene, OperatingPoint};
 /// Exit code: invalid input (nothing written).
 pub const EXIT_INVALID: i32 = 1;
 /// Exit code: numerical failure.
-#[allow(dead_code)]
 pub const EXIT_NUMERICAL: i32 = 2;
 /// Exit code: I/O failure while writing outputs.
 pub const EXIT_IO: i32 = 3;
@@ -63,6 +64,9 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Drive-cycle transient: losses heat the thermal network; writes timeseries.csv and
+    /// summary.json into the output directory.
+    Run(run::RunArgs),
 }
 
 /// A failure with its exit code and message.
@@ -165,6 +169,15 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
                 print_json(&report)?;
             } else {
                 print!("{}", losses::to_text(&report));
+            }
+            Ok(())
+        }
+        Command::Run(args) => {
+            let outcome = run::run(&args)?;
+            if args.json {
+                print_json(&outcome.summary)?;
+            } else {
+                print!("{}", run::to_text(&outcome));
             }
             Ok(())
         }

@@ -213,10 +213,10 @@ pub struct Gearbox {
     pub sump_volume: Option<f64>,
     /// Loss models with their coefficients.
     pub losses: LossModels,
-    /// `[thermal]` section as written (reserved).
-    pub thermal: Option<toml::Table>,
-    /// `[vehicle]` section as written (reserved).
-    pub vehicle: Option<toml::Table>,
+    /// The thermal network (`[thermal]`), if the model has one.
+    pub thermal: Option<super::thermal::ThermalNetwork>,
+    /// The vehicle (`[vehicle]`), if the model has one.
+    pub vehicle: Option<crate::cycle::Vehicle>,
 }
 
 impl Gearbox {

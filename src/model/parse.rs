@@ -179,7 +179,7 @@ pub fn parse_model(text: &str, problems: &mut Problems) -> Option<ModelFile> {
     let train = section::<TrainSpec>(&mut table, "train", true, problems);
     let lubrication = section::<LubricationSpec>(&mut table, "lubrication", true, problems);
     let losses = section::<LossesSpec>(&mut table, "losses", false, problems);
-    let thermal = section::<Table>(&mut table, "thermal", false, problems);
+    let thermal = section::<super::thermal::ThermalSpec>(&mut table, "thermal", false, problems);
     let vehicle = section::<Table>(&mut table, "vehicle", false, problems);
     if problems.len() > before || !problems.is_empty() {
         return None;

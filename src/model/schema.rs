@@ -347,9 +347,9 @@ pub struct ModelFile {
     /// `[losses]` (reserved: loss-model choices).
     #[serde(default)]
     pub losses: Option<LossesSpec>,
-    /// `[thermal]` (reserved: thermal network; read by the transient issue).
+    /// `[thermal]`: the lumped thermal network.
     #[serde(default)]
-    pub thermal: Option<toml::Table>,
+    pub thermal: Option<super::thermal::ThermalSpec>,
     /// `[vehicle]` (reserved: vehicle and shift strategy; read by the transient issue).
     #[serde(default)]
     pub vehicle: Option<toml::Table>,

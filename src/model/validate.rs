@@ -12,6 +12,8 @@ use super::catalogue;
 use super::gearbox::*;
 use super::problems::Problems;
 use super::schema::*;
+use super::thermal::{validate_thermal, GearInfo};
+use crate::cycle::{GearTable, VehicleSpec};
 use crate::physics::geometry::{GearGeometry, GearSpec, MeshGeometry, MeshKind};
 use crate::physics::kinematics::{Constraint, GearTrain, KinematicsError};
 use crate::physics::oil::{Oil, WaltherVariant, ALPHA_T_MINERAL, CST};
@@ -765,6 +767,38 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         problems,
     );
 
+    let thermal = file.thermal.as_ref().and_then(|spec| {
+        let infos: Vec<GearInfo<'_>> = gears
+            .iter()
+            .map(|g: &Gear| GearInfo {
+                name: &g.name,
+                radius: 0.5 * g.geometry.d_a.max(g.geometry.d_f),
+                face_width: g.geometry.spec.b,
+            })
+            .collect();
+        let mesh_names: Vec<&str> = meshes.iter().map(|m| m.name.as_str()).collect();
+        validate_thermal(spec, &infos, &mesh_names, problems)
+    });
+
+    let vehicle = file.vehicle.as_ref().and_then(|table| {
+        let gt = GearTable::new(
+            gear_states
+                .iter()
+                .map(|g: &GearState| (g.name.clone(), g.ratio()))
+                .collect(),
+        );
+        let checked = VehicleSpec::from_table(table).and_then(|spec| spec.validate(&gt));
+        match checked {
+            Ok(v) => Some(v),
+            Err(list) => {
+                for p in list {
+                    problems.push(p.path, p.value, p.allowed);
+                }
+                None
+            }
+        }
+    });
+
     if problems.len() > start {
         return None;
     }
@@ -792,8 +826,8 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         oil_level: level,
         sump_volume: lub.sump_volume_l.map(|v| v * 1e-3),
         losses: losses?,
-        thermal: file.thermal.clone(),
-        vehicle: file.vehicle.clone(),
+        thermal,
+        vehicle,
     })
 }
 

@@ -3,3 +3,4 @@ pub mod geometry;
 pub mod kinematics;
 pub mod losses;
 pub mod oil;
+pub mod thermal;

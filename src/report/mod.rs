@@ -1,3 +1,5 @@
-//! Reports: text/JSON summaries and (later) CSV and PNG outputs.
+//! Reports: text/JSON summaries, run outputs (CSV, JSON) and PNG plots.
+pub mod files;
 pub mod info;
 pub mod losses;
+pub mod run;

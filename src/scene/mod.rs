@@ -1,5 +1,8 @@
 //! Scene compile: from a checked model (and a scenario) to flat, precomputed structures the
 //! solvers evaluate without strings, maps or allocation.
 pub mod losses;
+pub mod system;
+pub mod thermal;
 
 pub use losses::{LossItem, LossScene, OperatingPoint, SceneError, Skipped, Source};
+pub use system::{Inputs, RhsFailure, Scene, Work};

@@ -1,0 +1,216 @@
+//! `geartherm run`: a drive-cycle transient, written to `timeseries.csv` and `summary.json`.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+
+use geartherm::cycle::DriveCycle;
+use geartherm::model::{self, Gearbox};
+use geartherm::physics::oil::KELVIN_OFFSET;
+use geartherm::report::files::write_all_atomic;
+use geartherm::report::run::{summary, timeseries_csv, Summary};
+use geartherm::scene::Scene;
+use geartherm::solve::drive::{row_inputs, segments};
+use geartherm::solve::transient::{integrate, Method, Restart, Trajectory, TransientOptions};
+
+use super::{check_range, invalid, Failure, EXIT_IO, EXIT_NUMERICAL};
+
+/// Arguments of `run`.
+#[derive(clap::Args, Debug)]
+pub struct RunArgs {
+    /// Model file (TOML).
+    pub model: PathBuf,
+    /// Bundled cycle name (wltc, nedc, ftp75, udds, hwfet, us06, artemis_urban, artemis_road,
+    /// artemis_motorway130, artemis_motorway150) or a CSV file (vehicle or rig cycle).
+    #[arg(long, default_value = "wltc")]
+    pub cycle: String,
+    /// Output directory (default: runs/<model>_<cycle>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Solver: esdirk34 (default), tr-bdf2, bdf, tsit45.
+    #[arg(long, default_value = "esdirk34")]
+    pub solver: String,
+    /// Relative tolerance.
+    #[arg(long, default_value_t = geartherm::solve::transient::DEFAULT_RTOL)]
+    pub rtol: f64,
+    /// Absolute tolerance on temperatures, K.
+    #[arg(long, default_value_t = geartherm::solve::transient::DEFAULT_ATOL)]
+    pub atol: f64,
+    /// Initial temperature of every node, °C (default: the model's).
+    #[arg(long, allow_negative_numbers = true)]
+    pub initial_temp_c: Option<f64>,
+    /// Ambient temperature, °C (default: the model's ambient boundary).
+    #[arg(long, allow_negative_numbers = true)]
+    pub ambient_c: Option<f64>,
+    /// Freeze the oil properties at this temperature, °C (switches the viscosity feedback off).
+    #[arg(long, allow_negative_numbers = true)]
+    pub frozen_viscosity_c: Option<f64>,
+    /// Also write PNG plots and report.md.
+    #[arg(long)]
+    pub report: bool,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Print the summary as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Everything a finished run produced.
+pub struct RunOutcome {
+    /// Summary.
+    pub summary: Summary,
+    /// Output directory.
+    pub dir: PathBuf,
+}
+
+fn stem(p: &Path) -> String {
+    p.file_stem()
+        .map_or_else(|| "model".into(), |s| s.to_string_lossy().into_owned())
+}
+
+/// Load, check, compile: everything that can fail with exit 1.
+pub fn prepare(args: &RunArgs) -> Result<(Gearbox, Scene, DriveCycle, TransientOptions), Failure> {
+    let gb = model::load(&args.model)?;
+    let method = Method::parse(&args.solver).ok_or_else(|| {
+        invalid(format!(
+            "--solver {}: unknown; allowed: {}",
+            args.solver,
+            Method::ALL.map(|m| m.name()).join(", ")
+        ))
+    })?;
+    check_range("--rtol", args.rtol, 1e-14, 1e-1, "")?;
+    check_range("--atol", args.atol, 1e-14, 1.0, " K")?;
+    for (flag, v) in [
+        ("--initial-temp-c", args.initial_temp_c),
+        ("--ambient-c", args.ambient_c),
+        ("--frozen-viscosity-c", args.frozen_viscosity_c),
+    ] {
+        if let Some(v) = v {
+            check_range(flag, v, -60.0, 250.0, " °C")?;
+        }
+    }
+    let mut scene = Scene::compile(&gb).map_err(|e| invalid(format!("{}: {e}", args.model.display())))?;
+    if let Some(a) = args.ambient_c {
+        let idx = scene.thermal.ambient.ok_or_else(|| {
+            invalid(format!(
+                "--ambient-c: {} has no ambient boundary (name one `ambient` or set ambient = true)",
+                args.model.display()
+            ))
+        })?;
+        scene.thermal.set_boundary_fixed(idx, a + KELVIN_OFFSET);
+    }
+    scene.frozen_oil_temp = args.frozen_viscosity_c.map(|c| c + KELVIN_OFFSET);
+    let cycle = DriveCycle::resolve(&args.cycle).map_err(|e| invalid(format!("--cycle: {e}")))?;
+    let opts = TransientOptions {
+        method,
+        rtol: args.rtol,
+        atol: args.atol,
+        restart: Restart::AtJumps,
+        initial_temp: args.initial_temp_c.map(|c| c + KELVIN_OFFSET),
+        ..TransientOptions::default()
+    };
+    Ok((gb, scene, cycle, opts))
+}
+
+/// The whole command.
+pub fn run(args: &RunArgs) -> Result<RunOutcome, Failure> {
+    let (gb, scene, cycle, opts) = prepare(args)?;
+    let (sched, segs) =
+        segments(&gb, &cycle).map_err(|e| invalid(format!("{}: {e}", args.model.display())))?;
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("runs").join(format!("{}_{}", stem(&args.model), cycle.name)));
+
+    let bar = (!args.quiet && std::io::stderr().is_terminal()).then(|| {
+        let b = indicatif::ProgressBar::new(segs.len() as u64);
+        if let Ok(style) = indicatif::ProgressStyle::with_template(
+            "{spinner} {msg} [{bar:40}] {pos}/{len} s of cycle ({eta})",
+        ) {
+            b.set_style(style.progress_chars("=> "));
+        }
+        b.set_message(format!("{} on {}", gb.name, cycle.name));
+        b
+    });
+    let mut progress = |k: usize, _n: usize| {
+        if let Some(b) = &bar {
+            if k % 20 == 0 {
+                b.set_position(k as u64);
+            }
+        }
+    };
+    let result = integrate(&scene, &segs, &opts, &mut progress);
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let traj: Trajectory = result.map_err(|e| Failure {
+        code: EXIT_NUMERICAL,
+        message: format!("{}: {e}", args.model.display()),
+    })?;
+    let rows = row_inputs(&gb, &sched, &traj);
+    let sum = summary(
+        &scene,
+        &traj,
+        &rows,
+        &gb.name,
+        &cycle.name,
+        opts.method.name(),
+        opts.rtol,
+        opts.atol,
+    );
+    let work = std::cell::RefCell::new(scene.thermal.work());
+    let bt = |t: f64| {
+        let mut w = work.borrow_mut();
+        scene.thermal.boundary_temperatures(t, &mut w);
+        w.boundary_t.clone()
+    };
+    let csv = timeseries_csv(&scene, &traj, &rows, &bt);
+    let json = serde_json::to_string_pretty(&sum).map_err(|e| Failure {
+        code: EXIT_IO,
+        message: format!("cannot serialise the summary: {e}"),
+    })?;
+    write_all_atomic(
+        &dir,
+        &[
+            ("timeseries.csv", csv.as_bytes()),
+            ("summary.json", json.as_bytes()),
+        ],
+    )
+    .map_err(|e| Failure {
+        code: EXIT_IO,
+        message: format!("{}: cannot write outputs: {e}", dir.display()),
+    })?;
+    Ok(RunOutcome { summary: sum, dir })
+}
+
+/// Human-readable summary for stdout.
+pub fn to_text(o: &RunOutcome) -> String {
+    let s = &o.summary;
+    let mut t = String::new();
+    t.push_str(&format!(
+        "{} over {} ({:.0} s): {} in {:.3} s wall, {} steps, {} rejected, {} RHS evaluations\n",
+        s.model, s.cycle, s.duration_s, s.solver, s.wall_time_s, s.steps, s.stats.rejected, s.stats.rhs_evals
+    ));
+    let e = &s.energy_lost_j;
+    t.push_str(&format!(
+        "energy lost: churning {:.1} kJ, pocketing {:.2} kJ, sliding {:.1} kJ, total {:.1} kJ\n",
+        e.churning / 1e3,
+        e.pocketing / 1e3,
+        e.sliding / 1e3,
+        e.total / 1e3
+    ));
+    t.push_str(&format!(
+        "energy balance residual {:.2e} (relative); mean efficiency {}\n",
+        s.energy_balance_relative,
+        s.mean_efficiency.map_or("n/a".into(), |x| format!("{x:.4}"))
+    ));
+    t.push_str("temperatures, °C        min      max    final\n");
+    for (name, ts) in &s.temperatures_c {
+        t.push_str(&format!(
+            "  {name:<18} {:>8.2} {:>8.2} {:>8.2}\n",
+            ts.min, ts.max, ts.r#final
+        ));
+    }
+    t.push_str(&format!("outputs in {}\n", o.dir.display()));
+    t
+}

@@ -1,0 +1,198 @@
+//! Heat-transfer laws of the lumped thermal network: conduction/convection conductances,
+//! radiation, rotating-disc convection correlations and an oil cooler opened by a smooth
+//! thermostat. Pure functions in SI units (K, W, m, s); the network assembly lives in
+//! `scene::thermal`.
+
+/// Stefan–Boltzmann constant σ, W/(m²·K⁴) (CODATA 2018, exact).
+pub const STEFAN_BOLTZMANN: f64 = 5.670_374_419e-8;
+
+/// Radiation exchange between two surfaces: `Q = σ·ε·A·(T_a⁴ − T_b⁴)` (W, from a to b).
+///
+/// [std] Grey-body exchange with an effective emissivity ε (for a small body in a large enclosure,
+/// ε is the body's own emissivity; incropera §13.3).
+pub fn radiation_power(sigma_eps_area: f64, t_a: f64, t_b: f64) -> f64 {
+    sigma_eps_area * (t_a.powi(4) - t_b.powi(4))
+}
+
+/// ∂Q/∂T_a of [`radiation_power`] (the derivative to T_b is its negative with T_b): 4σεA·T_a³.
+pub fn radiation_derivative(sigma_eps_area: f64, t: f64) -> f64 {
+    4.0 * sigma_eps_area * t.powi(3)
+}
+
+/// Convection coefficient against vehicle speed, `h = h0 + h1·v^0.8` (W/m²K, v in m/s).
+///
+/// [recalled] The exponent 0.8 is that of turbulent forced convection over a plate
+/// (Nu ∝ Re^0.8, Incropera eq. 7.36); h0 covers natural convection and radiation at rest.
+pub fn h_power_law(h0: f64, h1: f64, speed: f64) -> f64 {
+    h0 + h1 * speed.max(0.0).powf(0.8)
+}
+
+/// Piecewise-linear table h(v), clamped to its end values outside the table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HTable {
+    speed: Vec<f64>,
+    h: Vec<f64>,
+}
+
+impl HTable {
+    /// Build from increasing speeds (m/s) and coefficients (W/m²K). The caller (model
+    /// validation) guarantees equal lengths ≥ 1 and strictly increasing speeds.
+    pub fn new(speed: Vec<f64>, h: Vec<f64>) -> Self {
+        Self { speed, h }
+    }
+
+    /// h at vehicle speed `v` (m/s).
+    pub fn at(&self, v: f64) -> f64 {
+        let (s, h) = (&self.speed, &self.h);
+        if s.len() == 1 || v <= s[0] {
+            return h[0];
+        }
+        let last = s.len() - 1;
+        if v >= s[last] {
+            return h[last];
+        }
+        let k = s.partition_point(|&x| x <= v).saturating_sub(1).min(last - 1);
+        let f = (v - s[k]) / (s[k + 1] - s[k]);
+        h[k] + f * (h[k + 1] - h[k])
+    }
+}
+
+/// Fluid properties for a convection correlation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FluidProperties {
+    /// Thermal conductivity, W/(m·K).
+    pub conductivity: f64,
+    /// Kinematic viscosity, m²/s.
+    pub kinematic_viscosity: f64,
+    /// Prandtl number.
+    pub prandtl: f64,
+}
+
+/// Dry air at 50 °C and 1 atm (Incropera table A.4, interpolated): k = 0.0280 W/mK,
+/// ν = 1.80e-5 m²/s, Pr = 0.703. Used for rotating parts in air (temperature dependence of
+/// air properties neglected: ±15 % over 0–100 °C, within the correlation's own scatter).
+pub const AIR_50C: FluidProperties = FluidProperties {
+    conductivity: 0.0280,
+    kinematic_viscosity: 1.80e-5,
+    prandtl: 0.703,
+};
+
+/// Thermal conductivity of gear oils and ATFs, W/(m·K) [recalled: 0.12–0.14 for mineral and
+/// PAO oils at 40–100 °C, e.g. Changenet et al. 2006]; taken constant.
+pub const OIL_CONDUCTIVITY: f64 = 0.13;
+
+/// Specific heat of gear oils, J/(kg·K) [recalled: 1.9–2.1 kJ/kgK at 40–100 °C]; used only for the
+/// Prandtl number of the rotating-part correlation in oil.
+pub const OIL_SPECIFIC_HEAT: f64 = 2000.0;
+
+/// Mean heat-transfer coefficient of a disc of radius `r` (m) rotating at `omega` (rad/s) in a
+/// fluid, W/m²K.
+///
+/// [recalled] Free rotating disc, mean Nusselt number Nu = h·r/k: laminar
+/// Nu_l = 0.36·Re^0.5 (Cobb & Saunders 1956, Re < 2.4e5), turbulent Nu_t = 0.015·Re^0.8
+/// (same source), Re = ω·r²/ν, with a Prandtl factor Pr^(1/3) (exact for air, an extension for
+/// oil). [derived] The two branches are blended as Nu = (Nu_l⁴ + Nu_t⁴)^(1/4) so that h is smooth
+/// in speed (no step at the transition; a discontinuous h would stall the stiff solver). At rest
+/// the correlation gives 0: natural convection is left to a fixed conductance in parallel.
+pub fn rotating_disc_h(omega: f64, radius: f64, fluid: &FluidProperties) -> f64 {
+    let re = omega.abs() * radius * radius / fluid.kinematic_viscosity;
+    let nu_l = 0.36 * re.sqrt();
+    let nu_t = 0.015 * re.powf(0.8);
+    let nu = (nu_l.powi(4) + nu_t.powi(4)).powf(0.25) * fluid.prandtl.cbrt();
+    nu * fluid.conductivity / radius
+}
+
+/// Opening of a thermostat valve at temperature `t` (K): 0 below `t_open`, 1 above `t_full`,
+/// and the C¹ smoothstep 3s² − 2s³ in between (s = (t − t_open)/(t_full − t_open)).
+///
+/// [derived] A smooth ramp instead of a switch: the cooler's heat flow and its derivative stay
+/// continuous, so the implicit solver's Newton iteration sees no step (physics.md §8).
+/// Returns (opening, d opening / dT).
+pub fn thermostat_opening(t: f64, t_open: f64, t_full: f64) -> (f64, f64) {
+    if t <= t_open {
+        (0.0, 0.0)
+    } else if t >= t_full {
+        (1.0, 0.0)
+    } else {
+        let w = t_full - t_open;
+        let s = (t - t_open) / w;
+        (s * s * (3.0 - 2.0 * s), 6.0 * s * (1.0 - s) / w)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn table_interpolates_and_clamps() {
+        let t = HTable::new(vec![0.0, 10.0, 30.0], vec![10.0, 30.0, 50.0]);
+        assert_eq!(t.at(-1.0), 10.0);
+        assert!((t.at(5.0) - 20.0).abs() < 1e-12);
+        assert!((t.at(20.0) - 40.0).abs() < 1e-12);
+        assert_eq!(t.at(10.0), 30.0);
+        assert_eq!(t.at(100.0), 50.0);
+        let one = HTable::new(vec![3.0], vec![7.0]);
+        assert_eq!(one.at(0.0), 7.0);
+        assert_eq!(one.at(9.0), 7.0);
+    }
+
+    #[test]
+    fn thermostat_is_c1_and_monotone() {
+        let (a, b) = (348.15, 358.15);
+        let mut last = -1.0;
+        for k in 0..=200 {
+            let t = a - 5.0 + 0.1 * f64::from(k);
+            let (x, dx) = thermostat_opening(t, a, b);
+            assert!((0.0..=1.0).contains(&x) && x >= last);
+            last = x;
+            let h = 1e-6;
+            let fd = (thermostat_opening(t + h, a, b).0 - thermostat_opening(t - h, a, b).0) / (2.0 * h);
+            assert!((fd - dx).abs() < 1e-6, "t={t} fd={fd} dx={dx}");
+        }
+        assert_eq!(thermostat_opening(0.5 * (a + b), a, b).0, 0.5);
+    }
+
+    #[test]
+    fn rotating_disc_limits_and_smoothness() {
+        // Far below the transition the blend equals the laminar law, far above the turbulent one.
+        let r = 0.1;
+        let nu = AIR_50C.kinematic_viscosity;
+        let pr = AIR_50C.prandtl.cbrt();
+        let omega_lo = 1e3 * nu / (r * r);
+        let h_lo = rotating_disc_h(omega_lo, r, &AIR_50C);
+        let lam = 0.36 * 1e3f64.sqrt() * pr * AIR_50C.conductivity / r;
+        assert!((h_lo / lam - 1.0).abs() < 1e-3);
+        let omega_hi = 1e8 * nu / (r * r);
+        let turb = 0.015 * 1e8f64.powf(0.8) * pr * AIR_50C.conductivity / r;
+        assert!((rotating_disc_h(omega_hi, r, &AIR_50C) / turb - 1.0).abs() < 1e-3);
+        // Monotone in speed, symmetric in direction.
+        let mut last = 0.0;
+        for k in 1..400 {
+            let w = f64::from(k) * 5.0;
+            let h = rotating_disc_h(w, r, &AIR_50C);
+            assert!(h > last);
+            last = h;
+            assert_eq!(h, rotating_disc_h(-w, r, &AIR_50C));
+        }
+    }
+
+    #[test]
+    fn radiation_derivative_matches_difference() {
+        let k = STEFAN_BOLTZMANN * 0.9 * 0.5;
+        let (ta, tb) = (360.0, 295.0);
+        let h = 1e-4;
+        let fd = (radiation_power(k, ta + h, tb) - radiation_power(k, ta - h, tb)) / (2.0 * h);
+        assert!((fd / radiation_derivative(k, ta) - 1.0).abs() < 1e-9);
+        // 0.5 m² at ε 0.9, 360 K to 295 K: about 210 W.
+        let q = radiation_power(k, ta, tb);
+        assert!(q > 200.0 && q < 220.0, "{q}");
+    }
+
+    #[test]
+    fn power_law_grows_with_speed() {
+        assert_eq!(h_power_law(12.0, 4.0, 0.0), 12.0);
+        assert!((h_power_law(12.0, 4.0, 10.0) - (12.0 + 4.0 * 10f64.powf(0.8))).abs() < 1e-12);
+        assert_eq!(h_power_law(12.0, 4.0, -3.0), 12.0);
+    }
+}

@@ -1,0 +1,286 @@
+//! Outputs of a transient run: `timeseries.csv` and `summary.json`.
+//!
+//! Column and key names are the contract the plots (`report::plots`) and users rely on; see
+//! docs/outputs.md.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use serde::Serialize;
+
+use crate::physics::oil::KELVIN_OFFSET;
+use crate::scene::{Scene, Skipped, Source};
+use crate::solve::transient::{energy_balance, Stats, Trajectory};
+
+/// Per-row context the solver does not know: vehicle speed, gear name, input speed and torque,
+/// output power.
+#[derive(Debug, Clone)]
+pub struct RowInputs {
+    /// Vehicle speed, km/h.
+    pub vehicle_speed_kmh: f64,
+    /// Gear-state name.
+    pub gear: String,
+    /// Input speed, rpm.
+    pub input_speed_rpm: f64,
+    /// Loss-free input torque, N·m.
+    pub input_torque_nm: f64,
+    /// Output power, W.
+    pub output_power_w: f64,
+}
+
+/// Energy of one loss item.
+#[derive(Debug, Clone, Serialize)]
+pub struct ItemEnergy {
+    /// Source.
+    pub source: Source,
+    /// Item name.
+    pub name: String,
+    /// Energy, J.
+    pub j: f64,
+}
+
+/// Min / max / final temperature of a node, °C.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct TempStats {
+    /// Minimum over the output rows.
+    pub min: f64,
+    /// Maximum.
+    pub max: f64,
+    /// Final.
+    pub r#final: f64,
+}
+
+/// A node listed in the summary.
+#[derive(Debug, Clone, Serialize)]
+pub struct NodeInfo {
+    /// Name.
+    pub name: String,
+    /// True for boundary nodes.
+    pub boundary: bool,
+}
+
+/// Energy per source, J.
+#[derive(Debug, Clone, Copy, Serialize, Default)]
+pub struct SourceEnergy {
+    /// Churning.
+    pub churning: f64,
+    /// Pocketing.
+    pub pocketing: f64,
+    /// Sliding.
+    pub sliding: f64,
+    /// Sum.
+    pub total: f64,
+}
+
+/// `summary.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct Summary {
+    /// Model name.
+    pub model: String,
+    /// Cycle name.
+    pub cycle: String,
+    /// Solver.
+    pub solver: String,
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Absolute tolerance on temperatures, K.
+    pub atol: f64,
+    /// Wall time of the integration, s.
+    pub wall_time_s: f64,
+    /// Accepted steps.
+    pub steps: usize,
+    /// All counters.
+    pub stats: Stats,
+    /// Cycle duration, s.
+    pub duration_s: f64,
+    /// Energy lost per source, J.
+    pub energy_lost_j: SourceEnergy,
+    /// Energy per item, J.
+    pub energy_by_item_j: Vec<ItemEnergy>,
+    /// Heat stored in the nodes, J.
+    pub energy_stored_j: f64,
+    /// Heat into boundaries (ambient, coolant), J.
+    pub energy_to_boundaries_j: f64,
+    /// |lost − stored − to boundaries| / max of the three.
+    pub energy_balance_relative: f64,
+    /// Output energy, J (positive output power integrated).
+    pub output_energy_j: f64,
+    /// Mean efficiency: output energy / (output energy + loss energy while driving).
+    pub mean_efficiency: Option<f64>,
+    /// Temperatures per node, °C.
+    pub temperatures_c: BTreeMap<String, TempStats>,
+    /// Nodes (capacity nodes then boundaries).
+    pub nodes: Vec<NodeInfo>,
+    /// Oil node.
+    pub oil_node: String,
+    /// What the scene left out and why.
+    pub skipped: Vec<Skipped>,
+    /// True when the oil properties were frozen (viscosity feedback off).
+    pub frozen_viscosity: bool,
+}
+
+/// Build the summary of a run.
+#[allow(clippy::too_many_arguments)]
+pub fn summary(
+    scene: &Scene,
+    traj: &Trajectory,
+    rows: &[RowInputs],
+    model: &str,
+    cycle: &str,
+    solver: &str,
+    rtol: f64,
+    atol: f64,
+) -> Summary {
+    let n = scene.nodes();
+    let m = scene.items();
+    let last = traj.states.last().cloned().unwrap_or_default();
+    let mut per_source = SourceEnergy::default();
+    let mut items = Vec::with_capacity(m);
+    for (k, it) in scene.losses.items.iter().enumerate() {
+        let j = last.get(n + k).copied().unwrap_or(0.0);
+        match it.source {
+            Source::Churning => per_source.churning += j,
+            Source::Pocketing => per_source.pocketing += j,
+            Source::Sliding => per_source.sliding += j,
+        }
+        items.push(ItemEnergy {
+            source: it.source,
+            name: it.name.clone(),
+            j,
+        });
+    }
+    per_source.total = per_source.churning + per_source.pocketing + per_source.sliding;
+    let bal = energy_balance(scene, traj);
+
+    // Output energy and the loss energy while driving (positive output power), by the trapezoidal
+    // rule over each segment with its constant inputs: the output power is constant per segment,
+    // and the loss energy while driving comes from the exact per-item energies' increments.
+    let mut out_e = 0.0;
+    let mut loss_drive = 0.0;
+    for k in 0..traj.times.len().saturating_sub(1) {
+        let p = rows[k].output_power_w;
+        if p > 0.0 {
+            let dt = traj.times[k + 1] - traj.times[k];
+            out_e += p * dt;
+            let e1: f64 = traj.states[k + 1][n..n + m].iter().sum();
+            let e0: f64 = traj.states[k][n..n + m].iter().sum();
+            loss_drive += e1 - e0;
+        }
+    }
+    let mean_eff = (out_e > 0.0).then(|| out_e / (out_e + loss_drive));
+
+    let mut temps = BTreeMap::new();
+    for i in 0..n {
+        let series = traj.states.iter().map(|y| y[i] - KELVIN_OFFSET);
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for v in series {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+        temps.insert(
+            scene.thermal.names[i].clone(),
+            TempStats {
+                min: lo,
+                max: hi,
+                r#final: last.get(i).map_or(f64::NAN, |t| t - KELVIN_OFFSET),
+            },
+        );
+    }
+    let mut nodes: Vec<NodeInfo> = scene
+        .thermal
+        .names
+        .iter()
+        .map(|x| NodeInfo {
+            name: x.clone(),
+            boundary: false,
+        })
+        .collect();
+    nodes.extend(scene.thermal.boundary_names.iter().map(|x| NodeInfo {
+        name: x.clone(),
+        boundary: true,
+    }));
+    Summary {
+        model: model.to_string(),
+        cycle: cycle.to_string(),
+        solver: solver.to_string(),
+        rtol,
+        atol,
+        wall_time_s: traj.wall_time_s,
+        steps: traj.stats.steps,
+        stats: traj.stats,
+        duration_s: traj.times.last().copied().unwrap_or(0.0) - traj.times.first().copied().unwrap_or(0.0),
+        energy_lost_j: per_source,
+        energy_by_item_j: items,
+        energy_stored_j: bal.stored,
+        energy_to_boundaries_j: bal.to_boundaries,
+        energy_balance_relative: bal.relative,
+        output_energy_j: out_e,
+        mean_efficiency: mean_eff,
+        temperatures_c: temps,
+        nodes,
+        oil_node: scene.thermal.names[scene.thermal.oil].clone(),
+        skipped: scene.skipped.clone(),
+        frozen_viscosity: scene.frozen_oil_temp.is_some(),
+    }
+}
+
+fn num(s: &mut String, v: f64) {
+    if v.is_finite() {
+        let _ = write!(s, "{v}");
+    }
+}
+
+/// `timeseries.csv` text: one row per output time. `boundary_temps(t)` gives the boundary
+/// temperatures (K) at time t.
+pub fn timeseries_csv(
+    scene: &Scene,
+    traj: &Trajectory,
+    rows: &[RowInputs],
+    boundary_temps: &dyn Fn(f64) -> Vec<f64>,
+) -> String {
+    let n = scene.nodes();
+    let mut s = String::with_capacity(traj.times.len() * 64 * (n + scene.items() + 10));
+    s.push_str("time_s,vehicle_speed_kmh,gear,input_speed_rpm,input_torque_nm,output_power_w");
+    for name in scene.thermal.names.iter().chain(&scene.thermal.boundary_names) {
+        let _ = write!(s, ",temp_{name}_c");
+    }
+    for it in &scene.losses.items {
+        let _ = write!(s, ",loss_{}_{}_w", it.source.as_str(), it.name);
+    }
+    s.push_str(",churning_w,pocketing_w,sliding_w,total_loss_w,efficiency\n");
+    for (k, t) in traj.times.iter().enumerate() {
+        let r = &rows[k];
+        let y = &traj.states[k];
+        let _ = write!(
+            s,
+            "{t},{},{},{},{},{}",
+            r.vehicle_speed_kmh, r.gear, r.input_speed_rpm, r.input_torque_nm, r.output_power_w
+        );
+        for v in y.iter().take(n) {
+            s.push(',');
+            num(&mut s, v - KELVIN_OFFSET);
+        }
+        for v in boundary_temps(*t) {
+            s.push(',');
+            num(&mut s, v - KELVIN_OFFSET);
+        }
+        let mut by = [0.0; 3];
+        for (q, it) in traj.losses[k].iter().zip(&scene.losses.items) {
+            s.push(',');
+            num(&mut s, *q);
+            by[match it.source {
+                Source::Churning => 0,
+                Source::Pocketing => 1,
+                Source::Sliding => 2,
+            }] += q;
+        }
+        let total = by[0] + by[1] + by[2];
+        let _ = write!(s, ",{},{},{},{}", by[0], by[1], by[2], total);
+        s.push(',');
+        if r.output_power_w > 0.0 {
+            num(&mut s, r.output_power_w / (r.output_power_w + total));
+        }
+        s.push('\n');
+    }
+    s
+}

@@ -1,0 +1,319 @@
+//! The whole compiled scene: loss items feeding the thermal network, as one ODE right-hand side
+//! `dy/dt = f(t, y)` with its Jacobian–vector product.
+//!
+//! State layout: `y = [T_1 … T_n (K) | E_1 … E_m (J, energy of each loss item) | E_b (J, heat
+//! into boundaries)]`. The energies are quadratures (their columns of the Jacobian are zero), so
+//! `Σ C_i ΔT_i + E_b − Σ E_k = 0` is a linear invariant the integrators preserve to round-off:
+//! the energy balance checks the assembly, not the integration error.
+//!
+//! Losses depend on the temperatures only through the oil node (ν, ρ of the oil). The Jacobian is
+//! analytic for the network and a one-sided finite difference in T_oil for the losses (and any
+//! rotating-part-in-oil link), evaluated once per Jacobian (cached on T_oil and the sample).
+
+use crate::model::gearbox::Gearbox;
+use crate::physics::oil::OilProperties;
+
+use super::losses::{LossScene, OperatingPoint, SceneError, Skipped};
+use super::thermal::{NetworkWork, Operating, ThermalScene};
+
+/// Inputs that hold during one cycle interval.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Inputs {
+    /// Gear-state index.
+    pub state: usize,
+    /// Gearbox input speed, rad/s.
+    pub input_speed: f64,
+    /// Loss-free input torque, N·m.
+    pub input_torque: f64,
+    /// Vehicle speed, m/s.
+    pub vehicle_speed: f64,
+}
+
+/// What went wrong inside the right-hand side (reported when the solver gives up).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RhsFailure {
+    /// Time, s.
+    pub time: f64,
+    /// Node concerned.
+    pub node: String,
+    /// Loss item concerned, if any.
+    pub item: Option<String>,
+    /// What happened.
+    pub what: String,
+}
+
+/// The compiled scene.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// Loss items.
+    pub losses: LossScene,
+    /// Thermal network.
+    pub thermal: ThermalScene,
+    /// What the compile step left out and why.
+    pub skipped: Vec<Skipped>,
+    /// Oil temperature used for the oil properties instead of the oil node's (K); `None` for the
+    /// normal coupled model. Used to measure the viscosity feedback.
+    pub frozen_oil_temp: Option<f64>,
+}
+
+/// Mutable work area of one solve: current inputs, sample values and buffers. No allocation after
+/// creation.
+#[derive(Debug, Clone)]
+pub struct Work {
+    /// Current inputs.
+    pub inputs: Inputs,
+    /// Network per-sample values.
+    pub net: NetworkWork,
+    /// Loss of each item at the last evaluation, W.
+    pub q: Vec<f64>,
+    heat: Vec<f64>,
+    q2: Vec<f64>,
+    heat2: Vec<f64>,
+    /// ∂f/∂T_oil for the whole state (column of the Jacobian), cached.
+    oil_col: Vec<f64>,
+    col_key: Option<(u64, u64)>,
+    sample_id: u64,
+    /// Right-hand-side evaluations.
+    pub rhs_evals: usize,
+    /// Jacobian column evaluations (finite differences in T_oil).
+    pub jac_evals: usize,
+    /// Last failure seen inside the right-hand side.
+    pub failure: Option<RhsFailure>,
+}
+
+impl Scene {
+    /// Compile the scene of a gearbox with a thermal network.
+    pub fn compile(gb: &Gearbox) -> Result<Scene, SceneError> {
+        let net = gb.thermal.as_ref().ok_or_else(|| SceneError {
+            what: "thermal network".into(),
+            why: "the model has no [thermal] section; a transient or steady run needs one".into(),
+        })?;
+        let losses = LossScene::compile(gb)?;
+        let thermal = ThermalScene::compile(gb, net, &losses.items);
+        let skipped = losses.skipped.clone();
+        Ok(Scene {
+            losses,
+            thermal,
+            skipped,
+            frozen_oil_temp: None,
+        })
+    }
+
+    /// Number of capacity nodes.
+    pub fn nodes(&self) -> usize {
+        self.thermal.len()
+    }
+
+    /// Number of loss items.
+    pub fn items(&self) -> usize {
+        self.losses.len()
+    }
+
+    /// Length of the state vector.
+    pub fn n_states(&self) -> usize {
+        self.nodes() + self.items() + 1
+    }
+
+    /// Initial state: node temperatures (K), zero energies. `initial_temp` overrides every node.
+    pub fn initial_state(&self, initial_temp: Option<f64>) -> Vec<f64> {
+        let mut y = vec![0.0; self.n_states()];
+        for (x, t) in y.iter_mut().zip(&self.thermal.initial) {
+            *x = initial_temp.unwrap_or(*t);
+        }
+        y
+    }
+
+    /// A fresh work area with the given inputs.
+    pub fn work(&self, inputs: Inputs) -> Work {
+        let n = self.nodes();
+        let m = self.items();
+        let mut w = Work {
+            inputs,
+            net: self.thermal.work(),
+            q: vec![0.0; m],
+            heat: vec![0.0; n],
+            q2: vec![0.0; m],
+            heat2: vec![0.0; n],
+            oil_col: vec![0.0; n + m + 1],
+            col_key: None,
+            sample_id: 0,
+            rhs_evals: 0,
+            jac_evals: 0,
+            failure: None,
+        };
+        self.set_inputs(inputs, &mut w);
+        w
+    }
+
+    fn operating(inputs: &Inputs) -> Operating {
+        Operating {
+            state: inputs.state,
+            input_speed: inputs.input_speed,
+            vehicle_speed: inputs.vehicle_speed,
+        }
+    }
+
+    /// Switch to new inputs (a new cycle interval): per-sample conductances are recomputed here.
+    pub fn set_inputs(&self, inputs: Inputs, work: &mut Work) {
+        work.inputs = inputs;
+        work.sample_id = work.sample_id.wrapping_add(1);
+        self.thermal
+            .sample_conductances(&Self::operating(&inputs), &mut work.net);
+    }
+
+    /// Oil temperature (K) that sets the oil properties.
+    pub fn oil_temp(&self, y: &[f64]) -> f64 {
+        self.frozen_oil_temp.unwrap_or(y[self.thermal.oil])
+    }
+
+    /// Evaluate every loss item (W) at state `y` into `work.q` (also used for output).
+    pub fn evaluate_losses(&self, y: &[f64], work: &mut Work) {
+        let oil = self.thermal.oil_properties(self.oil_temp(y));
+        let op = self.op(&work.inputs, oil);
+        self.losses.evaluate(&op, &mut work.q);
+    }
+
+    fn op(&self, inputs: &Inputs, oil: OilProperties) -> OperatingPoint {
+        OperatingPoint {
+            state: inputs.state,
+            input_speed: inputs.input_speed,
+            input_torque: inputs.input_torque,
+            oil,
+        }
+    }
+
+    /// Terms that depend on T_oil (losses to nodes, rotating-part-in-oil links) at oil
+    /// temperature `t_oil`, plus the rest of the network: net heat per node into `heat`, loss per
+    /// item into `q`; returns the heat into boundaries.
+    fn heat_balance(
+        &self,
+        y: &[f64],
+        t_oil: f64,
+        inputs: &Inputs,
+        net: &NetworkWork,
+        q: &mut [f64],
+        heat: &mut [f64],
+    ) -> f64 {
+        let n = self.nodes();
+        let oil = self.thermal.oil_properties(t_oil);
+        self.losses.evaluate(&self.op(inputs, oil), q);
+        let to_b = self
+            .thermal
+            .network_heat(&y[..n], &oil, &Self::operating(inputs), net, heat);
+        for (qk, dest) in q.iter().zip(&self.thermal.heat) {
+            for &(node, f) in dest {
+                heat[node] += f * qk;
+            }
+        }
+        to_b
+    }
+
+    /// Right-hand side `dy = f(t, y)`. Allocation-free. A non-finite value is recorded in
+    /// `work.failure` (time, node, item) and propagates as NaN so the solver rejects the step.
+    pub fn rhs(&self, t: f64, y: &[f64], work: &mut Work, dy: &mut [f64]) {
+        work.rhs_evals += 1;
+        let n = self.nodes();
+        let m = self.items();
+        self.thermal.boundary_temperatures(t, &mut work.net);
+        let t_oil = self.oil_temp(y);
+        let to_b = self.heat_balance(y, t_oil, &work.inputs, &work.net, &mut work.q, &mut work.heat);
+        for i in 0..n {
+            dy[i] = work.heat[i] / self.thermal.capacity[i];
+        }
+        dy[n..n + m].copy_from_slice(&work.q);
+        dy[n + m] = to_b;
+        if !dy.iter().all(|v| v.is_finite()) {
+            work.failure = Some(self.diagnose(t, y, &work.q));
+        }
+    }
+
+    /// Name what is non-finite: a loss item, else a node.
+    fn diagnose(&self, t: f64, y: &[f64], q: &[f64]) -> RhsFailure {
+        let n = self.nodes();
+        let oil_name = self.thermal.names[self.thermal.oil].clone();
+        if let Some(k) = q.iter().position(|v| !v.is_finite()) {
+            let it = &self.losses.items[k];
+            return RhsFailure {
+                time: t,
+                node: oil_name,
+                item: Some(format!("{}:{}", it.source.as_str(), it.name)),
+                what: format!(
+                    "loss is {} at oil temperature {:.3} °C",
+                    q[k],
+                    self.oil_temp(y) - crate::physics::oil::KELVIN_OFFSET
+                ),
+            };
+        }
+        let i = y[..n]
+            .iter()
+            .position(|v| !v.is_finite())
+            .unwrap_or(self.thermal.oil);
+        RhsFailure {
+            time: t,
+            node: self.thermal.names[i].clone(),
+            item: None,
+            what: format!("temperature is {}", y[i]),
+        }
+    }
+
+    /// Jacobian–vector product `out = J(t, y)·v`. Allocation-free.
+    pub fn jvp(&self, t: f64, y: &[f64], v: &[f64], work: &mut Work, out: &mut [f64]) {
+        let n = self.nodes();
+        let m = self.items();
+        self.thermal.boundary_temperatures(t, &mut work.net);
+        let oil_i = self.thermal.oil;
+        let t_oil = self.oil_temp(y);
+        let oil = self.thermal.oil_properties(t_oil);
+        let to_b = self.thermal.network_heat_jvp(
+            &y[..n],
+            &oil,
+            &Self::operating(&work.inputs),
+            &work.net,
+            &v[..n],
+            &mut work.heat,
+        );
+        for i in 0..n {
+            out[i] = work.heat[i] / self.thermal.capacity[i];
+        }
+        out[n..n + m].iter_mut().for_each(|x| *x = 0.0);
+        out[n + m] = to_b;
+        if self.frozen_oil_temp.is_some() || v[oil_i] == 0.0 {
+            return;
+        }
+        // ∂f/∂T_oil through the oil properties, by a forward difference, cached per (T_oil, sample).
+        let key = (t_oil.to_bits(), work.sample_id);
+        if work.col_key != Some(key) {
+            work.jac_evals += 1;
+            let h = 1e-4 * (1.0 + t_oil.abs() / 300.0);
+            let inputs = work.inputs;
+            let b0 = self.heat_balance(y, t_oil, &inputs, &work.net, &mut work.q2, &mut work.heat2);
+            work.oil_col[..n].copy_from_slice(&work.heat2);
+            work.oil_col[n..n + m].copy_from_slice(&work.q2);
+            work.oil_col[n + m] = b0;
+            // Only the oil properties move (t_oil + h); the node temperatures stay those of y, whose
+            // effect is the analytic part above.
+            let b1 = self.heat_balance(y, t_oil + h, &inputs, &work.net, &mut work.q2, &mut work.heat2);
+            for i in 0..n {
+                work.oil_col[i] = (work.heat2[i] - work.oil_col[i]) / h / self.thermal.capacity[i];
+            }
+            for k in 0..m {
+                work.oil_col[n + k] = (work.q2[k] - work.oil_col[n + k]) / h;
+            }
+            work.oil_col[n + m] = (b1 - work.oil_col[n + m]) / h;
+            work.col_key = Some(key);
+        }
+        let s = v[oil_i];
+        for (o, c) in out.iter_mut().zip(&work.oil_col) {
+            *o += c * s;
+        }
+    }
+
+    /// Heat flow into each node (W) and into boundaries at state `y` with the current inputs (for
+    /// the steady-state residual). `heat` has length [`Self::nodes`].
+    pub fn net_heat(&self, t: f64, y: &[f64], work: &mut Work, heat: &mut [f64]) -> f64 {
+        self.thermal.boundary_temperatures(t, &mut work.net);
+        let t_oil = self.oil_temp(y);
+        let inputs = work.inputs;
+        self.heat_balance(y, t_oil, &inputs, &work.net, &mut work.q, heat)
+    }
+}

@@ -1,0 +1,479 @@
+//! The thermal part of a compiled scene: the network as flat arrays, split by what its terms
+//! depend on, so that each is computed only as often as it changes:
+//!
+//! - constant conductances (conduction, fixed-h convection): once per scene;
+//! - conductances that depend on the operating point only (h(v) tables and laws, rotating parts in
+//!   air): once per cycle sample ([`ThermalScene::sample_conductances`]);
+//! - terms that depend on the temperatures (losses through ν(T_oil), rotating parts in oil,
+//!   radiation, thermostat coolers): at every right-hand-side call.
+
+use crate::model::gearbox::{GearMount, Gearbox};
+use crate::model::thermal::{BoundaryTemp, Fluid, HeatTarget, LinkLaw, NodeRef, ThermalNetwork};
+use crate::physics::oil::{Oil, OilProperties};
+use crate::physics::thermal::{
+    h_power_law, radiation_derivative, radiation_power, rotating_disc_h, thermostat_opening, FluidProperties,
+    HTable, AIR_50C, OIL_CONDUCTIVITY, OIL_SPECIFIC_HEAT,
+};
+
+use super::losses::{LossItem, Source};
+
+/// Endpoint of a compiled link: a state (capacity node) or a boundary.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum End {
+    /// Capacity node index.
+    Node(usize),
+    /// Boundary index.
+    Boundary(usize),
+}
+
+impl From<NodeRef> for End {
+    fn from(r: NodeRef) -> Self {
+        match r {
+            NodeRef::Node(i) => End::Node(i),
+            NodeRef::Boundary(i) => End::Boundary(i),
+        }
+    }
+}
+
+/// A conductance between two ends.
+#[derive(Debug, Clone)]
+struct Conductance {
+    a: End,
+    b: End,
+    g: f64,
+}
+
+/// A conductance that depends on the operating point (vehicle speed or gear speed).
+#[derive(Debug, Clone)]
+enum SampleLaw {
+    Table {
+        area: f64,
+        table: HTable,
+    },
+    Law {
+        area: f64,
+        h0: f64,
+        h1: f64,
+    },
+    RotatingAir {
+        area: f64,
+        radius: f64,
+        speed_per_input: Vec<f64>,
+    },
+}
+
+#[derive(Debug, Clone)]
+struct SampleLink {
+    a: End,
+    b: End,
+    law: SampleLaw,
+}
+
+/// A rotating part in oil: h depends on the gear speed and on ν(T_oil).
+#[derive(Debug, Clone)]
+struct OilLink {
+    a: End,
+    b: End,
+    area: f64,
+    radius: f64,
+    speed_per_input: Vec<f64>,
+}
+
+#[derive(Debug, Clone)]
+struct Radiation {
+    a: End,
+    b: End,
+    k: f64,
+}
+
+#[derive(Debug, Clone)]
+struct CoolerTerm {
+    hot: usize,
+    cold: End,
+    g: f64,
+    thermostat: Option<(f64, f64)>,
+}
+
+/// What the network needs of the operating point during one cycle interval.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Operating {
+    /// Gear-state index.
+    pub state: usize,
+    /// Gearbox input speed, rad/s.
+    pub input_speed: f64,
+    /// Vehicle speed, m/s (for h(v)).
+    pub vehicle_speed: f64,
+}
+
+/// The compiled thermal network.
+#[derive(Debug, Clone)]
+pub struct ThermalScene {
+    /// Capacity-node names.
+    pub names: Vec<String>,
+    /// Boundary names.
+    pub boundary_names: Vec<String>,
+    /// Heat capacities, J/K.
+    pub capacity: Vec<f64>,
+    /// Initial temperatures, K.
+    pub initial: Vec<f64>,
+    /// Oil node.
+    pub oil: usize,
+    /// Ambient boundary, if any.
+    pub ambient: Option<usize>,
+    /// Heat destination of every loss item: (node, fraction).
+    pub heat: Vec<Vec<(usize, f64)>>,
+    boundaries: Vec<BoundaryTemp>,
+    fixed: Vec<Conductance>,
+    sample: Vec<SampleLink>,
+    oil_links: Vec<OilLink>,
+    radiation: Vec<Radiation>,
+    coolers: Vec<CoolerTerm>,
+    oil_model: Oil,
+}
+
+/// Buffers and per-sample values of the network (one per solver; no allocation when used).
+#[derive(Debug, Clone)]
+pub struct NetworkWork {
+    /// Conductances of the operating-point-dependent links for the current sample, W/K.
+    pub sample_g: Vec<f64>,
+    /// Boundary temperatures at the current time, K.
+    pub boundary_t: Vec<f64>,
+}
+
+impl ThermalScene {
+    /// Compile the network of `gb` for the loss items `items`.
+    pub fn compile(gb: &Gearbox, net: &ThermalNetwork, items: &[LossItem]) -> ThermalScene {
+        let n = net.nodes.len();
+        let names = net.nodes.iter().map(|x| x.name.clone()).collect();
+        let capacity = net.nodes.iter().map(|x| x.capacity).collect();
+        let initial = net
+            .nodes
+            .iter()
+            .map(|x| x.initial_temp.unwrap_or(net.initial_temp))
+            .collect();
+        // Speed of each gear relative to the surrounding fluid, per unit input speed: the spin for
+        // planets (the oil/air in a carrier rotates roughly with it), the absolute speed otherwise.
+        let speeds_abs: Vec<Vec<f64>> = (0..gb.gear_states.len())
+            .map(|s| {
+                gb.gear_speeds(s)
+                    .iter()
+                    .zip(&gb.gears)
+                    .map(|(w, g)| match g.mount {
+                        GearMount::Planet { .. } => w.relative,
+                        GearMount::OnMember => w.absolute,
+                    })
+                    .collect()
+            })
+            .collect();
+        let per_state = |gear: usize| -> Vec<f64> { speeds_abs.iter().map(|s| s[gear].abs()).collect() };
+        let mut fixed = Vec::new();
+        let mut sample = Vec::new();
+        let mut oil_links = Vec::new();
+        let mut radiation = Vec::new();
+        for l in &net.links {
+            let (a, b) = (End::from(l.a), End::from(l.b));
+            match &l.law {
+                LinkLaw::Conductance(g) => fixed.push(Conductance { a, b, g: *g }),
+                LinkLaw::Convection { area, h } => fixed.push(Conductance { a, b, g: area * h }),
+                LinkLaw::Table { area, table } => sample.push(SampleLink {
+                    a,
+                    b,
+                    law: SampleLaw::Table {
+                        area: *area,
+                        table: table.clone(),
+                    },
+                }),
+                LinkLaw::Law { area, h0, h1 } => sample.push(SampleLink {
+                    a,
+                    b,
+                    law: SampleLaw::Law {
+                        area: *area,
+                        h0: *h0,
+                        h1: *h1,
+                    },
+                }),
+                LinkLaw::Rotating {
+                    area,
+                    gear,
+                    radius,
+                    fluid,
+                } => match fluid {
+                    Fluid::Air => sample.push(SampleLink {
+                        a,
+                        b,
+                        law: SampleLaw::RotatingAir {
+                            area: *area,
+                            radius: *radius,
+                            speed_per_input: per_state(*gear),
+                        },
+                    }),
+                    Fluid::Oil => oil_links.push(OilLink {
+                        a,
+                        b,
+                        area: *area,
+                        radius: *radius,
+                        speed_per_input: per_state(*gear),
+                    }),
+                },
+                LinkLaw::Radiation(k) => radiation.push(Radiation { a, b, k: *k }),
+            }
+        }
+        let coolers = net
+            .coolers
+            .iter()
+            .filter_map(|c| match c.hot {
+                NodeRef::Node(h) => Some(CoolerTerm {
+                    hot: h,
+                    cold: c.cold.into(),
+                    g: c.conductance,
+                    thermostat: c.thermostat,
+                }),
+                NodeRef::Boundary(_) => None,
+            })
+            .collect();
+
+        // Heat destinations: defaults, then source rules, then item rules.
+        let body = |gear: usize| -> usize {
+            net.nodes
+                .iter()
+                .position(|x| x.gears.contains(&gear))
+                .unwrap_or(net.oil_node)
+        };
+        let heat = items
+            .iter()
+            .map(|it| {
+                let key = format!("{}:{}", it.source.as_str(), it.name);
+                let rule = net
+                    .heat
+                    .iter()
+                    .rev()
+                    .find(|r| r.target == HeatTarget::Item(key.clone()))
+                    .or_else(|| {
+                        net.heat
+                            .iter()
+                            .rev()
+                            .find(|r| r.target == HeatTarget::Source(it.source.as_str().to_string()))
+                    });
+                let mut to: Vec<(usize, f64)> = match rule {
+                    Some(r) => r.to.clone(),
+                    None => match it.source {
+                        Source::Churning | Source::Pocketing => vec![(net.oil_node, 1.0)],
+                        Source::Sliding => it.gears.iter().map(|&(g, f)| (body(g), f)).collect(),
+                    },
+                };
+                // Merge duplicates (both gears in one node).
+                to.sort_by_key(|x| x.0);
+                to.dedup_by(|x, y| {
+                    if x.0 == y.0 {
+                        y.1 += x.1;
+                        true
+                    } else {
+                        false
+                    }
+                });
+                to.retain(|x| x.1 != 0.0);
+                to
+            })
+            .collect();
+        debug_assert!(net.oil_node < n);
+        ThermalScene {
+            names,
+            boundary_names: net.boundaries.iter().map(|b| b.name.clone()).collect(),
+            capacity,
+            initial,
+            oil: net.oil_node,
+            ambient: net.ambient(),
+            heat,
+            boundaries: net.boundaries.iter().map(|b| b.temp.clone()).collect(),
+            fixed,
+            sample,
+            oil_links,
+            radiation,
+            coolers,
+            oil_model: gb.oil.clone(),
+        }
+    }
+
+    /// Number of capacity nodes.
+    pub fn len(&self) -> usize {
+        self.capacity.len()
+    }
+
+    /// True when the network has no capacity node (never, for a validated network).
+    pub fn is_empty(&self) -> bool {
+        self.capacity.is_empty()
+    }
+
+    /// The oil model.
+    pub fn oil_model(&self) -> &Oil {
+        &self.oil_model
+    }
+
+    /// Oil properties at temperature `t` (K).
+    pub fn oil_properties(&self, t: f64) -> OilProperties {
+        self.oil_model.properties(t)
+    }
+
+    /// Fresh work buffers.
+    pub fn work(&self) -> NetworkWork {
+        NetworkWork {
+            sample_g: vec![0.0; self.sample.len()],
+            boundary_t: self.boundaries.iter().map(|b| b.at(0.0)).collect(),
+        }
+    }
+
+    /// Replace the boundary temperatures by one constant (the ambient for `--ambient-c`) for the
+    /// boundary `index`.
+    pub fn set_boundary_fixed(&mut self, index: usize, temp: f64) {
+        if let Some(b) = self.boundaries.get_mut(index) {
+            *b = BoundaryTemp::Fixed(temp);
+        }
+    }
+
+    /// Conductances of the operating-point-dependent links (call once per cycle sample).
+    pub fn sample_conductances(&self, op: &Operating, work: &mut NetworkWork) {
+        for (g, l) in work.sample_g.iter_mut().zip(&self.sample) {
+            *g = match &l.law {
+                SampleLaw::Table { area, table } => area * table.at(op.vehicle_speed),
+                SampleLaw::Law { area, h0, h1 } => area * h_power_law(*h0, *h1, op.vehicle_speed),
+                SampleLaw::RotatingAir {
+                    area,
+                    radius,
+                    speed_per_input,
+                } => {
+                    let w = speed_per_input[op.state] * op.input_speed;
+                    area * rotating_disc_h(w, *radius, &AIR_50C)
+                }
+            };
+        }
+    }
+
+    /// Boundary temperatures at time `t` (call at each RHS evaluation; constant ones are cheap).
+    pub fn boundary_temperatures(&self, t: f64, work: &mut NetworkWork) {
+        for (x, b) in work.boundary_t.iter_mut().zip(&self.boundaries) {
+            *x = b.at(t);
+        }
+    }
+
+    #[inline]
+    fn temp(e: End, temps: &[f64], bt: &[f64]) -> f64 {
+        match e {
+            End::Node(i) => temps[i],
+            End::Boundary(i) => bt[i],
+        }
+    }
+
+    /// Add a flow `q` (W) from `a` to `b`; heat reaching a boundary is added to `to_boundary`.
+    #[inline]
+    fn flow(a: End, b: End, q: f64, heat: &mut [f64], to_boundary: &mut f64) {
+        match a {
+            End::Node(i) => heat[i] -= q,
+            End::Boundary(_) => *to_boundary -= q,
+        }
+        match b {
+            End::Node(i) => heat[i] += q,
+            End::Boundary(_) => *to_boundary += q,
+        }
+    }
+
+    /// Net heat flow (W) into each node from the network (not the losses), at node temperatures
+    /// `temps` (K), oil properties `oil`, the operating point `op` and the sample conductances in
+    /// `work`. Returns the heat flowing into boundaries (W). `heat` is overwritten.
+    pub fn network_heat(
+        &self,
+        temps: &[f64],
+        oil: &OilProperties,
+        op: &Operating,
+        work: &NetworkWork,
+        heat: &mut [f64],
+    ) -> f64 {
+        heat.iter_mut().for_each(|x| *x = 0.0);
+        let bt = &work.boundary_t;
+        let mut to_b = 0.0;
+        for c in &self.fixed {
+            let q = c.g * (Self::temp(c.a, temps, bt) - Self::temp(c.b, temps, bt));
+            Self::flow(c.a, c.b, q, heat, &mut to_b);
+        }
+        for (l, g) in self.sample.iter().zip(&work.sample_g) {
+            let q = g * (Self::temp(l.a, temps, bt) - Self::temp(l.b, temps, bt));
+            Self::flow(l.a, l.b, q, heat, &mut to_b);
+        }
+        for l in &self.oil_links {
+            let g = self.oil_link_conductance(l, oil, op);
+            let q = g * (Self::temp(l.a, temps, bt) - Self::temp(l.b, temps, bt));
+            Self::flow(l.a, l.b, q, heat, &mut to_b);
+        }
+        for r in &self.radiation {
+            let q = radiation_power(r.k, Self::temp(r.a, temps, bt), Self::temp(r.b, temps, bt));
+            Self::flow(r.a, r.b, q, heat, &mut to_b);
+        }
+        for c in &self.coolers {
+            let th = temps[c.hot];
+            let x = c.thermostat.map_or(1.0, |(a, b)| thermostat_opening(th, a, b).0);
+            let q = c.g * x * (th - Self::temp(c.cold, temps, bt));
+            Self::flow(End::Node(c.hot), c.cold, q, heat, &mut to_b);
+        }
+        to_b
+    }
+
+    fn oil_link_conductance(&self, l: &OilLink, oil: &OilProperties, op: &Operating) -> f64 {
+        let w = l.speed_per_input[op.state] * op.input_speed;
+        let fluid = FluidProperties {
+            conductivity: OIL_CONDUCTIVITY,
+            kinematic_viscosity: oil.nu,
+            prandtl: oil.mu * OIL_SPECIFIC_HEAT / OIL_CONDUCTIVITY,
+        };
+        l.area * rotating_disc_h(w, l.radius, &fluid)
+    }
+
+    /// True when some network term depends on the oil properties (rotating parts in oil).
+    pub fn has_oil_links(&self) -> bool {
+        !self.oil_links.is_empty()
+    }
+
+    /// Directional derivative of [`Self::network_heat`] along `v` (K), holding the oil properties
+    /// fixed (their dependence on T_oil is added by the caller through a finite difference).
+    /// Writes W per node into `out`; returns the derivative of the boundary heat.
+    pub fn network_heat_jvp(
+        &self,
+        temps: &[f64],
+        oil: &OilProperties,
+        op: &Operating,
+        work: &NetworkWork,
+        v: &[f64],
+        out: &mut [f64],
+    ) -> f64 {
+        out.iter_mut().for_each(|x| *x = 0.0);
+        let dv = |e: End| match e {
+            End::Node(i) => v[i],
+            End::Boundary(_) => 0.0,
+        };
+        let bt = &work.boundary_t;
+        let mut to_b = 0.0;
+        for c in &self.fixed {
+            Self::flow(c.a, c.b, c.g * (dv(c.a) - dv(c.b)), out, &mut to_b);
+        }
+        for (l, g) in self.sample.iter().zip(&work.sample_g) {
+            Self::flow(l.a, l.b, g * (dv(l.a) - dv(l.b)), out, &mut to_b);
+        }
+        for l in &self.oil_links {
+            let g = self.oil_link_conductance(l, oil, op);
+            Self::flow(l.a, l.b, g * (dv(l.a) - dv(l.b)), out, &mut to_b);
+        }
+        for r in &self.radiation {
+            let (ta, tb) = (Self::temp(r.a, temps, bt), Self::temp(r.b, temps, bt));
+            let dq = radiation_derivative(r.k, ta) * dv(r.a) - radiation_derivative(r.k, tb) * dv(r.b);
+            Self::flow(r.a, r.b, dq, out, &mut to_b);
+        }
+        for c in &self.coolers {
+            let th = temps[c.hot];
+            let tc = Self::temp(c.cold, temps, bt);
+            let (x, dx) = c
+                .thermostat
+                .map_or((1.0, 0.0), |(a, b)| thermostat_opening(th, a, b));
+            let dq = c.g * ((x + dx * (th - tc)) * v[c.hot] - x * dv(c.cold));
+            Self::flow(End::Node(c.hot), c.cold, dq, out, &mut to_b);
+        }
+        to_b
+    }
+}

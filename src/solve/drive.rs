@@ -1,0 +1,57 @@
+//! From a gearbox and a drive (or rig) cycle to the solver's input segments and the per-row
+//! inputs of the outputs: the glue between `cycle` and the transient driver.
+
+use crate::cycle::{schedule, CycleError, DriveCycle, GearTable, Schedule};
+use crate::model::Gearbox;
+use crate::report::run::RowInputs;
+use crate::scene::Inputs;
+
+use super::transient::{Segment, Trajectory};
+
+/// The gear table of a gearbox: every gear state with its ratio, in model order (the table index
+/// is the gear-state index).
+pub fn gear_table(gb: &Gearbox) -> GearTable {
+    GearTable::new(
+        gb.gear_states
+            .iter()
+            .map(|g| (g.name.clone(), g.ratio()))
+            .collect(),
+    )
+}
+
+/// Schedule a cycle on a gearbox and turn it into solver segments.
+pub fn segments(gb: &Gearbox, cycle: &DriveCycle) -> Result<(Schedule, Vec<Segment>), CycleError> {
+    let sched = schedule(cycle, gb.vehicle.as_ref(), &gear_table(gb))?;
+    let segs = sched
+        .intervals
+        .iter()
+        .map(|iv| Segment {
+            t0: iv.t0,
+            t1: iv.t1,
+            inputs: Inputs {
+                state: iv.gear,
+                input_speed: iv.input_speed,
+                input_torque: iv.input_torque,
+                vehicle_speed: iv.vehicle_speed,
+            },
+        })
+        .collect();
+    Ok((sched, segs))
+}
+
+/// Row inputs of a trajectory's output rows (each row shows the inputs of its segment).
+pub fn row_inputs(gb: &Gearbox, sched: &Schedule, traj: &Trajectory) -> Vec<RowInputs> {
+    traj.segment
+        .iter()
+        .map(|&k| {
+            let iv = &sched.intervals[k];
+            RowInputs {
+                vehicle_speed_kmh: iv.vehicle_speed * 3.6,
+                gear: gb.gear_states[iv.gear].name.clone(),
+                input_speed_rpm: iv.input_speed * 30.0 / std::f64::consts::PI,
+                input_torque_nm: iv.input_torque,
+                output_power_w: iv.output_power,
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,4 @@
+//! Solvers: the transient driver (diffsol) and the steady-state equilibrium search.
+pub mod drive;
+pub mod steady;
+pub mod transient;

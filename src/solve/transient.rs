@@ -1,0 +1,501 @@
+//! Transient driver: integrates a [`Scene`] over piecewise-constant input segments (drive-cycle
+//! intervals) with a diffsol solver.
+//!
+//! How the pitfalls of docs/numerics.md are handled (each has a test in `tests/transient.rs`):
+//! 1. `max_nonlinear_solver_failures` counts over the solver's life: raised to `usize::MAX / 2`;
+//!    runaway runs are stopped by our own step budget instead.
+//! 2. `TstopReached` may leave `t` one ulp short of the stop time: the segment index is kept here,
+//!    never derived from `t`; the time is reset to the exact segment start at a restart.
+//! 3. Roots are not used (samples and shifts are known times: stop times).
+//! 4. After a restart the step size is re-estimated (Hairer–Nørsett–Wanner II.4 starting step with
+//!    the new derivative), not kept from before the jump.
+//! 5. Restarts only where the inputs jump ([`Restart::AtJumps`], default); `EveryInterval` exists
+//!    for the benchmark.
+//! 6. After changing the inputs the state's `dy` is set to `f(t⁺, y)`.
+
+use std::cell::RefCell;
+use std::time::Instant;
+
+use diffsol::{
+    NalgebraLU, NalgebraMat, NalgebraVec, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason,
+    Vector, VectorCommon,
+};
+
+use crate::scene::{Inputs, Scene, Work};
+
+type M = NalgebraMat<f64>;
+type LS = NalgebraLU<f64>;
+
+/// Integration method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// Variable-order BDF (1–5), implicit multistep.
+    Bdf,
+    /// ESDIRK3(4), L-stable singly diagonally implicit Runge–Kutta.
+    Esdirk34,
+    /// TR-BDF2, L-stable one-step method of order 2.
+    TrBdf2,
+    /// Tsitouras 5(4), explicit (not for stiff networks).
+    Tsit45,
+}
+
+impl Method {
+    /// All methods.
+    pub const ALL: [Method; 4] = [Method::Bdf, Method::Esdirk34, Method::TrBdf2, Method::Tsit45];
+
+    /// Command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Bdf => "bdf",
+            Method::Esdirk34 => "esdirk34",
+            Method::TrBdf2 => "tr-bdf2",
+            Method::Tsit45 => "tsit45",
+        }
+    }
+
+    /// Parse a command-line name.
+    pub fn parse(s: &str) -> Option<Method> {
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name() == s || m.name().replace('-', "_") == s)
+    }
+
+    /// True for implicit methods.
+    pub fn is_implicit(self) -> bool {
+        self != Method::Tsit45
+    }
+}
+
+/// When the integrator is restarted at a segment boundary.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Restart {
+    /// Only where the inputs change.
+    AtJumps,
+    /// At every segment boundary.
+    EveryInterval,
+    /// Never: the error control alone handles input jumps.
+    Never,
+}
+
+/// One interval with constant inputs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Segment {
+    /// Start, s.
+    pub t0: f64,
+    /// End, s.
+    pub t1: f64,
+    /// Inputs during the interval.
+    pub inputs: Inputs,
+}
+
+/// Options of a transient run.
+#[derive(Debug, Clone)]
+pub struct TransientOptions {
+    /// Method.
+    pub method: Method,
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Absolute tolerance on temperatures, K (energies get `atol` × the mean node capacity, J).
+    pub atol: f64,
+    /// Restart policy.
+    pub restart: Restart,
+    /// Step budget for the whole run (the run fails with a clear message beyond it).
+    pub max_steps: usize,
+    /// Initial temperature of every node, K (None: the model's).
+    pub initial_temp: Option<f64>,
+}
+
+/// Default method (chosen by the work-precision study, docs/numerics.md).
+pub const DEFAULT_METHOD: Method = Method::Esdirk34;
+/// Default relative tolerance (docs/numerics.md).
+pub const DEFAULT_RTOL: f64 = 1e-6;
+/// Default absolute tolerance on temperatures, K.
+pub const DEFAULT_ATOL: f64 = 1e-6;
+
+impl Default for TransientOptions {
+    fn default() -> Self {
+        Self {
+            method: DEFAULT_METHOD,
+            rtol: DEFAULT_RTOL,
+            atol: DEFAULT_ATOL,
+            restart: Restart::AtJumps,
+            max_steps: 5_000_000,
+            initial_temp: None,
+        }
+    }
+}
+
+/// Solver work counters.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct Stats {
+    /// Accepted steps.
+    pub steps: usize,
+    /// Rejected steps (error test failures).
+    pub rejected: usize,
+    /// Right-hand-side evaluations.
+    pub rhs_evals: usize,
+    /// Jacobian evaluations (loss derivative columns).
+    pub jac_evals: usize,
+    /// LU factorisations (linear solver setups).
+    pub lu_factorisations: usize,
+    /// Newton iterations.
+    pub newton_iterations: usize,
+    /// Restarts at input jumps.
+    pub restarts: usize,
+}
+
+/// The result: the state at every segment boundary, and the losses there.
+#[derive(Debug, Clone)]
+pub struct Trajectory {
+    /// Output times, s (segment boundaries).
+    pub times: Vec<f64>,
+    /// State at each time (temperatures K, energies J).
+    pub states: Vec<Vec<f64>>,
+    /// Loss of each item at each time (W), with the inputs of the segment that starts there (the
+    /// last row: of the last segment).
+    pub losses: Vec<Vec<f64>>,
+    /// Segment index whose inputs each row shows.
+    pub segment: Vec<usize>,
+    /// Counters.
+    pub stats: Stats,
+    /// Wall time of the integration, s.
+    pub wall_time_s: f64,
+}
+
+/// The solver could not continue.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("numerical failure at t = {time:.6} s, node {node}{}: {message}", item.as_ref().map(|i| format!(", loss item {i}")).unwrap_or_default())]
+pub struct NumericalFailure {
+    /// Time, s.
+    pub time: f64,
+    /// Node concerned (the one changing fastest relative to its tolerance, or the one that became
+    /// non-finite).
+    pub node: String,
+    /// Loss item concerned (non-finite, or the largest at that time).
+    pub item: Option<String>,
+    /// What happened.
+    pub message: String,
+}
+
+/// Integrate `scene` over `segments` (contiguous, increasing). `progress(k, n)` is called after
+/// each segment.
+pub fn integrate(
+    scene: &Scene,
+    segments: &[Segment],
+    opts: &TransientOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Trajectory, NumericalFailure> {
+    let start = Instant::now();
+    let first = segments.first().ok_or_else(|| NumericalFailure {
+        time: 0.0,
+        node: scene.thermal.names[scene.thermal.oil].clone(),
+        item: None,
+        message: "empty input: no segment to integrate".into(),
+    })?;
+    let n = scene.nodes();
+    let ns = scene.n_states();
+    let y0 = scene.initial_state(opts.initial_temp);
+    let mean_c = scene.thermal.capacity.iter().sum::<f64>() / n as f64;
+    let mut atol = vec![opts.atol; ns];
+    for a in atol.iter_mut().skip(n) {
+        *a = opts.atol * mean_c;
+    }
+    let work = RefCell::new(scene.work(first.inputs));
+    let fail_build = |e: diffsol::error::DiffsolError| NumericalFailure {
+        time: first.t0,
+        node: scene.thermal.names[scene.thermal.oil].clone(),
+        item: None,
+        message: format!("could not set up the solver: {e}"),
+    };
+    let y0c = y0.clone();
+    let mut problem = OdeBuilder::<M>::new()
+        .t0(first.t0)
+        .rtol(opts.rtol)
+        .atol(atol.clone())
+        .use_coloring(false)
+        .rhs_implicit(
+            |x: &[f64], _p: &[f64], t: f64, y: &mut [f64]| {
+                scene.rhs(t, x, &mut work.borrow_mut(), y);
+            },
+            |x: &[f64], _p: &[f64], t: f64, v: &[f64], y: &mut [f64]| {
+                scene.jvp(t, x, v, &mut work.borrow_mut(), y);
+            },
+        )
+        .init(
+            move |_p: &[f64], _t: f64, y: &mut [f64]| {
+                y.copy_from_slice(&y0c);
+            },
+            ns,
+        )
+        .build()
+        .map_err(fail_build)?;
+    problem.ode_options.max_nonlinear_solver_failures = usize::MAX / 2;
+    let ctx = Driver {
+        scene,
+        work: &work,
+        segments,
+        opts,
+        atol: &atol,
+    };
+    let mut traj = Trajectory {
+        times: Vec::with_capacity(segments.len() + 1),
+        states: Vec::with_capacity(segments.len() + 1),
+        losses: Vec::with_capacity(segments.len() + 1),
+        segment: Vec::with_capacity(segments.len() + 1),
+        stats: Stats::default(),
+        wall_time_s: 0.0,
+    };
+    match opts.method {
+        Method::Bdf => {
+            let mut s = problem.bdf::<LS>().map_err(fail_build)?;
+            ctx.run(&mut s, &mut traj, progress)?;
+        }
+        Method::Esdirk34 => {
+            let mut s = problem.esdirk34::<LS>().map_err(fail_build)?;
+            ctx.run(&mut s, &mut traj, progress)?;
+        }
+        Method::TrBdf2 => {
+            let mut s = problem.tr_bdf2::<LS>().map_err(fail_build)?;
+            ctx.run(&mut s, &mut traj, progress)?;
+        }
+        Method::Tsit45 => {
+            let mut s = problem.tsit45().map_err(fail_build)?;
+            ctx.run(&mut s, &mut traj, progress)?;
+        }
+    }
+    let w = work.borrow();
+    traj.stats.rhs_evals = w.rhs_evals;
+    traj.stats.jac_evals = w.jac_evals;
+    traj.wall_time_s = start.elapsed().as_secs_f64();
+    Ok(traj)
+}
+
+struct Driver<'s> {
+    scene: &'s Scene,
+    work: &'s RefCell<Work>,
+    segments: &'s [Segment],
+    opts: &'s TransientOptions,
+    atol: &'s [f64],
+}
+
+impl Driver<'_> {
+    fn record(&self, traj: &mut Trajectory, t: f64, y: &[f64], seg: usize) {
+        let mut w = self.work.borrow_mut();
+        let saved = w.inputs;
+        let inputs = self.segments[seg].inputs;
+        if inputs != saved {
+            self.scene.set_inputs(inputs, &mut w);
+        }
+        self.scene.evaluate_losses(y, &mut w);
+        traj.times.push(t);
+        traj.states.push(y.to_vec());
+        traj.losses.push(w.q.clone());
+        traj.segment.push(seg);
+        if inputs != saved {
+            self.scene.set_inputs(saved, &mut w);
+        }
+    }
+
+    /// Failure at the solver's current state: names the node with the largest weighted rate and
+    /// the item (non-finite, else the largest loss).
+    fn failure(&self, t: f64, y: &[f64], message: String) -> NumericalFailure {
+        let mut w = self.work.borrow_mut();
+        if let Some(f) = w.failure.take() {
+            return NumericalFailure {
+                time: f.time,
+                node: f.node,
+                item: f.item,
+                message: format!("{} ({message})", f.what),
+            };
+        }
+        let n = self.scene.nodes();
+        let mut dy = vec![0.0; y.len()];
+        self.scene.rhs(t, y, &mut w, &mut dy);
+        let node = (0..n)
+            .max_by(|&a, &b| {
+                let ra = dy[a].abs() / (self.atol[a] + self.opts.rtol * y[a].abs());
+                let rb = dy[b].abs() / (self.atol[b] + self.opts.rtol * y[b].abs());
+                ra.total_cmp(&rb)
+            })
+            .unwrap_or(self.scene.thermal.oil);
+        let item =
+            w.q.iter()
+                .enumerate()
+                .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+                .map(|(k, _)| {
+                    let it = &self.scene.losses.items[k];
+                    format!("{}:{}", it.source.as_str(), it.name)
+                });
+        NumericalFailure {
+            time: t,
+            node: self.scene.thermal.names[node].clone(),
+            item,
+            message,
+        }
+    }
+
+    /// Starting step after a restart (Hairer, Nørsett & Wanner I, II.4), capped by the previous
+    /// step and the segment length.
+    fn restart_step(&self, y: &[f64], f: &[f64], h_prev: f64, len: f64) -> f64 {
+        let (mut d0, mut d1) = (0.0, 0.0);
+        for ((yi, fi), ai) in y.iter().zip(f).zip(self.atol) {
+            let w = ai + self.opts.rtol * yi.abs();
+            d0 += (yi / w).powi(2);
+            d1 += (fi / w).powi(2);
+        }
+        let k = y.len() as f64;
+        let (d0, d1) = ((d0 / k).sqrt(), (d1 / k).sqrt());
+        let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+            1e-6
+        } else {
+            0.01 * d0 / d1
+        };
+        h0.min(h_prev.abs().max(1e-6)).min(len).max(1e-10)
+    }
+
+    fn run<'a, Eqn, S>(
+        &self,
+        solver: &mut S,
+        traj: &mut Trajectory,
+        progress: &mut dyn FnMut(usize, usize),
+    ) -> Result<(), NumericalFailure>
+    where
+        Eqn: OdeEquations<T = f64, V = NalgebraVec<f64>> + 'a,
+        S: OdeSolverMethod<'a, Eqn>,
+    {
+        let segs = self.segments;
+        let total = segs.len();
+        {
+            let st = solver.state();
+            self.record(traj, segs[0].t0, st.y.inner().as_slice(), 0);
+        }
+        let mut restarts = 0;
+        for (k, seg) in segs.iter().enumerate() {
+            if k > 0 {
+                let changed = seg.inputs != segs[k - 1].inputs;
+                if changed {
+                    self.scene.set_inputs(seg.inputs, &mut self.work.borrow_mut());
+                }
+                let restart = match self.opts.restart {
+                    Restart::AtJumps => changed,
+                    Restart::EveryInterval => true,
+                    Restart::Never => false,
+                };
+                if restart {
+                    restarts += 1;
+                    let st = solver.state_mut();
+                    *st.t = seg.t0;
+                    self.scene.rhs(
+                        seg.t0,
+                        st.y.inner().as_slice(),
+                        &mut self.work.borrow_mut(),
+                        st.dy.inner_mut().as_mut_slice(),
+                    );
+                    let h = self.restart_step(
+                        st.y.inner().as_slice(),
+                        st.dy.inner().as_slice(),
+                        *st.h,
+                        seg.t1 - seg.t0,
+                    );
+                    *st.h = h;
+                }
+            }
+            solver.set_stop_time(seg.t1).map_err(|e| {
+                let st = solver.state();
+                self.failure(
+                    st.t.min(seg.t1),
+                    st.y.inner().as_slice(),
+                    format!("stop time rejected: {e}"),
+                )
+            })?;
+            loop {
+                let steps = solver.get_statistics().number_of_steps;
+                if steps > self.opts.max_steps {
+                    let st = solver.state();
+                    return Err(self.failure(
+                        st.t,
+                        st.y.inner().as_slice(),
+                        format!(
+                            "step budget of {} exceeded (the network is too stiff for {} at this tolerance, or oscillates)",
+                            self.opts.max_steps,
+                            self.opts.method.name()
+                        ),
+                    ));
+                }
+                match solver.step() {
+                    Ok(OdeSolverStopReason::TstopReached) => break,
+                    Ok(OdeSolverStopReason::InternalTimestep) => {}
+                    Ok(OdeSolverStopReason::RootFound(..)) => {}
+                    Err(e) => {
+                        let st = solver.state();
+                        return Err(self.failure(
+                            st.t,
+                            st.y.inner().as_slice(),
+                            format!("solver error: {e}"),
+                        ));
+                    }
+                }
+            }
+            let st = solver.state();
+            let y = st.y.inner().as_slice();
+            if let Some(i) = y.iter().position(|v| !v.is_finite()) {
+                return Err(self.failure(seg.t1, y, format!("state component {i} is not finite")));
+            }
+            let row_seg = if k + 1 < total { k + 1 } else { k };
+            self.record(traj, seg.t1, y, row_seg);
+            progress(k + 1, total);
+        }
+        let s = solver.get_statistics();
+        traj.stats.steps = s.number_of_steps;
+        traj.stats.rejected = s.number_of_error_test_failures;
+        traj.stats.lu_factorisations = s.number_of_linear_solver_setups;
+        traj.stats.newton_iterations = s.number_of_nonlinear_solver_iterations;
+        traj.stats.restarts = restarts;
+        Ok(())
+    }
+}
+
+/// Energy bookkeeping of a trajectory's last state.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct EnergyBalance {
+    /// Loss energy, J (sum over items).
+    pub lost: f64,
+    /// Heat stored in the nodes, Σ C_i (T_i(end) − T_i(0)), J.
+    pub stored: f64,
+    /// Heat into boundaries, J.
+    pub to_boundaries: f64,
+    /// |lost − stored − to_boundaries| / max(|lost|, |stored|, |to_boundaries|).
+    pub relative: f64,
+}
+
+/// Energy balance between the first and last state of a trajectory.
+pub fn energy_balance(scene: &Scene, traj: &Trajectory) -> EnergyBalance {
+    let n = scene.nodes();
+    let m = scene.items();
+    let (y0, y1) = match (traj.states.first(), traj.states.last()) {
+        (Some(a), Some(b)) => (a, b),
+        _ => {
+            return EnergyBalance {
+                lost: 0.0,
+                stored: 0.0,
+                to_boundaries: 0.0,
+                relative: 0.0,
+            }
+        }
+    };
+    let lost: f64 = y1[n..n + m].iter().sum::<f64>() - y0[n..n + m].iter().sum::<f64>();
+    let stored: f64 = (0..n).map(|i| scene.thermal.capacity[i] * (y1[i] - y0[i])).sum();
+    let to_b = y1[n + m] - y0[n + m];
+    let scale = lost
+        .abs()
+        .max(stored.abs())
+        .max(to_b.abs())
+        .max(f64::MIN_POSITIVE);
+    EnergyBalance {
+        lost,
+        stored,
+        to_boundaries: to_b,
+        relative: (lost - stored - to_b).abs() / scale,
+    }
+}
