@@ -67,6 +67,11 @@ pub enum Command {
     /// Drive-cycle transient: losses heat the thermal network; writes timeseries.csv and
     /// summary.json into the output directory.
     Run(run::RunArgs),
+    /// PNG plots and report.md from an existing output directory (a run, a map or a bench).
+    Report {
+        /// Directory with timeseries.csv + summary.json, map.csv, or bench.csv.
+        dir: PathBuf,
+    },
 }
 
 /// A failure with its exit code and message.
@@ -169,6 +174,33 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
                 print_json(&report)?;
             } else {
                 print!("{}", losses::to_text(&report));
+            }
+            Ok(())
+        }
+        Command::Report { dir } => {
+            use geartherm::report::plots;
+            let io = |e: plots::PlotError| Failure {
+                code: if dir.is_dir() { EXIT_IO } else { EXIT_INVALID },
+                message: format!("report: {e}"),
+            };
+            let mut written = Vec::new();
+            if dir.join("timeseries.csv").is_file() {
+                written.extend(plots::render_run(&dir).map_err(io)?);
+            }
+            if dir.join("map.csv").is_file() {
+                written.extend(plots::render_map(&dir).map_err(io)?);
+            }
+            if dir.join("bench.csv").is_file() {
+                written.push(plots::render_bench(&dir).map_err(io)?);
+            }
+            if written.is_empty() {
+                return Err(invalid(format!(
+                    "report: {} holds no timeseries.csv, map.csv or bench.csv",
+                    dir.display()
+                )));
+            }
+            for p in written {
+                println!("{}", p.display());
             }
             Ok(())
         }

@@ -180,6 +180,12 @@ pub fn run(args: &RunArgs) -> Result<RunOutcome, Failure> {
         code: EXIT_IO,
         message: format!("{}: cannot write outputs: {e}", dir.display()),
     })?;
+    if args.report {
+        geartherm::report::plots::render_run(&dir).map_err(|e| Failure {
+            code: EXIT_IO,
+            message: format!("report: {e}"),
+        })?;
+    }
     Ok(RunOutcome { summary: sum, dir })
 }
 

@@ -2,4 +2,5 @@
 pub mod files;
 pub mod info;
 pub mod losses;
+pub mod plots;
 pub mod run;

@@ -104,6 +104,30 @@ pub struct TransientOptions {
     pub max_steps: usize,
     /// Initial temperature of every node, K (None: the model's).
     pub initial_temp: Option<f64>,
+    /// Guards against the diffsol pitfalls of docs/numerics.md (all on by default; the tests
+    /// switch each off to show what it prevents).
+    pub guards: Guards,
+}
+
+/// Pitfall guards of the driver.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Guards {
+    /// Pitfall 1: raise `max_nonlinear_solver_failures` (a lifetime count in diffsol).
+    pub raise_failure_limit: bool,
+    /// Pitfall 4: re-estimate the step size at a restart.
+    pub reset_step: bool,
+    /// Pitfall 6: set `dy = f(t⁺, y)` at a restart.
+    pub refresh_derivative: bool,
+}
+
+impl Default for Guards {
+    fn default() -> Self {
+        Self {
+            raise_failure_limit: true,
+            reset_step: true,
+            refresh_derivative: true,
+        }
+    }
 }
 
 /// Default method (chosen by the work-precision study, docs/numerics.md).
@@ -122,6 +146,7 @@ impl Default for TransientOptions {
             restart: Restart::AtJumps,
             max_steps: 5_000_000,
             initial_temp: None,
+            guards: Guards::default(),
         }
     }
 }
@@ -141,6 +166,8 @@ pub struct Stats {
     pub lu_factorisations: usize,
     /// Newton iterations.
     pub newton_iterations: usize,
+    /// Newton convergence failures.
+    pub newton_failures: usize,
     /// Restarts at input jumps.
     pub restarts: usize,
 }
@@ -230,7 +257,9 @@ pub fn integrate(
         )
         .build()
         .map_err(fail_build)?;
-    problem.ode_options.max_nonlinear_solver_failures = usize::MAX / 2;
+    if opts.guards.raise_failure_limit {
+        problem.ode_options.max_nonlinear_solver_failures = usize::MAX / 2;
+    }
     let ctx = Driver {
         scene,
         work: &work,
@@ -384,21 +413,26 @@ impl Driver<'_> {
                 };
                 if restart {
                     restarts += 1;
+                    let g = self.opts.guards;
                     let st = solver.state_mut();
                     *st.t = seg.t0;
-                    self.scene.rhs(
-                        seg.t0,
-                        st.y.inner().as_slice(),
-                        &mut self.work.borrow_mut(),
-                        st.dy.inner_mut().as_mut_slice(),
-                    );
-                    let h = self.restart_step(
-                        st.y.inner().as_slice(),
-                        st.dy.inner().as_slice(),
-                        *st.h,
-                        seg.t1 - seg.t0,
-                    );
-                    *st.h = h;
+                    if g.refresh_derivative {
+                        self.scene.rhs(
+                            seg.t0,
+                            st.y.inner().as_slice(),
+                            &mut self.work.borrow_mut(),
+                            st.dy.inner_mut().as_mut_slice(),
+                        );
+                    }
+                    if g.reset_step {
+                        let h = self.restart_step(
+                            st.y.inner().as_slice(),
+                            st.dy.inner().as_slice(),
+                            *st.h,
+                            seg.t1 - seg.t0,
+                        );
+                        *st.h = h;
+                    }
                 }
             }
             solver.set_stop_time(seg.t1).map_err(|e| {
@@ -451,6 +485,7 @@ impl Driver<'_> {
         traj.stats.rejected = s.number_of_error_test_failures;
         traj.stats.lu_factorisations = s.number_of_linear_solver_setups;
         traj.stats.newton_iterations = s.number_of_nonlinear_solver_iterations;
+        traj.stats.newton_failures = s.number_of_nonlinear_solver_fails;
         traj.stats.restarts = restarts;
         Ok(())
     }

@@ -1,0 +1,513 @@
+//! Reading run, map and bench outputs (the file formats written by `report`).
+//!
+//! Missing numeric values (empty fields, `NaN`) become `f64::NAN` and are skipped by the plots;
+//! anything that is not a number, a wrong field count or a missing required column is an error
+//! that names the file.
+
+use std::collections::BTreeMap;
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use super::style::Source;
+use super::PlotError;
+
+/// One loss item's power over time.
+#[derive(Clone, Debug)]
+pub struct LossItemSeries {
+    pub source: Source,
+    pub name: String,
+    /// W per row.
+    pub power_w: Vec<f64>,
+}
+
+/// The columns of `timeseries.csv` that the plots use.
+#[derive(Clone, Debug, Default)]
+pub struct TimeSeries {
+    pub time_s: Vec<f64>,
+    pub vehicle_speed_kmh: Vec<f64>,
+    /// Gear-state name per row ("" where missing).
+    pub gear: Vec<String>,
+    /// (node name, °C per row), in column order.
+    pub temps_c: Vec<(String, Vec<f64>)>,
+    pub items: Vec<LossItemSeries>,
+    /// Per-source total power, W, indexed by `Source::index()`.
+    pub source_w: [Vec<f64>; 3],
+    pub total_loss_w: Vec<f64>,
+    /// Efficiency as a fraction, NaN where undefined.
+    pub efficiency: Vec<f64>,
+}
+
+impl TimeSeries {
+    pub fn len(&self) -> usize {
+        self.time_s.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.time_s.is_empty()
+    }
+
+    /// Row indices with a finite time, sorted by time (stable).
+    pub fn time_order(&self) -> Vec<usize> {
+        let mut idx: Vec<usize> = (0..self.len()).filter(|&i| self.time_s[i].is_finite()).collect();
+        idx.sort_by(|&a, &b| self.time_s[a].total_cmp(&self.time_s[b]));
+        idx
+    }
+
+    /// Weight (s) of each row in `order` by the midpoint rule: half the interval to each
+    /// neighbour. A single row gets weight 1 so that distributions are still defined.
+    pub fn time_weights(&self, order: &[usize]) -> Vec<f64> {
+        let n = order.len();
+        if n == 1 {
+            return vec![1.0];
+        }
+        (0..n)
+            .map(|k| {
+                let t = |j: usize| self.time_s[order[j]];
+                let left = if k > 0 { t(k) - t(k - 1) } else { 0.0 };
+                let right = if k + 1 < n { t(k + 1) - t(k) } else { 0.0 };
+                0.5 * (left + right)
+            })
+            .collect()
+    }
+}
+
+fn parse_num(field: &str) -> Option<f64> {
+    let f = field.trim();
+    if f.is_empty() {
+        return Some(f64::NAN);
+    }
+    f.parse::<f64>().ok()
+}
+
+fn csv_err(path: &Path, e: csv::Error) -> PlotError {
+    PlotError::Csv {
+        path: path.to_path_buf(),
+        msg: e.to_string(),
+    }
+}
+
+fn open_csv(path: &Path) -> Result<csv::Reader<fs::File>, PlotError> {
+    let file = fs::File::open(path).map_err(|e| PlotError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
+    Ok(csv::ReaderBuilder::new()
+        .has_headers(true)
+        .trim(csv::Trim::All)
+        .from_reader(file))
+}
+
+/// Read `timeseries.csv`.
+pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
+    let mut rdr = open_csv(path)?;
+    let headers = rdr.headers().map_err(|e| csv_err(path, e))?.clone();
+    let find = |name: &str| headers.iter().position(|h| h == name);
+    let require = |name: &str| {
+        find(name).ok_or_else(|| PlotError::Data {
+            path: path.to_path_buf(),
+            what: format!("missing required column `{name}`"),
+        })
+    };
+    let c_time = require("time_s")?;
+    let c_speed = require("vehicle_speed_kmh")?;
+    let c_gear = require("gear")?;
+    let c_src = [
+        require("churning_w")?,
+        require("pocketing_w")?,
+        require("sliding_w")?,
+    ];
+    let c_total = require("total_loss_w")?;
+    let c_eff = require("efficiency")?;
+
+    let mut ts = TimeSeries::default();
+    let mut temp_cols = Vec::new();
+    let mut item_cols = Vec::new();
+    for (i, h) in headers.iter().enumerate() {
+        if let Some(node) = h.strip_prefix("temp_").and_then(|r| r.strip_suffix("_c")) {
+            if !node.is_empty() {
+                temp_cols.push(i);
+                ts.temps_c.push((node.to_string(), Vec::new()));
+            }
+        } else if let Some(rest) = h.strip_prefix("loss_").and_then(|r| r.strip_suffix("_w")) {
+            let parsed = Source::ALL.into_iter().find_map(|s| {
+                rest.strip_prefix(s.name())
+                    .and_then(|r| r.strip_prefix('_'))
+                    .filter(|n| !n.is_empty())
+                    .map(|n| (s, n))
+            });
+            if let Some((source, name)) = parsed {
+                item_cols.push(i);
+                ts.items.push(LossItemSeries {
+                    source,
+                    name: name.to_string(),
+                    power_w: Vec::new(),
+                });
+            }
+            // loss columns of an unknown source are ignored (forward compatibility).
+        }
+    }
+
+    let mut record = csv::StringRecord::new();
+    let mut line = 1u64;
+    loop {
+        match rdr.read_record(&mut record) {
+            Ok(true) => {}
+            Ok(false) => break,
+            Err(e) => return Err(csv_err(path, e)),
+        }
+        line = record.position().map(|p| p.line()).unwrap_or(line + 1);
+        let num = |c: usize| -> Result<f64, PlotError> {
+            let field = record.get(c).unwrap_or("");
+            parse_num(field).ok_or_else(|| PlotError::Csv {
+                path: path.to_path_buf(),
+                msg: format!("line {line}, column `{}`: `{field}` is not a number", &headers[c]),
+            })
+        };
+        ts.time_s.push(num(c_time)?);
+        ts.vehicle_speed_kmh.push(num(c_speed)?);
+        ts.gear.push(record.get(c_gear).unwrap_or("").to_string());
+        for (k, &c) in temp_cols.iter().enumerate() {
+            let v = num(c)?;
+            ts.temps_c[k].1.push(v);
+        }
+        for (k, &c) in item_cols.iter().enumerate() {
+            let v = num(c)?;
+            ts.items[k].power_w.push(v);
+        }
+        for (k, &c) in c_src.iter().enumerate() {
+            let v = num(c)?;
+            ts.source_w[k].push(v);
+        }
+        ts.total_loss_w.push(num(c_total)?);
+        ts.efficiency.push(num(c_eff)?);
+    }
+    if ts.is_empty() {
+        return Err(PlotError::Data {
+            path: path.to_path_buf(),
+            what: "no data rows".into(),
+        });
+    }
+    Ok(ts)
+}
+
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(default)]
+pub struct EnergyBySource {
+    pub churning: Option<f64>,
+    pub pocketing: Option<f64>,
+    pub sliding: Option<f64>,
+    pub total: Option<f64>,
+}
+
+impl EnergyBySource {
+    pub fn get(&self, s: Source) -> Option<f64> {
+        match s {
+            Source::Churning => self.churning,
+            Source::Pocketing => self.pocketing,
+            Source::Sliding => self.sliding,
+        }
+    }
+}
+
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(default)]
+pub struct ItemEnergy {
+    pub source: String,
+    pub name: String,
+    pub j: Option<f64>,
+}
+
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(default)]
+pub struct TempStats {
+    pub min: Option<f64>,
+    pub max: Option<f64>,
+    #[serde(rename = "final")]
+    pub last: Option<f64>,
+}
+
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(default)]
+pub struct NodeInfo {
+    pub name: String,
+    pub boundary: bool,
+}
+
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(default)]
+pub struct Skipped {
+    pub what: String,
+    pub why: String,
+}
+
+/// `summary.json`. Every field is optional so that a partial summary still renders; unknown
+/// keys are ignored.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(default)]
+pub struct Summary {
+    pub model: Option<String>,
+    pub cycle: Option<String>,
+    pub solver: Option<serde_json::Value>,
+    pub rtol: Option<serde_json::Value>,
+    pub atol: Option<serde_json::Value>,
+    pub wall_time_s: Option<f64>,
+    pub steps: Option<f64>,
+    pub energy_lost_j: Option<EnergyBySource>,
+    pub energy_by_item_j: Vec<ItemEnergy>,
+    pub energy_balance_relative: Option<f64>,
+    pub mean_efficiency: Option<f64>,
+    pub temperatures_c: BTreeMap<String, TempStats>,
+    pub nodes: Vec<NodeInfo>,
+    pub oil_node: Option<String>,
+    pub skipped: Vec<Skipped>,
+}
+
+impl Summary {
+    pub fn is_boundary(&self, node: &str) -> bool {
+        self.nodes.iter().any(|n| n.name == node && n.boundary)
+    }
+}
+
+/// A JSON scalar as display text (strings without quotes).
+pub fn value_text(v: &Option<serde_json::Value>) -> String {
+    match v {
+        None | Some(serde_json::Value::Null) => "–".into(),
+        Some(serde_json::Value::String(s)) => s.clone(),
+        Some(serde_json::Value::Number(n)) => match n.as_f64() {
+            Some(x) if n.is_f64() => super::style::fmt_sig(x, 3),
+            _ => n.to_string(),
+        },
+        Some(other) => other.to_string(),
+    }
+}
+
+pub fn read_json<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T, PlotError> {
+    let text = fs::read_to_string(path).map_err(|e| PlotError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
+    serde_json::from_str(&text).map_err(|e| PlotError::Json {
+        path: path.to_path_buf(),
+        source: e,
+    })
+}
+
+/// Everything a run report needs.
+pub struct RunData {
+    pub dir: PathBuf,
+    pub ts: TimeSeries,
+    pub summary: Summary,
+}
+
+pub fn read_run(dir: &Path) -> Result<RunData, PlotError> {
+    let ts = read_timeseries(&dir.join("timeseries.csv"))?;
+    let summary: Summary = read_json(&dir.join("summary.json"))?;
+    Ok(RunData {
+        dir: dir.to_path_buf(),
+        ts,
+        summary,
+    })
+}
+
+/// One row of `map.csv`.
+#[derive(Clone, Debug, Deserialize)]
+pub struct MapRow {
+    pub speed_rpm: f64,
+    pub torque_nm: f64,
+    pub efficiency: Option<f64>,
+    pub total_loss_w: Option<f64>,
+    pub churning_w: Option<f64>,
+    pub pocketing_w: Option<f64>,
+    pub sliding_w: Option<f64>,
+    pub oil_temp_c: Option<f64>,
+    pub iterations: Option<f64>,
+    pub converged: bool,
+}
+
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(default)]
+pub struct MapMeta {
+    pub model: Option<String>,
+    pub gear: Option<serde_json::Value>,
+}
+
+/// A map on its (speed × torque) grid. Cell (i, j) = speed i, torque j; `None` = no point.
+pub struct MapGrid {
+    pub meta: MapMeta,
+    pub speeds_rpm: Vec<f64>,
+    pub torques_nm: Vec<f64>,
+    pub cells: Vec<Option<MapRow>>,
+}
+
+impl MapGrid {
+    pub fn cell(&self, i: usize, j: usize) -> Option<&MapRow> {
+        self.cells[j * self.speeds_rpm.len() + i].as_ref()
+    }
+}
+
+fn unique_sorted(mut v: Vec<f64>) -> Vec<f64> {
+    v.retain(|x| x.is_finite());
+    v.sort_by(f64::total_cmp);
+    let scale = v.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-300);
+    v.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * scale);
+    v
+}
+
+fn nearest(axis: &[f64], x: f64) -> usize {
+    let k = axis.partition_point(|&a| a < x);
+    if k == 0 {
+        0
+    } else if k >= axis.len() {
+        axis.len() - 1
+    } else if (axis[k] - x).abs() < (x - axis[k - 1]).abs() {
+        k
+    } else {
+        k - 1
+    }
+}
+
+pub fn read_map(dir: &Path) -> Result<MapGrid, PlotError> {
+    let path = dir.join("map.csv");
+    let mut rdr = open_csv(&path)?;
+    let mut rows = Vec::new();
+    for r in rdr.deserialize::<MapRow>() {
+        rows.push(r.map_err(|e| csv_err(&path, e))?);
+    }
+    if rows.is_empty() {
+        return Err(PlotError::Data {
+            path,
+            what: "no data rows".into(),
+        });
+    }
+    let meta: MapMeta = read_json(&dir.join("map.json"))?;
+    let speeds = unique_sorted(rows.iter().map(|r| r.speed_rpm).collect());
+    let torques = unique_sorted(rows.iter().map(|r| r.torque_nm).collect());
+    if speeds.is_empty() || torques.is_empty() {
+        return Err(PlotError::Data {
+            path,
+            what: "no finite speed/torque values".into(),
+        });
+    }
+    let mut cells = vec![None; speeds.len() * torques.len()];
+    for r in rows {
+        if !(r.speed_rpm.is_finite() && r.torque_nm.is_finite()) {
+            continue;
+        }
+        let (i, j) = (nearest(&speeds, r.speed_rpm), nearest(&torques, r.torque_nm));
+        cells[j * speeds.len() + i] = Some(r);
+    }
+    Ok(MapGrid {
+        meta,
+        speeds_rpm: speeds,
+        torques_nm: torques,
+        cells,
+    })
+}
+
+/// One row of `bench.csv`.
+#[derive(Clone, Debug, Deserialize)]
+pub struct BenchRow {
+    pub solver: String,
+    pub rtol: Option<f64>,
+    pub atol: Option<f64>,
+    pub wall_time_s: Option<f64>,
+    pub steps: Option<f64>,
+    pub rejected: Option<f64>,
+    pub rhs_evals: Option<f64>,
+    pub jac_evals: Option<f64>,
+    pub lu_count: Option<f64>,
+    pub err_final_k: Option<f64>,
+    pub err_max_k: Option<f64>,
+    pub err_rms_k: Option<f64>,
+    pub energy_balance_relative: Option<f64>,
+    pub default: bool,
+}
+
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(default)]
+pub struct BenchMeta {
+    pub model: Option<String>,
+    pub cycle: Option<String>,
+}
+
+pub fn read_bench(dir: &Path) -> Result<(Vec<BenchRow>, BenchMeta), PlotError> {
+    let path = dir.join("bench.csv");
+    let mut rdr = open_csv(&path)?;
+    let mut rows = Vec::new();
+    for r in rdr.deserialize::<BenchRow>() {
+        rows.push(r.map_err(|e| csv_err(&path, e))?);
+    }
+    if rows.is_empty() {
+        return Err(PlotError::Data {
+            path,
+            what: "no data rows".into(),
+        });
+    }
+    let meta: BenchMeta = read_json(&dir.join("bench.json"))?;
+    Ok((rows, meta))
+}
+
+/// Split the rows in `order` into runs of consecutive finite (x, y) points, so that missing
+/// values break a line instead of being bridged or drawn as zero.
+pub fn finite_segments(order: &[usize], x: &[f64], y: &[f64], x_scale: f64) -> Vec<Vec<(f64, f64)>> {
+    let mut out = Vec::new();
+    let mut cur: Vec<(f64, f64)> = Vec::new();
+    for &i in order {
+        let (xi, yi) = (x[i] * x_scale, y[i]);
+        if xi.is_finite() && yi.is_finite() {
+            cur.push((xi, yi));
+        } else if !cur.is_empty() {
+            out.push(std::mem::take(&mut cur));
+        }
+    }
+    if !cur.is_empty() {
+        out.push(cur);
+    }
+    out
+}
+
+/// Reduce a polyline (x increasing) to at most ~4 points per bucket (first, min, max, last)
+/// over `buckets` equal x intervals; the drawn line is visually identical at that resolution.
+pub fn decimate(points: &[(f64, f64)], buckets: usize) -> Vec<(f64, f64)> {
+    if points.len() <= 4 * buckets || points.len() < 2 {
+        return points.to_vec();
+    }
+    let x0 = points[0].0;
+    let x1 = points[points.len() - 1].0;
+    let w = (x1 - x0) / buckets as f64;
+    if w.is_nan() || w <= 0.0 {
+        return points.to_vec();
+    }
+    let mut out = Vec::with_capacity(4 * buckets + 2);
+    let mut start = 0;
+    while start < points.len() {
+        let b = ((points[start].0 - x0) / w).floor();
+        let mut end = start + 1;
+        while end < points.len() && ((points[end].0 - x0) / w).floor() <= b {
+            end += 1;
+        }
+        let chunk = &points[start..end];
+        let (mut kmin, mut kmax) = (0, 0);
+        for (k, p) in chunk.iter().enumerate() {
+            if p.1 < chunk[kmin].1 {
+                kmin = k;
+            }
+            if p.1 > chunk[kmax].1 {
+                kmax = k;
+            }
+        }
+        let mut ks = [0, kmin, kmax, chunk.len() - 1];
+        ks.sort_unstable();
+        let mut last = usize::MAX;
+        for k in ks {
+            if k != last {
+                out.push(chunk[k]);
+                last = k;
+            }
+        }
+        start = end;
+    }
+    out
+}

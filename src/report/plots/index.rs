@@ -1,0 +1,164 @@
+//! `report.md`: the run's summary figures and the four PNGs, as a Markdown page.
+
+use std::fmt::Write;
+
+use super::data::{value_text, RunData};
+use super::energy::source_energies;
+use super::style::{fmt_sig, Source};
+
+/// Escape text for a Markdown table cell.
+fn cell(s: &str) -> String {
+    s.replace('\\', "\\\\").replace('|', "\\|").replace('\n', " ")
+}
+
+fn opt(v: Option<f64>, f: impl Fn(f64) -> String) -> String {
+    v.filter(|x| x.is_finite()).map(f).unwrap_or_else(|| "–".into())
+}
+
+pub fn markdown(run: &RunData) -> String {
+    let sm = &run.summary;
+    let ts = &run.ts;
+    let model = sm.model.as_deref().unwrap_or("(unnamed model)");
+    let cycle = sm.cycle.as_deref().unwrap_or("(unnamed cycle)");
+    let mut s = String::new();
+    let _ = writeln!(s, "# geartherm run report: {} — {}\n", cell(model), cell(cycle));
+    let _ = writeln!(s, "| Quantity | Value |\n|---|---|");
+    let _ = writeln!(s, "| Model | {} |", cell(model));
+    let _ = writeln!(s, "| Cycle | {} |", cell(cycle));
+    let _ = writeln!(s, "| Solver | {} |", cell(&value_text(&sm.solver)));
+    let _ = writeln!(
+        s,
+        "| rtol / atol | {} / {} |",
+        cell(&value_text(&sm.rtol)),
+        cell(&value_text(&sm.atol))
+    );
+    let _ = writeln!(
+        s,
+        "| Wall time | {} |",
+        opt(sm.wall_time_s, |t| format!("{} s", fmt_sig(t, 3)))
+    );
+    let _ = writeln!(s, "| Steps | {} |", opt(sm.steps, |n| format!("{n:.0}")));
+    let t0 = ts.time_order().first().map(|&i| ts.time_s[i]);
+    let t1 = ts.time_order().last().map(|&i| ts.time_s[i]);
+    if let (Some(a), Some(b)) = (t0, t1) {
+        let _ = writeln!(
+            s,
+            "| Simulated time | {} s ({} rows) |",
+            fmt_sig(b - a, 4),
+            ts.len()
+        );
+    }
+    let _ = writeln!(
+        s,
+        "| Energy balance residual (relative) | {} |",
+        opt(sm.energy_balance_relative, |b| format!("{b:.2e}"))
+    );
+    let _ = writeln!(
+        s,
+        "| Mean efficiency | {} |",
+        opt(sm.mean_efficiency, |m| format!("{:.2} %", 100.0 * m))
+    );
+    if let Some(oil) = &sm.oil_node {
+        let _ = writeln!(s, "| Oil node | {} |", cell(oil));
+    }
+
+    let src = source_energies(run);
+    let total = sm
+        .energy_lost_j
+        .as_ref()
+        .and_then(|e| e.total)
+        .filter(|v| v.is_finite())
+        .unwrap_or_else(|| src.iter().sum());
+    let _ = writeln!(
+        s,
+        "\n## Energy lost\n\n| Source | Energy (kJ) | Share |\n|---|---:|---:|"
+    );
+    for x in Source::ALL {
+        let e = src[x.index()];
+        let share = if total > 0.0 {
+            format!("{:.1} %", 100.0 * e / total)
+        } else {
+            "–".into()
+        };
+        let _ = writeln!(s, "| {} | {} | {} |", x.name(), fmt_sig(e / 1e3, 4), share);
+    }
+    let _ = writeln!(s, "| **total** | **{}** | |", fmt_sig(total / 1e3, 4));
+
+    let _ = writeln!(
+        s,
+        "\n## Temperatures\n\n| Node | Boundary | Min (°C) | Max (°C) | Final (°C) |\n|---|---|---:|---:|---:|"
+    );
+    // Order: the summary's node list, then nodes only in the time series, then the rest.
+    let mut names: Vec<String> = sm.nodes.iter().map(|n| n.name.clone()).collect();
+    for (n, _) in &ts.temps_c {
+        if !names.contains(n) {
+            names.push(n.clone());
+        }
+    }
+    for n in sm.temperatures_c.keys() {
+        if !names.contains(n) {
+            names.push(n.clone());
+        }
+    }
+    for n in &names {
+        // Summary values first; otherwise computed from the time series.
+        let series = ts.temps_c.iter().find(|(m, _)| m == n).map(|(_, v)| v);
+        let finite = |v: &Vec<f64>| v.iter().copied().filter(|x| x.is_finite()).collect::<Vec<_>>();
+        let from_ts = series.map(finite).unwrap_or_default();
+        let st = sm.temperatures_c.get(n);
+        let min = st
+            .and_then(|t| t.min)
+            .or_else(|| from_ts.iter().copied().reduce(f64::min));
+        let max = st
+            .and_then(|t| t.max)
+            .or_else(|| from_ts.iter().copied().reduce(f64::max));
+        let last = st.and_then(|t| t.last).or_else(|| {
+            let order = ts.time_order();
+            series.and_then(|v| order.iter().rev().map(|&i| v[i]).find(|x| x.is_finite()))
+        });
+        let f = |v: Option<f64>| opt(v, |x| format!("{x:.1}"));
+        let boundary = if sm.is_boundary(n) { "yes" } else { "" };
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} |",
+            cell(n),
+            boundary,
+            f(min),
+            f(max),
+            f(last)
+        );
+    }
+
+    let _ = writeln!(s, "\n## Figures\n");
+    let _ = writeln!(
+        s,
+        "### Temperatures\n\n![Node temperatures, vehicle speed and gear](temperatures.png)\n"
+    );
+    let _ = writeln!(
+        s,
+        "### Loss power by source\n\n![Loss power stacked by source](losses.png)\n"
+    );
+    let _ = writeln!(
+        s,
+        "### Energy lost per component\n\n![Energy lost per component and per source](energy.png)\n"
+    );
+    let _ = writeln!(
+        s,
+        "### Efficiency\n\n![Efficiency vs time and its time-weighted distribution](efficiency.png)\n"
+    );
+
+    let _ = writeln!(s, "## Skipped by the scene\n");
+    if sm.skipped.is_empty() {
+        let _ = writeln!(s, "Nothing was skipped.");
+    } else {
+        for k in &sm.skipped {
+            let _ = writeln!(
+                s,
+                "- **{}**: {}",
+                k.what.replace('\n', " "),
+                k.why.replace('\n', " ")
+            );
+        }
+    }
+    s
+}

@@ -1,0 +1,202 @@
+//! PNG reports (plotters, bitmap backend, embedded DejaVu Sans font).
+//!
+//! - [`render_run`]: `temperatures.png`, `losses.png`, `energy.png`, `efficiency.png` and
+//!   `report.md` from a run directory (`timeseries.csv`, `summary.json`).
+//! - [`render_map`]: `map_efficiency.png`, `map_total_loss.png`, `map_oil_temp.png` from a map
+//!   directory (`map.csv`, `map.json`).
+//! - [`render_bench`]: `work_precision.png` from a bench directory (`bench.csv`, `bench.json`).
+//!
+//! Every PNG is 1600×1000 px. Each output is rendered to a temporary file in the target
+//! directory and all outputs of one call are renamed into place only after every one of them
+//! rendered: a failure leaves no partial file and does not overwrite earlier results.
+
+use std::error::Error;
+use std::path::{Path, PathBuf};
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use tempfile::NamedTempFile;
+
+pub mod data;
+pub mod efficiency;
+pub mod energy;
+pub mod heatmap;
+pub mod index;
+pub mod losses;
+pub mod style;
+pub mod temperatures;
+pub mod work_precision;
+
+#[cfg(test)]
+mod tests;
+
+/// Errors of the plot reports. Every variant names the file concerned.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{}: malformed CSV: {msg}", path.display())]
+    Csv { path: PathBuf, msg: String },
+    #[error("{}: malformed JSON: {source}", path.display())]
+    Json {
+        path: PathBuf,
+        #[source]
+        source: serde_json::Error,
+    },
+    #[error("{}: {what}", path.display())]
+    Data { path: PathBuf, what: String },
+    #[error("{}: drawing failed: {msg}", path.display())]
+    Draw { path: PathBuf, msg: String },
+    #[error("the embedded DejaVu Sans font could not be loaded")]
+    Font,
+}
+
+/// The bitmap drawing area every figure draws on.
+pub(crate) type Canvas<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
+pub(crate) type DrawResult = Result<(), Box<dyn Error>>;
+
+/// An output rendered to a temporary file, waiting to be renamed to `dest`.
+pub(crate) struct Staged {
+    tmp: NamedTempFile,
+    dest: PathBuf,
+}
+
+fn io_err(path: &Path, source: std::io::Error) -> PlotError {
+    PlotError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+fn temp_in(dir: &Path, name: &str, suffix: &str) -> Result<NamedTempFile, PlotError> {
+    tempfile::Builder::new()
+        .prefix(&format!(".{name}."))
+        .suffix(suffix)
+        .tempfile_in(dir)
+        .map_err(|e| io_err(&dir.join(name), e))
+}
+
+/// Render a 1600×1000 PNG into a temporary file in `dir` that becomes `name` on commit.
+pub(crate) fn stage_png(
+    dir: &Path,
+    name: &str,
+    draw: impl FnOnce(&Canvas) -> DrawResult,
+) -> Result<Staged, PlotError> {
+    let dest = dir.join(name);
+    let tmp = temp_in(dir, name, ".png")?;
+    let draw_err = |e: &dyn std::fmt::Display| PlotError::Draw {
+        path: dest.clone(),
+        msg: e.to_string(),
+    };
+    {
+        let root = BitMapBackend::new(tmp.path(), (style::WIDTH, style::HEIGHT)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| draw_err(&e))?;
+        draw(&root).map_err(|e| draw_err(&e))?;
+        root.present().map_err(|e| draw_err(&e))?;
+    }
+    Ok(Staged { tmp, dest })
+}
+
+/// Write a text file into a temporary file in `dir` that becomes `name` on commit.
+pub(crate) fn stage_text(dir: &Path, name: &str, content: &str) -> Result<Staged, PlotError> {
+    use std::io::Write;
+    let dest = dir.join(name);
+    let mut tmp = temp_in(dir, name, ".tmp")?;
+    tmp.write_all(content.as_bytes()).map_err(|e| io_err(&dest, e))?;
+    tmp.as_file().sync_all().map_err(|e| io_err(&dest, e))?;
+    Ok(Staged { tmp, dest })
+}
+
+/// Rename every staged file into place.
+pub(crate) fn commit(staged: Vec<Staged>) -> Result<Vec<PathBuf>, PlotError> {
+    let mut out = Vec::with_capacity(staged.len());
+    for s in staged {
+        s.tmp.persist(&s.dest).map_err(|e| io_err(&s.dest, e.error))?;
+        out.push(s.dest);
+    }
+    Ok(out)
+}
+
+/// Run the stage jobs on scoped threads (figures are independent) and collect their results.
+fn stage_parallel<'a>(
+    jobs: Vec<Box<dyn FnOnce() -> Result<Staged, PlotError> + Send + 'a>>,
+) -> Result<Vec<Staged>, PlotError> {
+    let results: Vec<Result<Staged, PlotError>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = jobs.into_iter().map(|job| scope.spawn(job)).collect();
+        handles
+            .into_iter()
+            .map(|h| {
+                h.join().unwrap_or_else(|_| {
+                    Err(PlotError::Data {
+                        path: PathBuf::new(),
+                        what: "renderer panicked".into(),
+                    })
+                })
+            })
+            .collect()
+    });
+    results.into_iter().collect()
+}
+
+fn check_dir(dir: &Path) -> Result<(), PlotError> {
+    if dir.is_dir() {
+        Ok(())
+    } else {
+        Err(PlotError::Data {
+            path: dir.to_path_buf(),
+            what: "not a directory".into(),
+        })
+    }
+}
+
+/// Render the run report into `dir` (which holds `timeseries.csv` and `summary.json`).
+/// Returns the paths written: the four PNGs and `report.md`.
+pub fn render_run(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+    check_dir(dir)?;
+    style::ensure_fonts()?;
+    let run = data::read_run(dir)?;
+    let run = &run;
+    let jobs: Vec<Box<dyn FnOnce() -> Result<Staged, PlotError> + Send + '_>> = vec![
+        Box::new(move || stage_png(dir, "temperatures.png", |root| temperatures::draw(root, run))),
+        Box::new(move || stage_png(dir, "losses.png", |root| losses::draw(root, run))),
+        Box::new(move || stage_png(dir, "energy.png", |root| energy::draw(root, run))),
+        Box::new(move || stage_png(dir, "efficiency.png", |root| efficiency::draw(root, run))),
+        Box::new(move || stage_text(dir, "report.md", &index::markdown(run))),
+    ];
+    commit(stage_parallel(jobs)?)
+}
+
+/// Render the three heat maps into `dir` (which holds `map.csv` and `map.json`).
+pub fn render_map(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+    check_dir(dir)?;
+    style::ensure_fonts()?;
+    let grid = data::read_map(dir)?;
+    let grid = &grid;
+    let jobs: Vec<Box<dyn FnOnce() -> Result<Staged, PlotError> + Send + '_>> = heatmap::Quantity::ALL
+        .into_iter()
+        .map(|q| {
+            Box::new(move || stage_png(dir, q.file_name(), |root| heatmap::draw(root, grid, q)))
+                as Box<dyn FnOnce() -> Result<Staged, PlotError> + Send>
+        })
+        .collect();
+    commit(stage_parallel(jobs)?)
+}
+
+/// Render `work_precision.png` into `dir` (which holds `bench.csv` and `bench.json`).
+pub fn render_bench(dir: &Path) -> Result<PathBuf, PlotError> {
+    check_dir(dir)?;
+    style::ensure_fonts()?;
+    let (rows, meta) = data::read_bench(dir)?;
+    let staged = stage_png(dir, "work_precision.png", |root| {
+        work_precision::draw(root, &rows, &meta)
+    })?;
+    let mut paths = commit(vec![staged])?;
+    paths.pop().ok_or_else(|| PlotError::Data {
+        path: dir.to_path_buf(),
+        what: "nothing written".into(),
+    })
+}

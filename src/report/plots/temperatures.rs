@@ -1,0 +1,216 @@
+//! `temperatures.png`: node temperatures vs time (boundary nodes dashed, the oil node thicker),
+//! and below it, on the same time axis, vehicle speed (left axis) and gear (step line, right axis).
+
+use plotters::prelude::*;
+use plotters::series::DashedLineSeries;
+use plotters::style::text_anchor::{HPos, VPos};
+
+use super::data::{decimate, finite_segments, RunData};
+use super::style::{self, LegendEntry, Swatch};
+use super::{Canvas, DrawResult};
+
+const LEGEND_W: u32 = 300;
+const Y_LABEL_W: u32 = 110;
+const Y2_LABEL_W: u32 = 100;
+
+/// Order gear-state names: P, R, N first, then numeric gears ascending, then the rest by name.
+pub fn gear_levels(gears: &[String]) -> Vec<String> {
+    let mut names: Vec<&str> = gears.iter().map(|g| g.trim()).filter(|g| !g.is_empty()).collect();
+    names.sort_unstable();
+    names.dedup();
+    let rank = |g: &str| -> (u8, f64, String) {
+        match g {
+            "P" => (0, 0.0, String::new()),
+            "R" => (1, 0.0, String::new()),
+            "N" => (2, 0.0, String::new()),
+            _ => match g.parse::<f64>() {
+                Ok(x) => (3, x, String::new()),
+                Err(_) => (4, 0.0, g.to_string()),
+            },
+        }
+    };
+    names.sort_by(|a, b| {
+        let (ra, rb) = (rank(a), rank(b));
+        ra.0.cmp(&rb.0).then(ra.1.total_cmp(&rb.1)).then(ra.2.cmp(&rb.2))
+    });
+    names.into_iter().map(String::from).collect()
+}
+
+pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
+    let ts = &run.ts;
+    let sm = &run.summary;
+    let title = format!(
+        "Temperatures — {} / {}",
+        sm.model.as_deref().unwrap_or("model"),
+        sm.cycle.as_deref().unwrap_or("cycle")
+    );
+    let root = style::titled(root, &title)?;
+    let (w, h) = root.dim_in_pixel();
+    let (main, legend) = root.split_horizontally(w - LEGEND_W);
+    let split_y = (h as f64 * 0.64) as u32;
+    let (upper, lower) = main.split_vertically(split_y);
+    let (leg_up, leg_low) = legend.split_vertically(split_y);
+
+    let order = ts.time_order();
+    let t_lo = order.first().map(|&i| ts.time_s[i]).unwrap_or(0.0);
+    let t_hi = order.last().map(|&i| ts.time_s[i]).unwrap_or(1.0);
+    let (t_scale, t_desc) = style::time_axis(t_hi);
+    let (x0, x1) = if t_hi > t_lo {
+        (t_lo * t_scale, t_hi * t_scale)
+    } else {
+        style::pad_range(t_lo * t_scale, t_hi * t_scale, 0.0)
+    };
+    let buckets = (w - LEGEND_W) as usize;
+
+    // Upper panel: temperatures.
+    let (y0, y1) = style::padded_range(ts.temps_c.iter().flat_map(|(_, v)| v.iter().copied()), 0.06);
+    let mut chart = ChartBuilder::on(&upper)
+        .margin_left(20)
+        .margin_right(10 + Y2_LABEL_W)
+        .margin_top(10)
+        .x_label_area_size(12)
+        .y_label_area_size(Y_LABEL_W)
+        .build_cartesian_2d(x0..x1, y0..y1)?;
+    chart
+        .configure_mesh()
+        .y_desc("Temperature (°C)")
+        .axis_desc_style(style::font(style::AXIS_DESC_PX))
+        .label_style(style::font(style::TICK_PX))
+        .light_line_style(style::GRID)
+        .bold_line_style(style::GRID_BOLD)
+        .x_labels(12)
+        .y_labels(8)
+        .x_label_formatter(&|_| String::new())
+        .y_label_formatter(&|v| style::fmt_num(*v))
+        .draw()?;
+
+    let oil = sm.oil_node.as_deref();
+    let mut entries = Vec::new();
+    for (k, (name, values)) in ts.temps_c.iter().enumerate() {
+        let colour = style::series_colour(k);
+        let boundary = sm.is_boundary(name);
+        let width = if Some(name.as_str()) == oil { 5 } else { 3 };
+        for seg in finite_segments(&order, &ts.time_s, values, t_scale) {
+            let seg = decimate(&seg, buckets);
+            if seg.len() == 1 {
+                chart.draw_series(std::iter::once(Circle::new(seg[0], 5, colour.filled())))?;
+            } else if boundary {
+                chart.draw_series(DashedLineSeries::new(seg, 14, 10, colour.stroke_width(2)))?;
+            } else {
+                chart.draw_series(LineSeries::new(seg, colour.stroke_width(width)))?;
+            }
+        }
+        let (label, swatch) = if boundary {
+            (format!("{name} (boundary)"), Swatch::Dashed(colour, 2))
+        } else if Some(name.as_str()) == oil {
+            (format!("{name} (oil)"), Swatch::Line(colour, 5))
+        } else {
+            (name.clone(), Swatch::Line(colour, 3))
+        };
+        entries.push(LegendEntry::new(label, swatch));
+    }
+    if ts.temps_c.is_empty() {
+        style::draw_note_centre(&upper, "no temperature columns in timeseries.csv")?;
+    }
+    style::draw_legend_column(&leg_up, Some("Thermal nodes"), &entries, 14)?;
+
+    // Lower panel: vehicle speed and gear.
+    let (s0, s1) = style::padded_range(ts.vehicle_speed_kmh.iter().copied().chain([0.0]), 0.06);
+    let all_non_negative = ts.vehicle_speed_kmh.iter().all(|v| v.is_nan() || *v >= 0.0);
+    let s0 = if all_non_negative { 0.0 } else { s0 };
+    let levels = gear_levels(&ts.gear);
+    let n_levels = levels.len().max(1) as f64;
+    let mut lower_chart = ChartBuilder::on(&lower)
+        .margin_left(20)
+        .margin_right(10)
+        .margin_top(14)
+        .margin_bottom(10)
+        .x_label_area_size(80)
+        .y_label_area_size(Y_LABEL_W)
+        .right_y_label_area_size(Y2_LABEL_W)
+        .build_cartesian_2d(x0..x1, s0..s1)?
+        .set_secondary_coord(x0..x1, -0.6..(n_levels - 0.4));
+    lower_chart
+        .configure_mesh()
+        .x_desc(t_desc)
+        .y_desc("Vehicle speed (km/h)")
+        .axis_desc_style(style::font(style::AXIS_DESC_PX))
+        .label_style(style::font(style::TICK_PX))
+        .light_line_style(style::GRID)
+        .bold_line_style(style::GRID_BOLD)
+        .x_labels(12)
+        .y_labels(5)
+        .x_label_formatter(&|v| style::fmt_num(*v))
+        .y_label_formatter(&|v| style::fmt_num(*v))
+        .draw()?;
+    let gear_label = |v: &f64| {
+        let r = v.round();
+        if (v - r).abs() < 1e-6 && r >= 0.0 && (r as usize) < levels.len() {
+            levels[r as usize].clone()
+        } else {
+            String::new()
+        }
+    };
+    lower_chart
+        .configure_secondary_axes()
+        .y_desc("Gear")
+        .axis_desc_style(style::font(style::AXIS_DESC_PX))
+        .label_style(style::font(style::TICK_PX))
+        .y_labels(levels.len() + 1)
+        .y_label_formatter(&gear_label)
+        .draw()?;
+
+    let speed_colour = RGBColor(40, 40, 40);
+    let gear_colour = RGBColor(204, 121, 167);
+    for seg in finite_segments(&order, &ts.time_s, &ts.vehicle_speed_kmh, t_scale) {
+        if seg.len() == 1 {
+            lower_chart.draw_series(std::iter::once(Circle::new(seg[0], 5, speed_colour.filled())))?;
+        }
+        let seg = decimate(&seg, buckets);
+        lower_chart.draw_series(LineSeries::new(seg, speed_colour.stroke_width(2)))?;
+    }
+    // Gear as a step line: hold each gear until the next sample; breaks where the gear is missing.
+    let mut step: Vec<(f64, f64)> = Vec::new();
+    let mut steps = Vec::new();
+    for &i in &order {
+        let lvl = levels.iter().position(|l| l == ts.gear[i].trim());
+        let t = ts.time_s[i] * t_scale;
+        match lvl {
+            Some(l) => {
+                let y = l as f64;
+                if let Some(&(_, py)) = step.last() {
+                    step.push((t, py));
+                }
+                step.push((t, y));
+            }
+            None => {
+                if !step.is_empty() {
+                    step.push((t, step[step.len() - 1].1));
+                    steps.push(std::mem::take(&mut step));
+                }
+            }
+        }
+    }
+    if !step.is_empty() {
+        steps.push(step);
+    }
+    for s in steps {
+        if s.len() == 1 {
+            lower_chart.draw_secondary_series(std::iter::once(Circle::new(s[0], 6, gear_colour.filled())))?;
+        }
+        lower_chart.draw_secondary_series(LineSeries::new(s, gear_colour.stroke_width(3)))?;
+    }
+    let low_entries = [
+        LegendEntry::new("vehicle speed", Swatch::Line(speed_colour, 2)),
+        LegendEntry::new("gear (right axis)", Swatch::Line(gear_colour, 3)),
+    ];
+    style::draw_legend_column(&leg_low, Some("Drive"), &low_entries, 18)?;
+    if levels.is_empty() {
+        lower.draw(&Text::new(
+            "no gear data",
+            (w as i32 / 2, 30),
+            style::text_at(style::NOTE_PX, HPos::Center, VPos::Top),
+        ))?;
+    }
+    Ok(())
+}
