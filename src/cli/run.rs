@@ -50,6 +50,9 @@ pub struct RunArgs {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// Step budget of the solver (the run fails with exit 2 beyond it).
+    #[arg(long, default_value_t = 5_000_000)]
+    pub max_steps: usize,
     /// Print the summary as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -106,6 +109,7 @@ pub fn prepare(args: &RunArgs) -> Result<(Gearbox, Scene, DriveCycle, TransientO
         rtol: args.rtol,
         atol: args.atol,
         restart: Restart::AtJumps,
+        max_steps: args.max_steps,
         initial_temp: args.initial_temp_c.map(|c| c + KELVIN_OFFSET),
         ..TransientOptions::default()
     };

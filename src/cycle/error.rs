@@ -81,7 +81,7 @@ impl fmt::Display for CycleError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}", self.source)?;
         if let Some(line) = self.line {
-            write!(f, ":{line}")?;
+            write!(f, ", line {line}")?;
         }
         write!(f, ": ")?;
         match (&self.column, &self.value) {
@@ -106,7 +106,7 @@ mod tests {
             .at_line(12)
             .at_value("speed_kmh", "-3");
         let s = e.to_string();
-        assert_eq!(s, "c.csv:12: column speed_kmh = \"-3\": must be >= 0 km/h");
+        assert_eq!(s, "c.csv, line 12: column speed_kmh = \"-3\": must be >= 0 km/h");
         assert!(!s.contains('\n'));
         let e = CycleError::new(CycleErrorKind::Config, "bundled:wltc", "needs a vehicle");
         assert_eq!(e.to_string(), "bundled:wltc: needs a vehicle");

@@ -405,7 +405,8 @@ mod tests {
         let e = fails("time_s,speed_kmh\n0,0\n1,-0.5\n");
         assert_eq!((e.kind, e.line), (CycleErrorKind::Value, Some(3)));
         assert!(
-            e.to_string().starts_with("t.csv:3: column speed_kmh = \"-0.5\""),
+            e.to_string()
+                .starts_with("t.csv, line 3: column speed_kmh = \"-0.5\""),
             "{e}"
         );
         let e = fails("time_s,speed_kmh\n0,0\n1,1,1\n");

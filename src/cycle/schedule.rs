@@ -157,6 +157,11 @@ pub fn schedule(
         }
     };
 
+    // Every row's gear must exist, the last one included (it only closes the last interval, but
+    // a name the model does not know is a mistake in the file either way).
+    for k in 0..cycle.rows.len() {
+        gear_of(k)?;
+    }
     let n = cycle.rows.len().saturating_sub(1);
     let mut out: Vec<Interval> = Vec::with_capacity(n);
     match cycle.kind {
@@ -451,7 +456,7 @@ mod tests {
         );
         assert!(
             e.to_string()
-                .starts_with("g.csv:4: column gear = \"7\": not a gear state"),
+                .starts_with("g.csv, line 4: column gear = \"7\": not a gear state"),
             "{e}"
         );
     }

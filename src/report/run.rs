@@ -157,8 +157,8 @@ pub fn summary(
     // and the loss energy while driving comes from the exact per-item energies' increments.
     let mut out_e = 0.0;
     let mut loss_drive = 0.0;
-    for k in 0..traj.times.len().saturating_sub(1) {
-        let p = rows[k].output_power_w;
+    for (k, row) in rows.iter().enumerate().take(traj.times.len().saturating_sub(1)) {
+        let p = row.output_power_w;
         if p > 0.0 {
             let dt = traj.times[k + 1] - traj.times[k];
             out_e += p * dt;

@@ -217,8 +217,8 @@ impl Scene {
         self.thermal.boundary_temperatures(t, &mut work.net);
         let t_oil = self.oil_temp(y);
         let to_b = self.heat_balance(y, t_oil, &work.inputs, &work.net, &mut work.q, &mut work.heat);
-        for i in 0..n {
-            dy[i] = work.heat[i] / self.thermal.capacity[i];
+        for ((d, h), c) in dy.iter_mut().zip(&work.heat).zip(&self.thermal.capacity) {
+            *d = h / c;
         }
         dy[n..n + m].copy_from_slice(&work.q);
         dy[n + m] = to_b;
@@ -272,8 +272,8 @@ impl Scene {
             &v[..n],
             &mut work.heat,
         );
-        for i in 0..n {
-            out[i] = work.heat[i] / self.thermal.capacity[i];
+        for ((o, h), c) in out.iter_mut().zip(&work.heat).zip(&self.thermal.capacity) {
+            *o = h / c;
         }
         out[n..n + m].iter_mut().for_each(|x| *x = 0.0);
         out[n + m] = to_b;

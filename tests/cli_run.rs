@@ -1,0 +1,272 @@
+//! `geartherm run` end to end: every example model over every bundled cycle, outputs and their
+//! contract, invalid input (exit 1, nothing written), numerical failure (exit 2, named).
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_geartherm"))
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().expect("binary runs")
+}
+
+const MODELS: [&str; 4] = [
+    "models/at6_lepelletier.toml",
+    "models/fzg_c.toml",
+    "models/helical_stage.toml",
+    "models/pt6_spur_pair.toml",
+];
+
+const CYCLES: [&str; 10] = [
+    "wltc",
+    "nedc",
+    "ftp75",
+    "udds",
+    "hwfet",
+    "us06",
+    "artemis_urban",
+    "artemis_road",
+    "artemis_motorway130",
+    "artemis_motorway150",
+];
+
+fn summary(dir: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn every_example_model_runs_every_bundled_cycle() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut table = String::new();
+    for m in MODELS {
+        for c in CYCLES {
+            let dir = tmp.path().join(format!(
+                "{}_{c}",
+                Path::new(m).file_stem().unwrap().to_string_lossy()
+            ));
+            let out = run(&["run", m, "--cycle", c, "--out", dir.to_str().unwrap(), "--quiet"]);
+            assert!(
+                out.status.success(),
+                "{m} {c}: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            let s = summary(&dir);
+            let bal = s["energy_balance_relative"].as_f64().unwrap();
+            let total = s["energy_lost_j"]["total"].as_f64().unwrap();
+            assert!(bal <= 1e-9, "{m} {c}: balance {bal}");
+            assert!(total > 0.0 && total.is_finite(), "{m} {c}: {total}");
+            let oil = s["oil_node"].as_str().unwrap();
+            let t = &s["temperatures_c"][oil];
+            assert!(
+                t["final"].as_f64().unwrap() > t["min"].as_f64().unwrap(),
+                "{m} {c}: oil warms"
+            );
+            let csv = std::fs::read_to_string(dir.join("timeseries.csv")).unwrap();
+            assert!(!csv.contains("NaN") && !csv.contains("inf"), "{m} {c}");
+            table.push_str(&format!(
+                "{m:<32} {c:<20} loss {:>8.1} kJ  oil final {:>6.2} °C  balance {bal:.1e}  {} steps  {:.3} s\n",
+                total / 1e3,
+                t["final"].as_f64().unwrap(),
+                s["steps"],
+                s["wall_time_s"].as_f64().unwrap()
+            ));
+        }
+    }
+    println!("{table}");
+}
+
+#[test]
+fn run_outputs_follow_the_contract() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    let out = run(&[
+        "run",
+        MODELS[0],
+        "--cycle",
+        "wltc",
+        "--out",
+        dir.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let s: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is one JSON document");
+    for key in [
+        "wall_time_s",
+        "steps",
+        "solver",
+        "rtol",
+        "energy_lost_j",
+        "energy_balance_relative",
+        "mean_efficiency",
+        "temperatures_c",
+        "skipped",
+    ] {
+        assert!(s.get(key).is_some(), "summary lacks {key}");
+    }
+    for k in ["churning", "pocketing", "sliding", "total"] {
+        assert!(s["energy_lost_j"][k].as_f64().is_some(), "{k}");
+    }
+    let e = &s["energy_lost_j"];
+    let sum =
+        e["churning"].as_f64().unwrap() + e["pocketing"].as_f64().unwrap() + e["sliding"].as_f64().unwrap();
+    assert!((sum - e["total"].as_f64().unwrap()).abs() < 1e-6 * sum);
+    let eta = s["mean_efficiency"].as_f64().unwrap();
+    assert!(eta > 0.9 && eta < 1.0, "{eta}");
+    assert!(
+        !s["skipped"].as_array().unwrap().is_empty(),
+        "AT6 skips the suns' churning"
+    );
+    let csv = std::fs::read_to_string(dir.join("timeseries.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(
+        &header[..6],
+        &[
+            "time_s",
+            "vehicle_speed_kmh",
+            "gear",
+            "input_speed_rpm",
+            "input_torque_nm",
+            "output_power_w"
+        ]
+    );
+    assert!(header.contains(&"temp_sump_c") && header.contains(&"temp_ambient_c"));
+    assert!(header.iter().any(|h| h.starts_with("loss_sliding_")));
+    assert_eq!(header[header.len() - 1], "efficiency");
+    assert_eq!(lines.count(), 1801, "one row per second including t = 0");
+    // Nothing but the outputs in the directory (no temporary files left).
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["summary.json", "timeseries.csv"]);
+}
+
+fn assert_invalid_and_nothing_written(args: &[&str], dir: &Path, expect: &[&str]) {
+    let out = run(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+    for e in expect {
+        assert!(err.contains(e), "{args:?}: expected '{e}' in: {err}");
+    }
+    assert!(out.stdout.is_empty());
+    assert!(!dir.exists(), "{args:?} wrote {}", dir.display());
+}
+
+#[test]
+fn malformed_cycles_are_rejected_with_their_line_and_nothing_written() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("never");
+    let cases = [
+        ("nonincreasing.csv", "time_s,speed_kmh\n0,0\n1,5\n1,6\n", "line 4"),
+        ("nan.csv", "time_s,speed_kmh\n0,0\n1,NaN\n", "line 3"),
+        ("negative.csv", "time_s,speed_kmh\n0,0\n1,-3\n2,0\n", "line 3"),
+        (
+            "unknown_gear.csv",
+            "time_s,input_speed_rpm,input_torque_nm,gear\n0,1000,50,1\n1,1000,50,9\n",
+            "line 3",
+        ),
+    ];
+    for (name, text, line) in cases {
+        let f = tmp.path().join(name);
+        std::fs::write(&f, text).unwrap();
+        assert_invalid_and_nothing_written(
+            &[
+                "run",
+                MODELS[1],
+                "--cycle",
+                f.to_str().unwrap(),
+                "--out",
+                dir.to_str().unwrap(),
+            ],
+            &dir,
+            &[line, name],
+        );
+    }
+    assert_invalid_and_nothing_written(
+        &[
+            "run",
+            MODELS[1],
+            "--cycle",
+            "no_such_cycle",
+            "--out",
+            dir.to_str().unwrap(),
+        ],
+        &dir,
+        &["wltc"],
+    );
+    assert_invalid_and_nothing_written(
+        &[
+            "run",
+            MODELS[1],
+            "--solver",
+            "euler",
+            "--out",
+            dir.to_str().unwrap(),
+        ],
+        &dir,
+        &["--solver", "esdirk34"],
+    );
+    assert_invalid_and_nothing_written(
+        &[
+            "run",
+            "tests/invalid/thermal_isolated_node.toml",
+            "--out",
+            dir.to_str().unwrap(),
+        ],
+        &dir,
+        &["thermal.nodes[5]", "isolated"],
+    );
+}
+
+#[test]
+fn rig_cycle_runs_a_model_without_vehicle_semantics() {
+    let tmp = tempfile::tempdir().unwrap();
+    let f = tmp.path().join("rig.csv");
+    std::fs::write(
+        &f,
+        "time_s,input_speed_rpm,input_torque_nm,gear\n0,1450,35.3,1\n600,1450,94.1,1\n1200,1450,135.3,1\n1800,0,0,1\n",
+    )
+    .unwrap();
+    let dir = tmp.path().join("rig");
+    let out = run(&[
+        "run",
+        MODELS[1],
+        "--cycle",
+        f.to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let s = summary(&dir);
+    assert!(s["energy_balance_relative"].as_f64().unwrap() <= 1e-9);
+    assert_eq!(s["duration_s"].as_f64().unwrap(), 1800.0);
+}
+
+#[test]
+fn numerical_failure_exits_2_naming_time_node_and_item() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("fail");
+    let out = run(&[
+        "run",
+        MODELS[1],
+        "--cycle",
+        "wltc",
+        "--solver",
+        "tsit45",
+        "--max-steps",
+        "200",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("t = ") && err.contains("node ") && err.contains("loss item "),
+        "{err}"
+    );
+    assert!(!dir.exists());
+}
