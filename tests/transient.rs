@@ -452,3 +452,25 @@ conductance_w_per_k = 4.0
     o.guards.raise_failure_limit = false;
     assert!(integrate(&scene, &segs, &o, &mut |_, _| {}).is_err());
 }
+
+#[test]
+fn default_settings_on_at6_wltc_are_within_a_millikelvin_of_the_reference() {
+    let gb = model::load(std::path::Path::new("models/at6_lepelletier.toml")).unwrap();
+    let scene = Scene::compile(&gb).unwrap();
+    let cycle = geartherm::cycle::DriveCycle::resolve("wltc").unwrap();
+    let (_, segs) = segments(&gb, &cycle).unwrap();
+    let (reference, info) = geartherm::solve::work_precision::reference(&scene, &segs, 1e-12).unwrap();
+    let default = run(&scene, &segs, &TransientOptions::default());
+    let (fin, max, rms) = geartherm::solve::work_precision::errors(&default, &reference, scene.nodes());
+    let bal = energy_balance(&scene, &default).relative;
+    println!(
+        "AT6 WLTC, default {} rtol {:e}: error vs reference max {max:.2e} K, final {fin:.2e} K, rms {rms:.2e} K; \
+         balance {bal:.1e}; reference pair agrees to {:.1e} K",
+        TransientOptions::default().method.name(),
+        TransientOptions::default().rtol,
+        info.agreement_k
+    );
+    assert!(info.agreement_k < 1e-6);
+    assert!(max <= 1e-3, "{max}");
+    assert!(bal <= 1e-9, "{bal}");
+}

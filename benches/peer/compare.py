@@ -160,7 +160,7 @@ def _main(root, exe, reps, quick, tmp):
             print(results[-1], flush=True)
 
     # ---- 4. peer sweep ---------------------------------------------------------------------
-    p_rtols = (1e-4, 1e-6, 1e-8) if quick else (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
+    p_rtols = (1e-4, 1e-6, 1e-8) if quick else (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
     for meth in ("BDF", "Radau", "LSODA"):
         for rt in p_rtols:
             runs = [peer.run(scene, sched, meth, rt, rt) for _ in range(reps)]
@@ -258,6 +258,17 @@ def _main(root, exe, reps, quick, tmp):
         ir = f"{q['p_interp'] / q['g_wall']:.0f}× / {q['p_interp'] / q['g_proc']:.0f}×" if q["p_interp"] else ""
         L.append(f"| {q['g_method']} rtol {q['g_rtol']:g} | {q['g_err']:.1e} | {q['g_wall']:.4f} | "
                  f"{q['p_method']} | {b} | {rr} | {ir} |")
+    L.append("\n## Notes\n")
+    L.append("- geartherm takes about one step per 1 s interval at rtol 1e-4 to 1e-8: the interval ends "
+             "are stop times, so at loose tolerances the step size is capped by the output grid "
+             "rather than by error control. This is why rtol 1e-4 and 1e-5 give the same result.")
+    L.append("- Radau's error at the step ends is tiny: its final |ΔT| is at the reference level at "
+             "every rtol. Its 1 Hz grid error comes from scipy's dense output (`t_eval`) inside "
+             "multi-second steps over stretches of constant input. That is why its max |ΔT| is not "
+             "monotone in rtol.")
+    L.append("- scipy's LSODA is Fortran. It is 4–7× faster than scipy's pure-Python BDF/Radau on "
+             "this problem, and it is the strongest peer. The peer's cost is mostly Python overhead "
+             "per RHS call and per `solve_ivp` call (about 1560 restarts).")
     with open(os.path.join(HERE, "results.md"), "w") as f:
         f.write("\n".join(L) + "\n")
     print("\n".join(L))

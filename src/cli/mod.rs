@@ -5,7 +5,9 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 
+mod bench;
 mod run;
+mod steady;
 
 use geartherm::model::{self, Gearbox, ModelError};
 use geartherm::physics::oil::KELVIN_OFFSET;
@@ -67,6 +69,13 @@ pub enum Command {
     /// Drive-cycle transient: losses heat the thermal network; writes timeseries.csv and
     /// summary.json into the output directory.
     Run(run::RunArgs),
+    /// Equilibrium temperatures, losses and efficiency at one operating point.
+    Steady(steady::SteadyArgs),
+    /// Equilibria over a speed × torque grid (map.csv and heat maps).
+    Map(steady::MapArgs),
+    /// Work-precision study: every solver over rtol 1e-3 … 1e-10 against a 1e-12 reference;
+    /// writes bench.csv, bench.json and work_precision.png.
+    Bench(bench::BenchArgs),
     /// PNG plots and report.md from an existing output directory (a run, a map or a bench).
     Report {
         /// Directory with timeseries.csv + summary.json, map.csv, or bench.csv.
@@ -204,6 +213,9 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             }
             Ok(())
         }
+        Command::Bench(args) => bench::bench(&args),
+        Command::Steady(args) => steady::steady(&args),
+        Command::Map(args) => steady::map(&args),
         Command::Run(args) => {
             let outcome = run::run(&args)?;
             if args.json {

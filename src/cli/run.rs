@@ -26,8 +26,8 @@ pub struct RunArgs {
     /// Output directory (default: runs/<model>_<cycle>).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Solver: esdirk34 (default), tr-bdf2, bdf, tsit45.
-    #[arg(long, default_value = "esdirk34")]
+    /// Solver: tr-bdf2 (default), esdirk34, bdf, tsit45.
+    #[arg(long, default_value = "tr-bdf2")]
     pub solver: String,
     /// Relative tolerance.
     #[arg(long, default_value_t = geartherm::solve::transient::DEFAULT_RTOL)]

@@ -1,4 +1,6 @@
 //! Solvers: the transient driver (diffsol) and the steady-state equilibrium search.
 pub mod drive;
+pub mod equilibrium;
 pub mod steady;
 pub mod transient;
+pub mod work_precision;

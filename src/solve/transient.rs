@@ -131,9 +131,9 @@ impl Default for Guards {
 }
 
 /// Default method (chosen by the work-precision study, docs/numerics.md).
-pub const DEFAULT_METHOD: Method = Method::Esdirk34;
+pub const DEFAULT_METHOD: Method = Method::TrBdf2;
 /// Default relative tolerance (docs/numerics.md).
-pub const DEFAULT_RTOL: f64 = 1e-6;
+pub const DEFAULT_RTOL: f64 = 1e-4;
 /// Default absolute tolerance on temperatures, K.
 pub const DEFAULT_ATOL: f64 = 1e-6;
 

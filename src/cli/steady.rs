@@ -1,0 +1,374 @@
+//! `geartherm steady` (one equilibrium) and `geartherm map` (equilibria over a speed × torque
+//! grid, in parallel with warm starts).
+
+use std::collections::BTreeMap;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+use rayon::prelude::*;
+
+use geartherm::model::{self, Gearbox};
+use geartherm::physics::oil::KELVIN_OFFSET;
+use geartherm::scene::{Inputs, Scene};
+use geartherm::solve::equilibrium::{equilibrium, Equilibrium};
+use geartherm::solve::steady::SteadyOptions;
+
+use super::{check_range, invalid, print_json, state_index, Failure, EXIT_IO, EXIT_NUMERICAL};
+
+/// Operating-point arguments shared by `steady` and `map`.
+#[derive(clap::Args, Debug)]
+pub struct PointArgs {
+    /// Model file (TOML).
+    pub model: PathBuf,
+    /// Gear state name.
+    #[arg(long)]
+    pub gear: String,
+    /// Ambient temperature, °C (default: the model's ambient boundary).
+    #[arg(long, allow_negative_numbers = true)]
+    pub ambient_c: Option<f64>,
+    /// Vehicle speed for h(v) links, km/h.
+    #[arg(long, default_value_t = 0.0)]
+    pub vehicle_speed_kmh: f64,
+}
+
+/// Arguments of `steady`.
+#[derive(clap::Args, Debug)]
+pub struct SteadyArgs {
+    #[command(flatten)]
+    pub point: PointArgs,
+    /// Input speed, rpm.
+    #[arg(long)]
+    pub speed_rpm: f64,
+    /// Input torque, N·m.
+    #[arg(long, allow_negative_numbers = true)]
+    pub torque_nm: f64,
+    /// One JSON document on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Arguments of `map`.
+#[derive(clap::Args, Debug)]
+pub struct MapArgs {
+    #[command(flatten)]
+    pub point: PointArgs,
+    /// Speeds A:B:N (rpm, N points from A to B).
+    #[arg(long)]
+    pub speed_rpm: String,
+    /// Torques A:B:N (N·m).
+    #[arg(long)]
+    pub torque_nm: String,
+    /// Output directory (default: maps/<model>_gear<G>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Skip the PNG heat maps.
+    #[arg(long)]
+    pub no_plots: bool,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+fn prepare(p: &PointArgs) -> Result<(Gearbox, Scene, usize), Failure> {
+    let gb = model::load(&p.model)?;
+    let state = state_index(&gb, &p.gear)?;
+    check_range("--vehicle-speed-kmh", p.vehicle_speed_kmh, 0.0, 400.0, " km/h")?;
+    let mut scene = Scene::compile(&gb).map_err(|e| invalid(format!("{}: {e}", p.model.display())))?;
+    if let Some(a) = p.ambient_c {
+        check_range("--ambient-c", a, -60.0, 80.0, " °C")?;
+        let idx = scene.thermal.ambient.ok_or_else(|| {
+            invalid(format!(
+                "--ambient-c: {} has no ambient boundary",
+                p.model.display()
+            ))
+        })?;
+        scene.thermal.set_boundary_fixed(idx, a + KELVIN_OFFSET);
+    }
+    Ok((gb, scene, state))
+}
+
+fn inputs(p: &PointArgs, state: usize, speed_rpm: f64, torque: f64) -> Inputs {
+    Inputs {
+        state,
+        input_speed: speed_rpm * std::f64::consts::PI / 30.0,
+        input_torque: torque,
+        vehicle_speed: p.vehicle_speed_kmh / 3.6,
+    }
+}
+
+/// `steady` report.
+#[derive(serde::Serialize)]
+struct SteadyReport {
+    model: String,
+    gear: String,
+    speed_rpm: f64,
+    torque_nm: f64,
+    temperatures_c: BTreeMap<String, f64>,
+    losses_w: BTreeMap<String, f64>,
+    by_source_w: BTreeMap<&'static str, f64>,
+    total_loss_w: f64,
+    efficiency: Option<f64>,
+    iterations: usize,
+    ptc_iterations: usize,
+    method: &'static str,
+    residual_w: f64,
+}
+
+/// Run `steady`.
+pub fn steady(a: &SteadyArgs) -> Result<(), Failure> {
+    let (gb, scene, state) = prepare(&a.point)?;
+    check_range("--speed-rpm", a.speed_rpm, 0.0, 50_000.0, " rpm")?;
+    check_range("--torque-nm", a.torque_nm, -1e6, 1e6, " N m")?;
+    let eq = equilibrium(
+        &scene,
+        inputs(&a.point, state, a.speed_rpm, a.torque_nm),
+        None,
+        &SteadyOptions::default(),
+    )
+    .map_err(|e| Failure {
+        code: EXIT_NUMERICAL,
+        message: format!(
+            "{}: no equilibrium: {}",
+            a.point.model.display(),
+            describe(&scene, &e)
+        ),
+    })?;
+    let mut temps = BTreeMap::new();
+    for (n, t) in scene.thermal.names.iter().zip(&eq.solution.temperatures) {
+        temps.insert(n.clone(), t - KELVIN_OFFSET);
+    }
+    let mut losses = BTreeMap::new();
+    for (it, q) in scene.losses.items.iter().zip(&eq.losses) {
+        losses.insert(format!("{}:{}", it.source.as_str(), it.name), *q);
+    }
+    let total: f64 = eq.by_source.iter().sum();
+    let r = SteadyReport {
+        model: gb.name.clone(),
+        gear: a.point.gear.clone(),
+        speed_rpm: a.speed_rpm,
+        torque_nm: a.torque_nm,
+        temperatures_c: temps,
+        losses_w: losses,
+        by_source_w: BTreeMap::from([
+            ("churning", eq.by_source[0]),
+            ("pocketing", eq.by_source[1]),
+            ("sliding", eq.by_source[2]),
+        ]),
+        total_loss_w: total,
+        efficiency: eq.efficiency,
+        iterations: eq.solution.iterations,
+        ptc_iterations: eq.solution.ptc_iterations,
+        method: eq.solution.method,
+        residual_w: eq.solution.residual_w,
+    };
+    if a.json {
+        return print_json(&r);
+    }
+    println!(
+        "{} gear {} at {} rpm, {} N·m: equilibrium after {} Newton + {} PTC iterations ({}), residual {:.1e} W",
+        r.model, r.gear, r.speed_rpm, r.torque_nm, r.iterations, r.ptc_iterations, r.method, r.residual_w
+    );
+    println!("temperatures, °C");
+    for (n, t) in &r.temperatures_c {
+        println!("  {n:<20} {t:>9.3}");
+    }
+    println!("losses, W");
+    for (n, q) in &r.losses_w {
+        println!("  {n:<44} {q:>10.3}");
+    }
+    println!(
+        "  churning {:.2} W, pocketing {:.2} W, sliding {:.2} W, total {:.2} W; efficiency {}",
+        eq.by_source[0],
+        eq.by_source[1],
+        eq.by_source[2],
+        total,
+        r.efficiency.map_or("n/a".into(), |e| format!("{e:.5}"))
+    );
+    Ok(())
+}
+
+fn describe(scene: &Scene, e: &geartherm::solve::steady::SteadyError) -> String {
+    use geartherm::solve::steady::SteadyError as E;
+    let name = |i: usize| scene.thermal.names.get(i).cloned().unwrap_or_default();
+    match e {
+        E::NoEquilibriumInRange {
+            node,
+            temperature_k,
+            bound_k,
+            which,
+        } => format!(
+            "node {} is driven past its {which} limit {:.1} °C (toward {:.1} °C): the losses grow faster with \
+             temperature than the cooling removes heat",
+            name(*node),
+            bound_k - KELVIN_OFFSET,
+            temperature_k - KELVIN_OFFSET
+        ),
+        E::Singular { nodes } => format!(
+            "node(s) {} have no thermal path to a boundary",
+            nodes.iter().map(|&i| name(i)).collect::<Vec<_>>().join(", ")
+        ),
+        other => other.to_string(),
+    }
+}
+
+fn range(flag: &str, s: &str) -> Result<Vec<f64>, Failure> {
+    let parts: Vec<&str> = s.split(':').collect();
+    let bad = || {
+        invalid(format!(
+            "{flag} {s}: expected A:B:N (from A to B in N points, N ≥ 1)"
+        ))
+    };
+    if parts.len() != 3 {
+        return Err(bad());
+    }
+    let a: f64 = parts[0].trim().parse().map_err(|_| bad())?;
+    let b: f64 = parts[1].trim().parse().map_err(|_| bad())?;
+    let n: usize = parts[2].trim().parse().map_err(|_| bad())?;
+    if n == 0 || n > 2000 || !a.is_finite() || !b.is_finite() || (n > 1 && b < a) {
+        return Err(bad());
+    }
+    Ok((0..n)
+        .map(|k| {
+            if n == 1 {
+                a
+            } else {
+                a + (b - a) * k as f64 / (n - 1) as f64
+            }
+        })
+        .collect())
+}
+
+struct MapPoint {
+    speed: f64,
+    torque: f64,
+    eq: Option<Equilibrium>,
+}
+
+/// Run `map`.
+pub fn map(a: &MapArgs) -> Result<(), Failure> {
+    let (gb, scene, state) = prepare(&a.point)?;
+    let speeds = range("--speed-rpm", &a.speed_rpm)?;
+    let torques = range("--torque-nm", &a.torque_nm)?;
+    for &s in &speeds {
+        check_range("--speed-rpm", s, 0.0, 50_000.0, " rpm")?;
+    }
+    let bar = (!a.quiet && std::io::stderr().is_terminal()).then(|| {
+        let b = indicatif::ProgressBar::new((speeds.len() * torques.len()) as u64);
+        if let Ok(st) = indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} points ({eta})")
+        {
+            b.set_style(st.progress_chars("=> "));
+        }
+        b.set_message("equilibria");
+        b
+    });
+    let start = std::time::Instant::now();
+    let opts = SteadyOptions::default();
+    // One speed per task; along the torque axis each point starts from its neighbour's solution.
+    let rows: Vec<Vec<MapPoint>> = speeds
+        .par_iter()
+        .map(|&sp| {
+            let mut warm: Option<Vec<f64>> = None;
+            torques
+                .iter()
+                .map(|&tq| {
+                    let r = equilibrium(&scene, inputs(&a.point, state, sp, tq), warm.as_deref(), &opts)
+                        .or_else(|_| equilibrium(&scene, inputs(&a.point, state, sp, tq), None, &opts))
+                        .ok();
+                    if let Some(e) = &r {
+                        warm = Some(e.solution.temperatures.clone());
+                    }
+                    if let Some(b) = &bar {
+                        b.inc(1);
+                    }
+                    MapPoint {
+                        speed: sp,
+                        torque: tq,
+                        eq: r,
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let wall = start.elapsed().as_secs_f64();
+    let oil = scene.thermal.oil;
+    let mut csv = String::from(
+        "speed_rpm,torque_nm,efficiency,total_loss_w,churning_w,pocketing_w,sliding_w,oil_temp_c,iterations,converged\n",
+    );
+    let (mut ok, mut iters) = (0usize, 0usize);
+    for p in rows.iter().flatten() {
+        match &p.eq {
+            Some(e) => {
+                ok += 1;
+                iters += e.solution.iterations + e.solution.ptc_iterations;
+                let total: f64 = e.by_source.iter().sum();
+                csv.push_str(&format!(
+                    "{},{},{},{},{},{},{},{},{},true\n",
+                    p.speed,
+                    p.torque,
+                    e.efficiency.map_or(String::new(), |x| x.to_string()),
+                    total,
+                    e.by_source[0],
+                    e.by_source[1],
+                    e.by_source[2],
+                    e.solution.temperatures[oil] - KELVIN_OFFSET,
+                    e.solution.iterations + e.solution.ptc_iterations
+                ));
+            }
+            None => csv.push_str(&format!("{},{},,,,,,,,false\n", p.speed, p.torque)),
+        }
+    }
+    let n = speeds.len() * torques.len();
+    let json = serde_json::json!({
+        "model": gb.name,
+        "gear": a.point.gear,
+        "points": n,
+        "converged": ok,
+        "mean_iterations": iters as f64 / ok.max(1) as f64,
+        "wall_time_s": wall,
+        "threads": rayon::current_num_threads(),
+    });
+    let dir = a.out.clone().unwrap_or_else(|| {
+        PathBuf::from("maps").join(format!(
+            "{}_gear{}",
+            a.point
+                .model
+                .file_stem()
+                .map_or("model".into(), |s| s.to_string_lossy()),
+            a.point.gear
+        ))
+    });
+    let text = serde_json::to_string_pretty(&json).map_err(|e| Failure {
+        code: EXIT_IO,
+        message: e.to_string(),
+    })?;
+    geartherm::report::files::write_all_atomic(
+        &dir,
+        &[("map.csv", csv.as_bytes()), ("map.json", text.as_bytes())],
+    )
+    .map_err(|e| Failure {
+        code: EXIT_IO,
+        message: format!("{}: {e}", dir.display()),
+    })?;
+    if !a.no_plots {
+        geartherm::report::plots::render_map(&dir).map_err(|e| Failure {
+            code: EXIT_IO,
+            message: format!("plot: {e}"),
+        })?;
+    }
+    println!(
+        "{n} points ({ok} converged, {:.1} iterations on average) in {wall:.3} s on {} threads; outputs in {}",
+        iters as f64 / ok.max(1) as f64,
+        rayon::current_num_threads(),
+        dir.display()
+    );
+    if ok < n {
+        return Err(Failure {
+            code: EXIT_NUMERICAL,
+            message: format!("{} of {n} points have no equilibrium (blank in map.csv)", n - ok),
+        });
+    }
+    Ok(())
+}

@@ -1,0 +1,162 @@
+//! Equilibrium of a scene at a fixed operating point: the scene's heat balance as a
+//! [`HeatBalance`] for the damped-Newton / pseudo-transient solver of [`super::steady`], the same
+//! right-hand side and Jacobian as the transient runs.
+
+use std::cell::RefCell;
+
+use nalgebra::DMatrix;
+
+use crate::physics::oil::KELVIN_OFFSET;
+use crate::scene::{Inputs, Scene, Source, Work};
+
+use super::steady::{solve_steady, HeatBalance, SteadyError, SteadyOptions, SteadySolution};
+
+/// Time at which time-series boundaries are evaluated for a steady state: their final value.
+pub const STEADY_TIME: f64 = 1e12;
+
+/// Valid range of the oil node, °C: below −60 °C the Walther fit is far outside its data, above
+/// 200 °C gear oils and ATFs are past their flash-point region (no equilibrium "exists" there).
+pub const OIL_RANGE_C: (f64, f64) = (-60.0, 200.0);
+/// Valid range of the other nodes, °C.
+pub const NODE_RANGE_C: (f64, f64) = (-100.0, 600.0);
+
+/// The scene's heat balance at fixed inputs.
+pub struct SceneBalance<'a> {
+    scene: &'a Scene,
+    work: RefCell<Work>,
+    y: RefCell<Vec<f64>>,
+    v: RefCell<Vec<f64>>,
+    out: RefCell<Vec<f64>>,
+}
+
+impl<'a> SceneBalance<'a> {
+    /// The balance of `scene` at `inputs`.
+    pub fn new(scene: &'a Scene, inputs: Inputs) -> Self {
+        let ns = scene.n_states();
+        Self {
+            scene,
+            work: RefCell::new(scene.work(inputs)),
+            y: RefCell::new(vec![0.0; ns]),
+            v: RefCell::new(vec![0.0; ns]),
+            out: RefCell::new(vec![0.0; ns]),
+        }
+    }
+}
+
+impl HeatBalance for SceneBalance<'_> {
+    fn dim(&self) -> usize {
+        self.scene.nodes()
+    }
+
+    fn residual(&self, t: &[f64], out: &mut [f64]) -> Result<(), String> {
+        let mut y = self.y.borrow_mut();
+        y[..t.len()].copy_from_slice(t);
+        let mut w = self.work.borrow_mut();
+        self.scene.net_heat(STEADY_TIME, &y, &mut w, out);
+        if let Some(k) = w.q.iter().position(|q| !q.is_finite()) {
+            let it = &self.scene.losses.items[k];
+            return Err(format!(
+                "loss item {}:{} is not finite at oil temperature {:.2} °C",
+                it.source.as_str(),
+                it.name,
+                self.scene.oil_temp(&y) - KELVIN_OFFSET
+            ));
+        }
+        Ok(())
+    }
+
+    fn jacobian(&self, t: &[f64], jac: &mut DMatrix<f64>) -> Result<(), String> {
+        let n = t.len();
+        let mut y = self.y.borrow_mut();
+        y[..n].copy_from_slice(t);
+        let mut v = self.v.borrow_mut();
+        let mut o = self.out.borrow_mut();
+        let mut w = self.work.borrow_mut();
+        for j in 0..n {
+            v.iter_mut().for_each(|x| *x = 0.0);
+            v[j] = 1.0;
+            self.scene.jvp(STEADY_TIME, &y, &v, &mut w, &mut o);
+            for i in 0..n {
+                // jvp gives d(dT/dt)/dT = J / C for the temperature rows.
+                jac[(i, j)] = o[i] * self.scene.thermal.capacity[i];
+            }
+        }
+        if jac.iter().any(|x| !x.is_finite()) {
+            return Err("the Jacobian is not finite".into());
+        }
+        Ok(())
+    }
+
+    fn capacities(&self) -> &[f64] {
+        &self.scene.thermal.capacity
+    }
+
+    fn bounds(&self, i: usize) -> (f64, f64) {
+        let (lo, hi) = if i == self.scene.thermal.oil {
+            OIL_RANGE_C
+        } else {
+            NODE_RANGE_C
+        };
+        (lo + KELVIN_OFFSET, hi + KELVIN_OFFSET)
+    }
+}
+
+/// An equilibrium with its losses.
+#[derive(Debug, Clone)]
+pub struct Equilibrium {
+    /// Solver result (temperatures in K).
+    pub solution: SteadySolution,
+    /// Loss of each item at equilibrium, W.
+    pub losses: Vec<f64>,
+    /// Per source: churning, pocketing, sliding, W.
+    pub by_source: [f64; 3],
+    /// Loss-free transmitted power T·ω, W.
+    pub power: f64,
+    /// Efficiency P / (P + losses) (None without power).
+    pub efficiency: Option<f64>,
+}
+
+/// Solve the equilibrium of `scene` at `inputs` from `start` (K per node; None: the ambient or
+/// the initial temperatures).
+pub fn equilibrium(
+    scene: &Scene,
+    inputs: Inputs,
+    start: Option<&[f64]>,
+    opts: &SteadyOptions,
+) -> Result<Equilibrium, SteadyError> {
+    let sys = SceneBalance::new(scene, inputs);
+    let t0: Vec<f64> = match start {
+        Some(s) => s.to_vec(),
+        None => {
+            let mut w = scene.thermal.work();
+            scene.thermal.boundary_temperatures(STEADY_TIME, &mut w);
+            let amb = scene.thermal.ambient.map(|a| w.boundary_t[a]);
+            match amb {
+                Some(a) => vec![a; scene.nodes()],
+                None => scene.thermal.initial.clone(),
+            }
+        }
+    };
+    let solution = solve_steady(&sys, &t0, opts)?;
+    let mut y = vec![0.0; scene.n_states()];
+    y[..scene.nodes()].copy_from_slice(&solution.temperatures);
+    let mut w = scene.work(inputs);
+    scene.evaluate_losses(&y, &mut w);
+    let mut by = [0.0; 3];
+    for (q, it) in w.q.iter().zip(&scene.losses.items) {
+        by[match it.source {
+            Source::Churning => 0,
+            Source::Pocketing => 1,
+            Source::Sliding => 2,
+        }] += q;
+    }
+    let power = inputs.input_torque * inputs.input_speed;
+    let total = by[0] + by[1] + by[2];
+    Ok(Equilibrium {
+        solution,
+        losses: w.q,
+        by_source: by,
+        power,
+        efficiency: (power > 0.0).then(|| power / (power + total)),
+    })
+}
