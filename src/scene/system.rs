@@ -54,6 +54,10 @@ pub struct Scene {
     /// Oil temperature used for the oil properties instead of the oil node's (K); `None` for the
     /// normal coupled model. Used to measure the viscosity feedback.
     pub frozen_oil_temp: Option<f64>,
+    /// Clamp of the oil temperature used for the oil properties (K), if any: lets a runaway be
+    /// followed past the oil's valid range without the property laws breaking down (used by the
+    /// steady-state fallback to prove that no equilibrium exists in range).
+    pub oil_temp_clamp: Option<(f64, f64)>,
 }
 
 /// Mutable work area of one solve: current inputs, sample values and buffers. No allocation after
@@ -96,6 +100,7 @@ impl Scene {
             thermal,
             skipped,
             frozen_oil_temp: None,
+            oil_temp_clamp: None,
         })
     }
 
@@ -163,7 +168,11 @@ impl Scene {
 
     /// Oil temperature (K) that sets the oil properties.
     pub fn oil_temp(&self, y: &[f64]) -> f64 {
-        self.frozen_oil_temp.unwrap_or(y[self.thermal.oil])
+        let t = self.frozen_oil_temp.unwrap_or(y[self.thermal.oil]);
+        match self.oil_temp_clamp {
+            Some((lo, hi)) => t.clamp(lo, hi),
+            None => t,
+        }
     }
 
     /// Evaluate every loss item (W) at state `y` into `work.q` (also used for output).

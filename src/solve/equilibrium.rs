@@ -9,7 +9,8 @@ use nalgebra::DMatrix;
 use crate::physics::oil::KELVIN_OFFSET;
 use crate::scene::{Inputs, Scene, Source, Work};
 
-use super::steady::{solve_steady, HeatBalance, SteadyError, SteadyOptions, SteadySolution};
+use super::steady::{solve_steady, BoundSide, HeatBalance, SteadyError, SteadyOptions, SteadySolution};
+use super::transient::{integrate, Method, Segment, TransientOptions};
 
 /// Time at which time-series boundaries are evaluated for a steady state: their final value.
 pub const STEADY_TIME: f64 = 1e12;
@@ -137,7 +138,17 @@ pub fn equilibrium(
             }
         }
     };
-    let solution = solve_steady(&sys, &t0, opts)?;
+    let solution = match solve_steady(&sys, &t0, opts) {
+        Ok(s) => s,
+        // Newton and PTC gave up: follow the physical transient (the real ODE with the driver of
+        // the transient runs) until it either settles, giving Newton a start next to the
+        // equilibrium, or carries a node past its limit, which proves there is none in range.
+        Err(SteadyError::NotConverged { .. }) => {
+            let settled = transient_fallback(scene, &sys, inputs, &t0)?;
+            solve_steady(&sys, &settled, opts)?
+        }
+        Err(e) => return Err(e),
+    };
     let mut y = vec![0.0; scene.n_states()];
     y[..scene.nodes()].copy_from_slice(&solution.temperatures);
     let mut w = scene.work(inputs);
@@ -159,4 +170,65 @@ pub fn equilibrium(
         power,
         efficiency: (power > 0.0).then(|| power / (power + total)),
     })
+}
+
+/// Follow the transient from `t0` at constant inputs, in segments of growing length, until the
+/// temperatures settle (returns them) or a node leaves its valid range (no equilibrium).
+fn transient_fallback(
+    scene: &Scene,
+    sys: &SceneBalance<'_>,
+    inputs: Inputs,
+    t0: &[f64],
+) -> Result<Vec<f64>, SteadyError> {
+    let n = scene.nodes();
+    // Node time constants are at most hours; 40 segments growing ×2 from 60 s cover ~2000 years.
+    let mut segs = Vec::new();
+    let (mut t, mut len) = (0.0, 60.0);
+    for _ in 0..40 {
+        segs.push(Segment {
+            t0: t,
+            t1: t + len,
+            inputs,
+        });
+        t += len;
+        len *= 2.0;
+    }
+    let o = TransientOptions {
+        method: Method::Bdf,
+        rtol: 1e-8,
+        atol: 1e-8,
+        initial_temp: None,
+        ..TransientOptions::default()
+    };
+    let mut scene_from = scene.clone();
+    scene_from.oil_temp_clamp = Some(sys.bounds(scene.thermal.oil));
+    let mut last = t0.to_vec();
+    // One segment at a time, checking the limits between them.
+    for seg in &segs {
+        scene_from.thermal.initial = last.clone();
+        let traj = integrate(&scene_from, std::slice::from_ref(seg), &o, &mut |_, _| {})
+            .map_err(|e| SteadyError::Model(format!("transient fallback failed: {e}")))?;
+        let y = traj.states.last().map_or(&last[..], |v| &v[..n]).to_vec();
+        for (i, &yi) in y.iter().enumerate() {
+            let (lo, hi) = sys.bounds(i);
+            if yi > hi || yi < lo {
+                return Err(SteadyError::NoEquilibriumInRange {
+                    node: i,
+                    temperature_k: yi,
+                    bound_k: if yi > hi { hi } else { lo },
+                    which: if yi > hi {
+                        BoundSide::Upper
+                    } else {
+                        BoundSide::Lower
+                    },
+                });
+            }
+        }
+        let settled = y.iter().zip(&last).all(|(a, b)| (a - b).abs() < 1e-9 * a.abs());
+        last = y;
+        if settled {
+            break;
+        }
+    }
+    Ok(last)
 }

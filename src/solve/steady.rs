@@ -541,6 +541,7 @@ impl<H: HeatBalance> Solver<'_, H> {
         let mut stuck = 0usize;
         while self.ptc_iters < self.opts.ptc_max_iter {
             self.ptc_iters += 1;
+
             self.eval_jacobian()?;
             for i in 0..self.n {
                 self.jac[(i, i)] -= self.caps[i] / dtau;
@@ -558,6 +559,16 @@ impl<H: HeatBalance> Solver<'_, H> {
             }
             let rn = norm2(&self.r_trial);
             if rn > PTC_REJECT_GROWTH * r_prev {
+                // A rejected step while a node sits at its limit with its heat balance pushing out
+                // also counts toward `bound_patience`: with that node clipped the others keep
+                // heating and every further step grows the residual (runaway with no equilibrium
+                // in range), which would otherwise only shrink Δτ until the budget runs out.
+                if self.pushing_node().is_some() {
+                    stuck += 1;
+                    if stuck >= self.opts.bound_patience {
+                        return Ok(PtcOutcome::Stuck);
+                    }
+                }
                 dtau *= PTC_SHRINK;
                 continue;
             }
