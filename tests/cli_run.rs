@@ -270,3 +270,110 @@ fn numerical_failure_exits_2_naming_time_node_and_item() {
     );
     assert!(!dir.exists());
 }
+
+fn png_stats(path: &Path) -> (u32, u32, f64) {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let px = &buf[..info.buffer_size()];
+    let mean = px.iter().map(|&v| f64::from(v)).sum::<f64>() / px.len() as f64;
+    let var = px.iter().map(|&v| (f64::from(v) - mean).powi(2)).sum::<f64>() / px.len() as f64;
+    (info.width, info.height, var)
+}
+
+#[test]
+fn run_with_report_writes_decodable_non_blank_pngs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let f = tmp.path().join("short.csv");
+    // A short vehicle cycle: launch, cruise, stop.
+    let mut text = String::from("time_s,speed_kmh\n");
+    for t in 0..=120 {
+        let v = if t < 30 {
+            2.0 * t as f64
+        } else if t < 90 {
+            60.0
+        } else {
+            2.0 * (120 - t) as f64
+        };
+        text.push_str(&format!("{t},{v}\n"));
+    }
+    std::fs::write(&f, text).unwrap();
+    let dir = tmp.path().join("rep");
+    let out = run(&[
+        "run",
+        MODELS[0],
+        "--cycle",
+        f.to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+        "--report",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for name in ["temperatures.png", "losses.png", "energy.png", "efficiency.png"] {
+        let (w, h, var) = png_stats(&dir.join(name));
+        assert_eq!((w, h), (1600, 1000), "{name}");
+        assert!(var > 100.0, "{name} looks blank (pixel variance {var})");
+    }
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    for name in ["temperatures.png", "losses.png", "energy.png", "efficiency.png"] {
+        assert!(md.contains(name), "report.md does not show {name}");
+    }
+}
+
+#[test]
+fn committed_plots_match_what_the_documented_commands_produce() {
+    // plots/regenerate.sh: the run and the map; their data files must be what the binary
+    // produces today (PNGs are rendered from them).
+    let tmp = tempfile::tempdir().unwrap();
+    let r = tmp.path().join("at6_wltc");
+    let out = run(&[
+        "run",
+        MODELS[0],
+        "--cycle",
+        "wltc",
+        "--out",
+        r.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(out.status.success());
+    assert_eq!(
+        std::fs::read_to_string(r.join("timeseries.csv")).unwrap(),
+        std::fs::read_to_string("plots/at6_wltc/timeseries.csv").unwrap(),
+        "plots/at6_wltc is stale: run plots/regenerate.sh"
+    );
+    let m = tmp.path().join("map");
+    let out = run(&[
+        "map",
+        MODELS[1],
+        "--gear",
+        "1",
+        "--speed-rpm",
+        "300:3000:28",
+        "--torque-nm",
+        "0:300:31",
+        "--out",
+        m.to_str().unwrap(),
+        "--no-plots",
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        std::fs::read_to_string(m.join("map.csv")).unwrap(),
+        std::fs::read_to_string("plots/fzg_c_map/map.csv").unwrap(),
+        "plots/fzg_c_map is stale: run plots/regenerate.sh"
+    );
+    for p in [
+        "plots/at6_wltc/temperatures.png",
+        "plots/at6_wltc/losses.png",
+        "plots/at6_wltc/energy.png",
+        "plots/at6_wltc/efficiency.png",
+        "plots/fzg_c_map/map_efficiency.png",
+        "plots/fzg_c_map/map_total_loss.png",
+        "plots/fzg_c_map/map_oil_temp.png",
+    ] {
+        let (w, h, var) = png_stats(Path::new(p));
+        assert_eq!((w, h), (1600, 1000), "{p}");
+        assert!(var > 100.0, "{p}");
+    }
+}

@@ -341,7 +341,14 @@ class Scene:
                 self.rad.append((a, b, STEFAN_BOLTZMANN * l["emissivity"] * l["area_m2"]))
             else:
                 raise ValueError(f"unsupported link {l}")
-        assert not th.get("coolers") and not th.get("heat")
+        assert not th.get("heat")
+        # coolers: q = eps*C * x(T_hot) * (T_hot - T_cold), x = smoothstep thermostat (thermal.rs)
+        self.coolers = []
+        for cl in th.get("coolers", []):
+            ts = cl.get("thermostat")
+            self.coolers.append((idx(cl["hot"]), idx(cl["cold"]),
+                                 cl["effectiveness"] * cl["capacity_rate_w_per_k"],
+                                 (ts["open_c"] + KELVIN, ts["full_c"] + KELVIN) if ts else None))
         # heat destinations: churning/pocketing → oil node; sliding → gear bodies 50/50
         body = {}
         for i, nd in enumerate(th["nodes"]):
@@ -438,11 +445,42 @@ class Scene:
                     to_b += qq
             return heat, to_b
 
+        coolers = self.coolers
+
+        def opening(th, ts):
+            if ts is None:
+                return 1.0, 0.0
+            a, b = ts
+            if th <= a:
+                return 0.0, 0.0
+            if th >= b:
+                return 1.0, 0.0
+            w = b - a
+            x = (th - a) / w
+            return x * x * (3 - 2 * x), 6 * x * (1 - x) / w
+
+        def cooler_terms(temps):
+            heat = np.zeros(n)
+            to_b = 0.0
+            for (hot, cold, g, ts) in coolers:
+                th = temps[hot[1]]
+                tc = temps[cold[1]] if cold[0] == "n" else bt[cold[1]]
+                x, _ = opening(th, ts)
+                qq = g * x * (th - tc)
+                heat[hot[1]] -= qq
+                if cold[0] == "n":
+                    heat[cold[1]] += qq
+                else:
+                    to_b += qq
+            return heat, to_b
+
         def rhs(t, y):
             temps = y[:n]
             h1, q, tb1 = oil_terms(temps, temps[oil_i])
             h2, tb2 = rad_terms(temps)
-            heat = A @ temps + c + h1 + h2
+            h3, tb3 = cooler_terms(temps)
+            tb2 += tb3
+            heat = A @ temps + c + h1 + h2 + h3
             dy = np.empty(n + m + 1)
             dy[:n] = heat / cap
             dy[n:n + m] = q
@@ -466,6 +504,21 @@ class Scene:
                             J[e2[1], j] += s2 * dq / cap[e2[1]]
                         else:
                             J[n + m, j] += s2 * dq
+            # coolers (analytic)
+            for (hot, cold, g, ts) in coolers:
+                i = hot[1]
+                th = temps[i]
+                tc = temps[cold[1]] if cold[0] == "n" else bt[cold[1]]
+                x, dx = opening(th, ts)
+                dqh = g * (x + dx * (th - tc))
+                J[i, i] -= dqh / cap[i]
+                if cold[0] == "n":
+                    j = cold[1]
+                    J[j, i] += dqh / cap[j]
+                    J[i, j] += g * x / cap[i]
+                    J[j, j] -= g * x / cap[j]
+                else:
+                    J[n + m, i] += dqh
             # rotating links (analytic in the end temperatures, oil props held)
             t_oil = temps[oil_i]
             nu, rho, mu = oil.props(t_oil)

@@ -1,0 +1,61 @@
+//! Criterion benches of the solvers: one right-hand-side evaluation, one equilibrium, and a full
+//! WLTC transient per example model (default solver and tolerance).
+
+use std::hint::black_box;
+use std::path::Path;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+
+use geartherm::cycle::DriveCycle;
+use geartherm::model;
+use geartherm::scene::{Inputs, Scene};
+use geartherm::solve::drive::segments;
+use geartherm::solve::equilibrium::equilibrium;
+use geartherm::solve::steady::SteadyOptions;
+use geartherm::solve::transient::{integrate, TransientOptions};
+
+const MODELS: [&str; 4] = [
+    "models/at6_lepelletier.toml",
+    "models/fzg_c.toml",
+    "models/helical_stage.toml",
+    "models/pt6_spur_pair.toml",
+];
+
+fn point(gb: &model::Gearbox) -> Inputs {
+    let state = gb.state_index("3").or_else(|| gb.state_index("1")).unwrap_or(0);
+    Inputs {
+        state,
+        input_speed: 2000.0 * std::f64::consts::PI / 30.0,
+        input_torque: 150.0,
+        vehicle_speed: 15.0,
+    }
+}
+
+fn benches(c: &mut Criterion) {
+    for m in MODELS {
+        let gb = model::load(Path::new(m)).unwrap();
+        let scene = Scene::compile(&gb).unwrap();
+        let name = Path::new(m).file_stem().unwrap().to_string_lossy().into_owned();
+        let inp = point(&gb);
+        let mut work = scene.work(inp);
+        let y = scene.initial_state(None);
+        let mut dy = vec![0.0; y.len()];
+        c.bench_function(&format!("rhs/{name}"), |b| {
+            b.iter(|| scene.rhs(black_box(0.0), black_box(&y), &mut work, &mut dy))
+        });
+        c.bench_function(&format!("equilibrium/{name}"), |b| {
+            b.iter(|| equilibrium(&scene, black_box(inp), None, &SteadyOptions::default()).unwrap())
+        });
+        let cycle = DriveCycle::resolve("wltc").unwrap();
+        let (_, segs) = segments(&gb, &cycle).unwrap();
+        let mut g = c.benchmark_group("wltc");
+        g.sample_size(10);
+        g.bench_function(&name, |b| {
+            b.iter(|| integrate(&scene, &segs, &TransientOptions::default(), &mut |_, _| {}).unwrap())
+        });
+        g.finish();
+    }
+}
+
+criterion_group!(solve, benches);
+criterion_main!(solve);
