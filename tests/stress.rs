@@ -1,0 +1,171 @@
+//! Stability stress tests (docs/numerics.md): every implicit solver either finishes with bounded
+//! steps, a finite state and a closed energy balance, or stops with a named numerical failure;
+//! never a panic, a hang or a NaN.
+
+use geartherm::model;
+use geartherm::physics::oil::KELVIN_OFFSET;
+use geartherm::scene::{Inputs, Scene};
+use geartherm::solve::drive::segments;
+use geartherm::solve::transient::{energy_balance, integrate, Method, Segment, TransientOptions};
+
+const IMPLICIT: [Method; 3] = [Method::Bdf, Method::Esdirk34, Method::TrBdf2];
+
+fn fzg_with(thermal: &str) -> Scene {
+    let text = std::fs::read_to_string("models/fzg_c.toml").unwrap();
+    let cut = text.find("# ------").unwrap();
+    let gb = model::from_str(
+        &format!("{}\n{thermal}", &text[..cut]),
+        std::path::Path::new("s.toml"),
+    )
+    .unwrap();
+    Scene::compile(&gb).unwrap()
+}
+
+fn jumpy(n: usize, state_of: impl Fn(usize) -> usize) -> Vec<Segment> {
+    (0..n)
+        .map(|k| {
+            let x = ((k * 7919) % 101) as f64 / 100.0;
+            Segment {
+                t0: k as f64,
+                t1: k as f64 + 1.0,
+                inputs: Inputs {
+                    state: state_of(k),
+                    input_speed: (500.0 + 2500.0 * x) * std::f64::consts::PI / 30.0,
+                    input_torque: 20.0 + 250.0 * (1.0 - x),
+                    vehicle_speed: 20.0 * x,
+                },
+            }
+        })
+        .collect()
+}
+
+/// Finishes with bounded work and a closed balance, or fails with a named failure.
+fn check(scene: &Scene, segs: &[Segment], o: &TransientOptions, what: &str) {
+    match integrate(scene, segs, o, &mut |_, _| {}) {
+        Ok(t) => {
+            let bal = energy_balance(scene, &t).relative;
+            assert!(t.states.iter().flatten().all(|v| v.is_finite()), "{what}: NaN");
+            assert!(bal <= 1e-9, "{what}: balance {bal}");
+            assert!(
+                t.stats.steps <= 200 * segs.len(),
+                "{what}: {} steps",
+                t.stats.steps
+            );
+            println!(
+                "{what}: {} steps, {} rejected, balance {bal:.1e}",
+                t.stats.steps, t.stats.rejected
+            );
+        }
+        Err(e) => {
+            assert!(!e.node.is_empty() && e.time.is_finite(), "{what}: {e}");
+            println!("{what}: failed cleanly: {e}");
+        }
+    }
+}
+
+#[test]
+fn stiffness_sweep_capacity_down_to_a_microjoule_per_kelvin_and_conductance_up_to_1e6() {
+    for (cap, g) in [(1e2, 1e2), (1e-2, 1e3), (1e-6, 1e3), (1e-6, 1e6), (1.0, 1e6)] {
+        let net = format!(
+            r#"
+[thermal]
+oil_node = "oil"
+[[thermal.nodes]]
+name = "oil"
+capacity_j_per_k = 2000.0
+[[thermal.nodes]]
+name = "film"
+capacity_j_per_k = {cap:e}
+gears = ["pinion", "wheel"]
+[[thermal.nodes]]
+name = "housing"
+capacity_j_per_k = 9000.0
+[[thermal.boundaries]]
+name = "ambient"
+temp_c = 23.0
+[[thermal.links]]
+between = ["film", "oil"]
+conductance_w_per_k = {g:e}
+[[thermal.links]]
+between = ["oil", "housing"]
+conductance_w_per_k = 20.0
+[[thermal.links]]
+between = ["housing", "ambient"]
+emissivity = 0.9
+area_m2 = 0.4
+[[thermal.links]]
+between = ["housing", "ambient"]
+h_w_per_m2k = 15.0
+area_m2 = 0.4
+"#
+        );
+        let scene = fzg_with(&net);
+        let segs = jumpy(600, |_| 0);
+        for m in IMPLICIT {
+            let o = TransientOptions {
+                method: m,
+                ..TransientOptions::default()
+            };
+            check(&scene, &segs, &o, &format!("{} C={cap:e} G={g:e}", m.name()));
+        }
+    }
+}
+
+fn at6() -> (model::Gearbox, Scene) {
+    let gb = model::load(std::path::Path::new("models/at6_lepelletier.toml")).unwrap();
+    let scene = Scene::compile(&gb).unwrap();
+    (gb, scene)
+}
+
+#[test]
+fn cold_start_at_minus_30_and_ten_wltc_back_to_back() {
+    let (gb, scene) = at6();
+    let cycle = geartherm::cycle::DriveCycle::resolve("wltc").unwrap();
+    let (_, one) = segments(&gb, &cycle).unwrap();
+    let mut segs = Vec::new();
+    for r in 0..10 {
+        let off = r as f64 * 1800.0;
+        segs.extend(one.iter().map(|s| Segment {
+            t0: s.t0 + off,
+            t1: s.t1 + off,
+            inputs: s.inputs,
+        }));
+    }
+    for m in IMPLICIT {
+        let o = TransientOptions {
+            method: m,
+            initial_temp: Some(-30.0 + KELVIN_OFFSET),
+            ..TransientOptions::default()
+        };
+        check(&scene, &segs, &o, &format!("{} 10×WLTC from −30 °C", m.name()));
+    }
+}
+
+#[test]
+fn a_shift_every_second_and_a_long_standstill() {
+    let (_, scene) = at6();
+    let mut segs = jumpy(1200, |k| k % 6);
+    let end = segs.last().unwrap().t1;
+    segs.push(Segment {
+        t0: end,
+        t1: end + 20_000.0,
+        inputs: Inputs {
+            state: 0,
+            input_speed: 0.0,
+            input_torque: 0.0,
+            vehicle_speed: 0.0,
+        },
+    });
+    for m in IMPLICIT {
+        let o = TransientOptions {
+            method: m,
+            ..TransientOptions::default()
+        };
+        check(
+            &scene,
+            &segs,
+            &o,
+            &format!("{} shifts every second + 20000 s standstill", m.name()),
+        );
+    }
+}
