@@ -135,7 +135,34 @@ fn run_outputs_follow_the_contract() {
     assert!(header.contains(&"temp_sump_c") && header.contains(&"temp_ambient_c"));
     assert!(header.iter().any(|h| h.starts_with("loss_sliding_")));
     assert_eq!(header[header.len() - 1], "efficiency");
-    assert_eq!(lines.count(), 1801, "one row per second including t = 0");
+    // The input supplies the output power and the losses: T_in·ω_in = P_out + P_loss.
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (ci, cw, cp, cl) = (
+        col("input_torque_nm"),
+        col("input_speed_rpm"),
+        col("output_power_w"),
+        col("total_loss_w"),
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| {
+            l.split(',')
+                .map(|x| x.parse::<f64>().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    assert_eq!(rows.len(), 1801, "one row per second including t = 0");
+    let mut checked = 0;
+    for r in rows.iter().filter(|r| r[cw] > 0.0 && r[cp] > 0.0) {
+        let p_in = r[ci] * r[cw] * std::f64::consts::PI / 30.0;
+        assert!(
+            (p_in - r[cp] - r[cl]).abs() <= 1e-9 * p_in,
+            "{p_in} vs {} + {}",
+            r[cp],
+            r[cl]
+        );
+        checked += 1;
+    }
+    assert!(checked > 500, "{checked} driving rows");
     // Nothing but the outputs in the directory (no temporary files left).
     let mut names: Vec<String> = std::fs::read_dir(&dir)
         .unwrap()

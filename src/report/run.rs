@@ -22,7 +22,7 @@ pub struct RowInputs {
     pub gear: String,
     /// Input speed, rpm.
     pub input_speed_rpm: f64,
-    /// Loss-free input torque, N·m.
+    /// Loss-free input torque T_out/i, N·m (`timeseries.csv` adds the losses: P_loss/ω_in).
     pub input_torque_nm: f64,
     /// Output power, W.
     pub output_power_w: f64,
@@ -138,11 +138,11 @@ pub fn summary(
     let mut items = Vec::with_capacity(m);
     for (k, it) in scene.losses.items.iter().enumerate() {
         let j = last.get(n + k).copied().unwrap_or(0.0);
-        match it.source {
-            Source::Churning => per_source.churning += j,
-            Source::Pocketing => per_source.pocketing += j,
-            Source::Sliding => per_source.sliding += j,
-        }
+        *match it.source {
+            Source::Churning => &mut per_source.churning,
+            Source::Pocketing => &mut per_source.pocketing,
+            Source::Sliding => &mut per_source.sliding,
+        } += j;
         items.push(ItemEnergy {
             source: it.source,
             name: it.name.clone(),
@@ -251,10 +251,24 @@ pub fn timeseries_csv(
     for (k, t) in traj.times.iter().enumerate() {
         let r = &rows[k];
         let y = &traj.states[k];
+        let mut by = [0.0; 3];
+        for (q, it) in traj.losses[k].iter().zip(&scene.losses.items) {
+            by[it.source.index()] += q;
+        }
+        let total = by[0] + by[1] + by[2];
+        // The input supplies the transmitted torque and the losses: T_in = T_out/i + P_loss/ω_in
+        // (physics spec §9). The loss items themselves are evaluated at the loss-free torque
+        // (docs/physics.md §10, "Mesh loads").
+        let w_in = r.input_speed_rpm * std::f64::consts::PI / 30.0;
+        let t_in = if w_in > 0.0 {
+            r.input_torque_nm + total / w_in
+        } else {
+            r.input_torque_nm
+        };
         let _ = write!(
             s,
             "{t},{},{},{},{},{}",
-            r.vehicle_speed_kmh, r.gear, r.input_speed_rpm, r.input_torque_nm, r.output_power_w
+            r.vehicle_speed_kmh, r.gear, r.input_speed_rpm, t_in, r.output_power_w
         );
         for v in y.iter().take(n) {
             s.push(',');
@@ -264,17 +278,10 @@ pub fn timeseries_csv(
             s.push(',');
             num(&mut s, v - KELVIN_OFFSET);
         }
-        let mut by = [0.0; 3];
-        for (q, it) in traj.losses[k].iter().zip(&scene.losses.items) {
+        for q in &traj.losses[k] {
             s.push(',');
             num(&mut s, *q);
-            by[match it.source {
-                Source::Churning => 0,
-                Source::Pocketing => 1,
-                Source::Sliding => 2,
-            }] += q;
         }
-        let total = by[0] + by[1] + by[2];
         let _ = write!(s, ",{},{},{},{}", by[0], by[1], by[2], total);
         s.push(',');
         if r.output_power_w > 0.0 {

@@ -31,6 +31,15 @@ pub enum Source {
 }
 
 impl Source {
+    /// Position in per-source arrays `[churning, pocketing, sliding]`.
+    pub fn index(self) -> usize {
+        match self {
+            Source::Churning => 0,
+            Source::Pocketing => 1,
+            Source::Sliding => 2,
+        }
+    }
+
     /// Lower-case name.
     pub fn as_str(self) -> &'static str {
         match self {

@@ -7,7 +7,7 @@ use std::cell::RefCell;
 use nalgebra::DMatrix;
 
 use crate::physics::oil::KELVIN_OFFSET;
-use crate::scene::{Inputs, Scene, Source, Work};
+use crate::scene::{Inputs, Scene, Work};
 
 use super::steady::{solve_steady, BoundSide, HeatBalance, SteadyError, SteadyOptions, SteadySolution};
 use super::transient::{integrate, Method, Segment, TransientOptions};
@@ -155,11 +155,7 @@ pub fn equilibrium(
     scene.evaluate_losses(&y, &mut w);
     let mut by = [0.0; 3];
     for (q, it) in w.q.iter().zip(&scene.losses.items) {
-        by[match it.source {
-            Source::Churning => 0,
-            Source::Pocketing => 1,
-            Source::Sliding => 2,
-        }] += q;
+        by[it.source.index()] += q;
     }
     let power = inputs.input_torque * inputs.input_speed;
     let total = by[0] + by[1] + by[2];
