@@ -1,17 +1,24 @@
 //! Evaluating all losses of a gearbox at an operating point allocates nothing (counting allocator).
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 use geartherm::model;
 use geartherm::scene::{LossScene, OperatingPoint};
 
 struct Counting;
-static ALLOCS: AtomicUsize = AtomicUsize::new(0);
+// Counted per thread: the tests run in parallel and must not see each other's allocations.
+thread_local! {
+    static COUNT: Cell<usize> = const { Cell::new(0) };
+}
+
+fn allocs() -> usize {
+    COUNT.with(Cell::get)
+}
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        let _ = COUNT.try_with(|c| c.set(c.get() + 1));
         unsafe { System.alloc(l) }
     }
     unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
@@ -37,12 +44,48 @@ fn loss_evaluation_allocates_nothing() {
                 oil: gb.oil.properties(350.0),
             })
             .collect();
-        let before = ALLOCS.load(Ordering::SeqCst);
+        let before = allocs();
         for op in &ops {
             scene.evaluate(op, &mut out);
         }
-        let after = ALLOCS.load(Ordering::SeqCst);
+        let after = allocs();
         assert_eq!(after - before, 0, "{m}: evaluation allocated");
         assert!(out.iter().all(|w| w.is_finite() && *w >= 0.0), "{m}: {out:?}");
+    }
+}
+
+#[test]
+fn right_hand_side_and_jacobian_product_allocate_nothing() {
+    use geartherm::scene::{Inputs, Scene};
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    for m in ["at6_lepelletier", "fzg_c", "helical_stage", "pt6_spur_pair"] {
+        let gb = model::load(&root.join(format!("models/{m}.toml"))).unwrap();
+        let scene = Scene::compile(&gb).unwrap();
+        let inputs = Inputs {
+            state: 0,
+            input_speed: 250.0,
+            input_torque: 150.0,
+            vehicle_speed: 20.0,
+        };
+        let mut work = scene.work(inputs);
+        let mut y = scene.initial_state(None);
+        let mut dy = vec![0.0; y.len()];
+        let mut v = vec![0.0; y.len()];
+        let mut jv = vec![0.0; y.len()];
+        let before = allocs();
+        for k in 0..20 {
+            y[scene.thermal.oil] += 0.5 * k as f64; // new T_oil: the Jacobian column is recomputed
+            scene.set_inputs(inputs, &mut work);
+            scene.rhs(k as f64, &y, &mut work, &mut dy);
+            for j in 0..scene.nodes() {
+                v.iter_mut().for_each(|x| *x = 0.0);
+                v[j] = 1.0;
+                scene.jvp(k as f64, &y, &v, &mut work, &mut jv);
+            }
+        }
+        let after = allocs();
+        assert_eq!(after - before, 0, "{m}: rhs/jvp allocated");
+        assert!(dy.iter().chain(&jv).all(|x| x.is_finite()), "{m}");
+        assert!(work.jac_evals >= 20, "{m}: Jacobian column recomputed per T_oil");
     }
 }
