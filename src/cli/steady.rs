@@ -5,13 +5,12 @@ use std::collections::BTreeMap;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use rayon::prelude::*;
-
 use geartherm::model::{self, Gearbox};
 use geartherm::physics::oil::KELVIN_OFFSET;
 use geartherm::scene::{Inputs, Scene};
-use geartherm::solve::equilibrium::{equilibrium, Equilibrium};
+use geartherm::solve::equilibrium::equilibrium;
 use geartherm::solve::steady::SteadyOptions;
+use geartherm::solve::sweep;
 
 use super::{check_range, invalid, print_json, state_index, Failure, EXIT_IO, EXIT_NUMERICAL};
 
@@ -238,12 +237,6 @@ fn range(flag: &str, s: &str) -> Result<Vec<f64>, Failure> {
         .collect())
 }
 
-struct MapPoint {
-    speed: f64,
-    torque: f64,
-    eq: Option<Equilibrium>,
-}
-
 /// Run `map`.
 pub fn map(a: &MapArgs) -> Result<(), Failure> {
     let (gb, scene, state) = prepare(&a.point)?;
@@ -251,6 +244,9 @@ pub fn map(a: &MapArgs) -> Result<(), Failure> {
     let torques = range("--torque-nm", &a.torque_nm)?;
     for &s in &speeds {
         check_range("--speed-rpm", s, 0.0, 50_000.0, " rpm")?;
+    }
+    for &t in &torques {
+        check_range("--torque-nm", t, -1e6, 1e6, " N m")?;
     }
     let bar = (!a.quiet && std::io::stderr().is_terminal()).then(|| {
         let b = indicatif::ProgressBar::new((speeds.len() * torques.len()) as u64);
@@ -262,64 +258,29 @@ pub fn map(a: &MapArgs) -> Result<(), Failure> {
         b
     });
     let start = std::time::Instant::now();
-    let opts = SteadyOptions::default();
-    // One speed per task; along the torque axis each point starts from its neighbour's solution.
-    let rows: Vec<Vec<MapPoint>> = speeds
-        .par_iter()
-        .map(|&sp| {
-            let mut warm: Option<Vec<f64>> = None;
-            torques
-                .iter()
-                .map(|&tq| {
-                    let r = equilibrium(&scene, inputs(&a.point, state, sp, tq), warm.as_deref(), &opts)
-                        .or_else(|_| equilibrium(&scene, inputs(&a.point, state, sp, tq), None, &opts))
-                        .ok();
-                    if let Some(e) = &r {
-                        warm = Some(e.solution.temperatures.clone());
-                    }
-                    if let Some(b) = &bar {
-                        b.inc(1);
-                    }
-                    MapPoint {
-                        speed: sp,
-                        torque: tq,
-                        eq: r,
-                    }
-                })
-                .collect()
-        })
-        .collect();
+    let tick = || {
+        if let Some(b) = &bar {
+            b.inc(1);
+        }
+    };
+    let points = sweep::map(
+        &scene,
+        state,
+        &speeds,
+        &torques,
+        a.point.vehicle_speed_kmh / 3.6,
+        &SteadyOptions::default(),
+        &tick,
+    );
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
     let wall = start.elapsed().as_secs_f64();
-    let oil = scene.thermal.oil;
-    let mut csv = String::from(
-        "speed_rpm,torque_nm,efficiency,total_loss_w,churning_w,pocketing_w,sliding_w,oil_temp_c,iterations,converged\n",
-    );
-    let (mut ok, mut iters) = (0usize, 0usize);
-    for p in rows.iter().flatten() {
-        match &p.eq {
-            Some(e) => {
-                ok += 1;
-                iters += e.solution.iterations + e.solution.ptc_iterations;
-                let total: f64 = e.by_source.iter().sum();
-                csv.push_str(&format!(
-                    "{},{},{},{},{},{},{},{},{},true\n",
-                    p.speed,
-                    p.torque,
-                    e.efficiency.map_or(String::new(), |x| x.to_string()),
-                    total,
-                    e.by_source[0],
-                    e.by_source[1],
-                    e.by_source[2],
-                    e.solution.temperatures[oil] - KELVIN_OFFSET,
-                    e.solution.iterations + e.solution.ptc_iterations
-                ));
-            }
-            None => csv.push_str(&format!("{},{},,,,,,,,false\n", p.speed, p.torque)),
-        }
-    }
+    let csv = geartherm::report::map::map_csv(&points, scene.thermal.oil);
+    let converged = points.iter().filter_map(|p| p.equilibrium.as_ref());
+    let (ok, iters) = converged.fold((0usize, 0usize), |(k, i), e| {
+        (k + 1, i + e.solution.iterations + e.solution.ptc_iterations)
+    });
     let n = speeds.len() * torques.len();
     let json = serde_json::json!({
         "model": gb.name,

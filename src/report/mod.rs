@@ -2,5 +2,6 @@
 pub mod files;
 pub mod info;
 pub mod losses;
+pub mod map;
 pub mod plots;
 pub mod run;

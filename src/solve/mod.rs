@@ -2,5 +2,6 @@
 pub mod drive;
 pub mod equilibrium;
 pub mod steady;
+pub mod sweep;
 pub mod transient;
 pub mod work_precision;
