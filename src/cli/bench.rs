@@ -3,10 +3,8 @@
 use std::path::PathBuf;
 
 use geartherm::solve::drive::segments;
-use geartherm::solve::transient::{
-    Method, Restart, TransientOptions, DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL,
-};
-use geartherm::solve::work_precision::{pareto, point, reference, to_csv, BenchRow};
+use geartherm::solve::transient::{Method, DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL};
+use geartherm::solve::work_precision::{pareto, reference, sweep, to_csv};
 
 use super::run::{prepare, RunArgs};
 use super::{invalid, Failure, EXIT_IO, EXIT_NUMERICAL};
@@ -80,35 +78,31 @@ pub fn bench(args: &BenchArgs) -> Result<(), Failure> {
         rtols.push(r);
         r /= 10.0;
     }
-    let mut rows: Vec<BenchRow> = Vec::new();
-    for &m in &methods {
-        for &rt in &rtols {
-            let o = TransientOptions {
-                method: m,
-                rtol: rt,
-                atol: rt * DEFAULT_ATOL / DEFAULT_RTOL,
-                restart: Restart::AtJumps,
-                max_steps: args.max_steps,
-                ..TransientOptions::default()
-            };
-            let is_default = m == DEFAULT_METHOD && (rt / DEFAULT_RTOL - 1.0).abs() < 1e-9;
-            let row = point(&scene, &segs, &refr, &o, args.repeats, is_default);
+    let rows = sweep(
+        &scene,
+        &segs,
+        &refr,
+        &methods,
+        &rtols,
+        args.repeats,
+        args.max_steps,
+        &mut |row| {
             eprintln!(
-                "{:<9} rtol {:>7.0e}: {:>9.4} ms, err max {:>9.2e} K final {:>9.2e} K, {:>6} steps, {:>5} rejected, {:>7} RHS, {:>5} LU{}",
-                row.solver,
-                row.rtol,
-                row.wall_time_s * 1e3,
-                row.err_max_k,
-                row.err_final_k,
-                row.steps,
-                row.rejected,
-                row.rhs_evals,
-                row.lu_count,
-                row.failure.as_ref().map(|f| format!("  FAILED: {f}")).unwrap_or_default()
-            );
-            rows.push(row);
-        }
-    }
+            "{:<9} rtol {:>7.0e} atol {:>7.0e}: {:>9.4} ms, err max {:>9.2e} K final {:>9.2e} K, {:>6} steps, {:>5} rejected, {:>7} RHS, {:>5} LU{}",
+            row.solver,
+            row.rtol,
+            row.atol,
+            row.wall_time_s * 1e3,
+            row.err_max_k,
+            row.err_final_k,
+            row.steps,
+            row.rejected,
+            row.rhs_evals,
+            row.lu_count,
+            row.failure.as_ref().map(|f| format!("  FAILED: {f}")).unwrap_or_default()
+        )
+        },
+    );
     let front = pareto(&rows);
     let default_on_front = rows.iter().zip(&front).any(|(r, f)| r.default && *f);
     eprintln!(

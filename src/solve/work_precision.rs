@@ -6,7 +6,10 @@ use serde::Serialize;
 
 use crate::scene::Scene;
 
-use super::transient::{energy_balance, integrate, Method, Restart, Segment, Trajectory, TransientOptions};
+use super::transient::{
+    energy_balance, integrate, Method, Restart, Segment, Trajectory, TransientOptions, DEFAULT_ATOL,
+    DEFAULT_METHOD, DEFAULT_RTOL,
+};
 
 /// One (solver, tolerance) point of the study.
 #[derive(Debug, Clone, Serialize)]
@@ -160,6 +163,39 @@ pub fn point(
         },
         None => base,
     }
+}
+
+/// Every method at every tolerance (atol scaled with rtol in the default's ratio
+/// `DEFAULT_ATOL / DEFAULT_RTOL`), restarted at jumps; `on_row` sees each row as it is measured.
+#[allow(clippy::too_many_arguments)]
+pub fn sweep(
+    scene: &Scene,
+    segs: &[Segment],
+    reference: &Trajectory,
+    methods: &[Method],
+    rtols: &[f64],
+    repeats: usize,
+    max_steps: usize,
+    on_row: &mut dyn FnMut(&BenchRow),
+) -> Vec<BenchRow> {
+    let mut rows = Vec::with_capacity(methods.len() * rtols.len());
+    for &m in methods {
+        for &rt in rtols {
+            let o = TransientOptions {
+                method: m,
+                rtol: rt,
+                atol: rt * DEFAULT_ATOL / DEFAULT_RTOL,
+                restart: Restart::AtJumps,
+                max_steps,
+                ..TransientOptions::default()
+            };
+            let is_default = m == DEFAULT_METHOD && (rt / DEFAULT_RTOL - 1.0).abs() < 1e-9;
+            let row = point(scene, segs, reference, &o, repeats, is_default);
+            on_row(&row);
+            rows.push(row);
+        }
+    }
+    rows
 }
 
 /// Timing noise margin of the Pareto test: the spread of median wall times measured on the
