@@ -2,42 +2,15 @@
 //! steps, a finite state and a closed energy balance, or stops with a named numerical failure;
 //! never a panic, a hang or a NaN.
 
-use geartherm::model;
 use geartherm::physics::oil::KELVIN_OFFSET;
 use geartherm::scene::{Inputs, Scene};
 use geartherm::solve::drive::segments;
 use geartherm::solve::transient::{energy_balance, integrate, Method, Segment, TransientOptions};
 
+mod common;
+use common::{fzg_with, jumpy, scene_of};
+
 const IMPLICIT: [Method; 3] = [Method::Bdf, Method::Esdirk34, Method::TrBdf2];
-
-fn fzg_with(thermal: &str) -> Scene {
-    let text = std::fs::read_to_string("models/fzg_c.toml").unwrap();
-    let cut = text.find("# ------").unwrap();
-    let gb = model::from_str(
-        &format!("{}\n{thermal}", &text[..cut]),
-        std::path::Path::new("s.toml"),
-    )
-    .unwrap();
-    Scene::compile(&gb).unwrap()
-}
-
-fn jumpy(n: usize, state_of: impl Fn(usize) -> usize) -> Vec<Segment> {
-    (0..n)
-        .map(|k| {
-            let x = ((k * 7919) % 101) as f64 / 100.0;
-            Segment {
-                t0: k as f64,
-                t1: k as f64 + 1.0,
-                inputs: Inputs {
-                    state: state_of(k),
-                    input_speed: (500.0 + 2500.0 * x) * std::f64::consts::PI / 30.0,
-                    input_torque: 20.0 + 250.0 * (1.0 - x),
-                    vehicle_speed: 20.0 * x,
-                },
-            }
-        })
-        .collect()
-}
 
 /// Finishes with bounded work and a closed balance, or fails with a named failure.
 fn check(scene: &Scene, segs: &[Segment], o: &TransientOptions, what: &str) {
@@ -111,10 +84,8 @@ area_m2 = 0.4
     }
 }
 
-fn at6() -> (model::Gearbox, Scene) {
-    let gb = model::load(std::path::Path::new("models/at6_lepelletier.toml")).unwrap();
-    let scene = Scene::compile(&gb).unwrap();
-    (gb, scene)
+fn at6() -> (geartherm::model::Gearbox, Scene) {
+    scene_of("models/at6_lepelletier.toml")
 }
 
 #[test]

@@ -11,25 +11,10 @@ use geartherm::solve::transient::{
 };
 use nalgebra::{DMatrix, DVector};
 
+mod common;
+use common::{film_network, fzg_with, jumpy, steady_inputs};
+
 const IMPLICIT: [Method; 3] = [Method::Bdf, Method::Esdirk34, Method::TrBdf2];
-
-/// The FZG C gear data without its thermal network and vehicle, plus `thermal`.
-fn fzg_with(thermal: &str) -> Scene {
-    let text = std::fs::read_to_string("models/fzg_c.toml").unwrap();
-    let cut = text.find("# ------").unwrap();
-    let full = format!("{}\n{thermal}", &text[..cut]);
-    let gb = model::from_str(&full, std::path::Path::new("test.toml")).unwrap();
-    Scene::compile(&gb).unwrap()
-}
-
-fn steady_inputs(speed_rpm: f64, torque: f64) -> Inputs {
-    Inputs {
-        state: 0,
-        input_speed: speed_rpm * std::f64::consts::PI / 30.0,
-        input_torque: torque,
-        vehicle_speed: 0.0,
-    }
-}
 
 fn uniform(inputs: Inputs, n: usize, dt: f64) -> Vec<Segment> {
     (0..n)
@@ -265,20 +250,6 @@ fn at6_wltc_cold_start_warms_up_with_viscosity_feedback() {
     );
 }
 
-/// A jumpy rig-like input: speed and torque change every second.
-fn jumpy(n: usize) -> Vec<Segment> {
-    (0..n)
-        .map(|k| {
-            let x = ((k * 7919) % 101) as f64 / 100.0;
-            Segment {
-                t0: k as f64,
-                t1: k as f64 + 1.0,
-                inputs: steady_inputs(500.0 + 2500.0 * x, 20.0 + 300.0 * (1.0 - x)),
-            }
-        })
-        .collect()
-}
-
 fn max_err(a: &Trajectory, b: &Trajectory, n: usize) -> f64 {
     a.states
         .iter()
@@ -334,7 +305,7 @@ fn pitfall_6_derivative_refreshed_after_an_input_jump() {
     // ESDIRK34 starts each step from the stored derivative (first stage explicit): a stale dy
     // after a jump puts the pre-jump heat into the first stage of the new interval.
     let scene = fzg_model_scene();
-    let segs = jumpy(300);
+    let segs = jumpy(300, |_| 0);
     let reference = run(&scene, &segs, &opts(Method::Esdirk34, 1e-11));
     let mut o = opts(Method::Esdirk34, 1e-6);
     let good = run(&scene, &segs, &o);
@@ -352,27 +323,8 @@ fn pitfall_6_derivative_refreshed_after_an_input_jump() {
 fn pitfall_4_step_size_reset_at_stiff_jumps() {
     // A near-massless node (0.01 J/K) next to the oil: after a jump the old (large) step makes
     // BDF fail its error test repeatedly; the re-estimated step avoids the rejections.
-    let net = r#"
-[thermal]
-oil_node = "oil"
-[[thermal.nodes]]
-name = "oil"
-capacity_j_per_k = 2000.0
-[[thermal.nodes]]
-name = "film"
-capacity_j_per_k = 0.01
-gears = ["pinion", "wheel"]
-[[thermal.boundaries]]
-name = "ambient"
-temp_c = 23.0
-[[thermal.links]]
-between = ["film", "oil"]
-conductance_w_per_k = 20.0
-[[thermal.links]]
-between = ["oil", "ambient"]
-conductance_w_per_k = 4.0
-"#;
-    let scene = fzg_with(net);
+    let net = film_network(0.01, 20.0);
+    let scene = fzg_with(&net);
     // Long quiet stretches (large steps) between load jumps.
     let segs: Vec<Segment> = (0..600)
         .map(|k| Segment {
@@ -413,28 +365,9 @@ conductance_w_per_k = 4.0
 fn pitfall_1_long_runs_survive_the_lifetime_newton_failure_count() {
     // Ten WLTCs of random jumps on a stiff network accumulate more than diffsol's default of 50
     // Newton failures over the solver's life; with the limit raised the run completes.
-    let net = r#"
-[thermal]
-oil_node = "oil"
-[[thermal.nodes]]
-name = "oil"
-capacity_j_per_k = 2000.0
-[[thermal.nodes]]
-name = "film"
-capacity_j_per_k = 0.001
-gears = ["pinion", "wheel"]
-[[thermal.boundaries]]
-name = "ambient"
-temp_c = 23.0
-[[thermal.links]]
-between = ["film", "oil"]
-conductance_w_per_k = 50.0
-[[thermal.links]]
-between = ["oil", "ambient"]
-conductance_w_per_k = 4.0
-"#;
-    let scene = fzg_with(net);
-    let segs = jumpy(18000);
+    let net = film_network(0.001, 50.0);
+    let scene = fzg_with(&net);
+    let segs = jumpy(18000, |_| 0);
     let mut o = opts(Method::Bdf, 1e-6);
     o.guards = Guards {
         reset_step: false,
