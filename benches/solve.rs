@@ -32,6 +32,17 @@ fn point(gb: &model::Gearbox) -> Inputs {
 }
 
 fn benches(c: &mut Criterion) {
+    // The floor's linear-algebra part: one dense LU of the AT6 iteration matrix size (5 nodes +
+    // 15 items + 1 = 21 states), nalgebra as diffsol's NalgebraLU uses it.
+    let n = 21;
+    let a = nalgebra::DMatrix::<f64>::from_fn(n, n, |i, j| {
+        if i == j {
+            4.0 + i as f64
+        } else {
+            1.0 / (1.0 + (i + 2 * j) as f64)
+        }
+    });
+    c.bench_function("lu/21x21", |b| b.iter(|| black_box(a.clone()).lu()));
     for m in MODELS {
         let gb = model::load(Path::new(m)).unwrap();
         let scene = Scene::compile(&gb).unwrap();
