@@ -4,7 +4,15 @@ mod cli;
 use clap::Parser;
 
 fn main() {
-    let args = cli::Cli::parse();
+    // Usage errors exit 1 like any other bad input (clap's own default is 2, which is this
+    // tool's code for a numerical failure); --help and --version exit 0.
+    let args = match cli::Cli::try_parse() {
+        Ok(a) => a,
+        Err(e) => {
+            let _ = e.print();
+            std::process::exit(if e.use_stderr() { 1 } else { 0 });
+        }
+    };
     if let Err(f) = cli::run(args) {
         eprint!("{}", f.message);
         if !f.message.ends_with('\n') {

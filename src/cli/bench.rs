@@ -2,7 +2,6 @@
 
 use std::path::PathBuf;
 
-use geartherm::solve::drive::segments;
 use geartherm::solve::transient::{Method, DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL};
 use geartherm::solve::work_precision::{pareto, reference, sweep, to_csv};
 
@@ -50,8 +49,17 @@ pub fn bench(args: &BenchArgs) -> Result<(), Failure> {
         quiet: true,
         max_steps: args.max_steps,
         json: false,
+        summary_only: false,
+        evaluate_all: false,
     };
-    let (gb, scene, cycle, _) = prepare(&run_args)?;
+    // The study measures the problem `run` solves by default (same scene pruning and outputs).
+    let super::run::Prepared {
+        gb,
+        scene,
+        cycle,
+        segs,
+        ..
+    } = prepare(&run_args)?;
     let methods: Vec<Method> = args
         .solvers
         .split(',')
@@ -63,7 +71,6 @@ pub fn bench(args: &BenchArgs) -> Result<(), Failure> {
             args.min_rtol
         )));
     }
-    let (_, segs) = segments(&gb, &cycle).map_err(|e| invalid(format!("{}: {e}", args.model.display())))?;
     let (refr, info) = reference(&scene, &segs, 1e-12).map_err(|e| Failure {
         code: EXIT_NUMERICAL,
         message: format!("reference solution failed: {e}"),

@@ -4,13 +4,14 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use geartherm::cycle::DriveCycle;
+use geartherm::cycle::Schedule;
 use geartherm::model::{self, Gearbox};
 use geartherm::physics::oil::KELVIN_OFFSET;
 use geartherm::report::files::write_all_atomic;
 use geartherm::report::run::{summary, timeseries_csv, Summary};
-use geartherm::scene::Scene;
+use geartherm::scene::{Needs, Scene};
 use geartherm::solve::drive::{row_inputs, segments};
-use geartherm::solve::transient::{integrate, Method, Restart, Trajectory, TransientOptions};
+use geartherm::solve::transient::{integrate, Method, Restart, Segment, Trajectory, TransientOptions};
 
 use super::{check_range, invalid, Failure, EXIT_IO, EXIT_NUMERICAL};
 
@@ -56,6 +57,30 @@ pub struct RunArgs {
     /// Print the summary as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Write summary.json only: no timeseries.csv, and loss energy per source instead of per
+    /// item (the scene leaves out what these outputs would need). Not with --report.
+    #[arg(long, conflicts_with = "report")]
+    pub summary_only: bool,
+    /// Evaluate everything: no scene pruning of unused gear states and idle items, no
+    /// per-sample loss cache (for measuring what they save; results agree to rounding).
+    #[arg(long)]
+    pub evaluate_all: bool,
+}
+
+/// A checked, compiled run, ready to integrate.
+pub struct Prepared {
+    /// The model.
+    pub gb: Gearbox,
+    /// The scene compiled for this cycle.
+    pub scene: Scene,
+    /// The cycle.
+    pub cycle: DriveCycle,
+    /// Its schedule (gear, speeds, torques per interval).
+    pub sched: Schedule,
+    /// Integration segments.
+    pub segs: Vec<Segment>,
+    /// Solver options.
+    pub opts: TransientOptions,
 }
 
 /// Everything a finished run produced.
@@ -71,8 +96,9 @@ fn stem(p: &Path) -> String {
         .map_or_else(|| "model".into(), |s| s.to_string_lossy().into_owned())
 }
 
-/// Load, check, compile: everything that can fail with exit 1.
-pub fn prepare(args: &RunArgs) -> Result<(Gearbox, Scene, DriveCycle, TransientOptions), Failure> {
+/// Load, check, schedule the cycle, compile the scene for it: everything that can fail with
+/// exit 1.
+pub fn prepare(args: &RunArgs) -> Result<Prepared, Failure> {
     let gb = model::load(&args.model)?;
     let method = Method::parse(&args.solver).ok_or_else(|| {
         invalid(format!(
@@ -92,7 +118,17 @@ pub fn prepare(args: &RunArgs) -> Result<(Gearbox, Scene, DriveCycle, TransientO
             check_range(flag, v, -60.0, 250.0, " °C")?;
         }
     }
-    let mut scene = Scene::compile(&gb).map_err(|e| invalid(format!("{}: {e}", args.model.display())))?;
+    let cycle = DriveCycle::resolve(&args.cycle).map_err(|e| invalid(format!("--cycle: {e}")))?;
+    let (sched, segs) =
+        segments(&gb, &cycle).map_err(|e| invalid(format!("{}: {e}", args.model.display())))?;
+    // Scene pruning: only the gear states this cycle visits, only the outputs asked for.
+    let needs = Needs {
+        states: Some(segs.iter().map(|s| s.inputs.state).collect()),
+        evaluate_all: args.evaluate_all,
+        energy_per_source_only: args.summary_only,
+    };
+    let mut scene =
+        Scene::compile_for(&gb, &needs).map_err(|e| invalid(format!("{}: {e}", args.model.display())))?;
     if let Some(a) = args.ambient_c {
         let idx = scene.thermal.ambient.ok_or_else(|| {
             invalid(format!(
@@ -103,7 +139,6 @@ pub fn prepare(args: &RunArgs) -> Result<(Gearbox, Scene, DriveCycle, TransientO
         scene.thermal.set_boundary_fixed(idx, a + KELVIN_OFFSET);
     }
     scene.frozen_oil_temp = args.frozen_viscosity_c.map(|c| c + KELVIN_OFFSET);
-    let cycle = DriveCycle::resolve(&args.cycle).map_err(|e| invalid(format!("--cycle: {e}")))?;
     let opts = TransientOptions {
         method,
         rtol: args.rtol,
@@ -111,16 +146,29 @@ pub fn prepare(args: &RunArgs) -> Result<(Gearbox, Scene, DriveCycle, TransientO
         restart: Restart::AtJumps,
         max_steps: args.max_steps,
         initial_temp: args.initial_temp_c.map(|c| c + KELVIN_OFFSET),
+        record_losses: !args.summary_only,
         ..TransientOptions::default()
     };
-    Ok((gb, scene, cycle, opts))
+    Ok(Prepared {
+        gb,
+        scene,
+        cycle,
+        sched,
+        segs,
+        opts,
+    })
 }
 
 /// The whole command.
 pub fn run(args: &RunArgs) -> Result<RunOutcome, Failure> {
-    let (gb, scene, cycle, opts) = prepare(args)?;
-    let (sched, segs) =
-        segments(&gb, &cycle).map_err(|e| invalid(format!("{}: {e}", args.model.display())))?;
+    let Prepared {
+        gb,
+        scene,
+        cycle,
+        sched,
+        segs,
+        opts,
+    } = prepare(args)?;
     let dir = args
         .out
         .clone()
@@ -168,19 +216,16 @@ pub fn run(args: &RunArgs) -> Result<RunOutcome, Failure> {
         scene.thermal.boundary_temperatures(t, &mut w);
         w.boundary_t.clone()
     };
-    let csv = timeseries_csv(&scene, &traj, &rows, &bt);
+    let csv = (!args.summary_only).then(|| timeseries_csv(&scene, &traj, &rows, &bt));
     let json = serde_json::to_string_pretty(&sum).map_err(|e| Failure {
         code: EXIT_IO,
         message: format!("cannot serialise the summary: {e}"),
     })?;
-    write_all_atomic(
-        &dir,
-        &[
-            ("timeseries.csv", csv.as_bytes()),
-            ("summary.json", json.as_bytes()),
-        ],
-    )
-    .map_err(|e| Failure {
+    let mut files: Vec<(&str, &[u8])> = vec![("summary.json", json.as_bytes())];
+    if let Some(csv) = &csv {
+        files.insert(0, ("timeseries.csv", csv.as_bytes()));
+    }
+    write_all_atomic(&dir, &files).map_err(|e| Failure {
         code: EXIT_IO,
         message: format!("{}: cannot write outputs: {e}", dir.display()),
     })?;

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use geartherm::model::{self, Gearbox};
 use geartherm::physics::oil::KELVIN_OFFSET;
-use geartherm::scene::{Inputs, Scene};
+use geartherm::scene::{Inputs, Needs, Scene};
 use geartherm::solve::equilibrium::equilibrium;
 use geartherm::solve::steady::SteadyOptions;
 use geartherm::solve::sweep;
@@ -72,7 +72,13 @@ fn prepare(p: &PointArgs) -> Result<(Gearbox, Scene, usize), Failure> {
     let gb = model::load(&p.model)?;
     let state = state_index(&gb, &p.gear)?;
     check_range("--vehicle-speed-kmh", p.vehicle_speed_kmh, 0.0, 400.0, " km/h")?;
-    let mut scene = Scene::compile(&gb).map_err(|e| invalid(format!("{}: {e}", p.model.display())))?;
+    // Scene pruning: only this gear state's active items are compiled.
+    let needs = Needs {
+        states: Some(vec![state]),
+        ..Needs::default()
+    };
+    let mut scene =
+        Scene::compile_for(&gb, &needs).map_err(|e| invalid(format!("{}: {e}", p.model.display())))?;
     if let Some(a) = p.ambient_c {
         check_range("--ambient-c", a, -60.0, 80.0, " °C")?;
         let idx = scene.thermal.ambient.ok_or_else(|| {

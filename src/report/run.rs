@@ -132,23 +132,35 @@ pub fn summary(
     atol: f64,
 ) -> Summary {
     let n = scene.nodes();
-    let m = scene.items();
     let last = traj.states.last().cloned().unwrap_or_default();
-    let mut per_source = SourceEnergy::default();
-    let mut items = Vec::with_capacity(m);
-    for (k, it) in scene.losses.items.iter().enumerate() {
-        let j = last.get(n + k).copied().unwrap_or(0.0);
-        *match it.source {
-            Source::Churning => &mut per_source.churning,
-            Source::Pocketing => &mut per_source.pocketing,
-            Source::Sliding => &mut per_source.sliding,
-        } += j;
-        items.push(ItemEnergy {
-            source: it.source,
-            name: it.name.clone(),
-            j,
-        });
-    }
+    let by = if last.is_empty() {
+        [0.0; 3]
+    } else {
+        scene.loss_energy_by_source(&last)
+    };
+    let mut per_source = SourceEnergy {
+        churning: by[0],
+        pocketing: by[1],
+        sliding: by[2],
+        ..SourceEnergy::default()
+    };
+    // Per-item energies only when the scene integrates them (an output that can be switched off).
+    let items = scene
+        .losses
+        .items
+        .iter()
+        .enumerate()
+        .filter_map(|(k, it)| {
+            let j = (!last.is_empty())
+                .then(|| scene.item_energy(&last, k))
+                .flatten()?;
+            Some(ItemEnergy {
+                source: it.source,
+                name: it.name.clone(),
+                j,
+            })
+        })
+        .collect();
     per_source.total = per_source.churning + per_source.pocketing + per_source.sliding;
     let bal = energy_balance(scene, traj);
 
@@ -162,9 +174,7 @@ pub fn summary(
         if p > 0.0 {
             let dt = traj.times[k + 1] - traj.times[k];
             out_e += p * dt;
-            let e1: f64 = traj.states[k + 1][n..n + m].iter().sum();
-            let e0: f64 = traj.states[k][n..n + m].iter().sum();
-            loss_drive += e1 - e0;
+            loss_drive += scene.loss_energy(&traj.states[k + 1]) - scene.loss_energy(&traj.states[k]);
         }
     }
     let mean_eff = (out_e > 0.0).then(|| out_e / (out_e + loss_drive));

@@ -11,7 +11,7 @@ use crate::physics::geometry::MeshKind;
 use crate::physics::losses::churning::{ChurningGear, GearChurning, OilState as ChurnOil};
 use crate::physics::losses::pocketing::{PocketMeshInput, PocketingMesh};
 use crate::physics::losses::sliding::friction::Schlenk;
-use crate::physics::losses::sliding::{OilState as SlideOil, SlidingMesh, SlidingMeshInput};
+use crate::physics::losses::sliding::{OilState as SlideOil, PowerLaw, SlidingMesh, SlidingMeshInput};
 use crate::physics::oil::OilProperties;
 
 /// Transverse slices of a helical pocket (physics default 64, itself within 0.3 % of 256; 48 raises
@@ -80,6 +80,9 @@ struct StateFactors {
     pocket_speed: Vec<f64>,
     /// Per sliding entry: torque on gear 1 (one mesh), carrier-frame ω1, ω2.
     slide: Vec<[f64; 3]>,
+    /// Per sliding entry with a power law: loss (W, multiplicity included) at input speed
+    /// 1 rad/s, η = 1 Pa·s and input torque +1 N·m / −1 N·m (the two power-flow directions).
+    slide_unit: Vec<[f64; 2]>,
 }
 
 #[derive(Debug, Clone)]
@@ -108,6 +111,38 @@ struct SlideEntry {
     item: usize,
     model: SlideModel,
     multiplicity: f64,
+    /// Exponents of torque, speed and viscosity when the friction law makes the loss a product
+    /// of their powers (`SlidingMesh::power_law`); `None`: evaluated in full at every call.
+    law: Option<PowerLaw>,
+}
+
+/// What a run needs from the scene (scene pruning, docs/performance.md).
+#[derive(Debug, Clone, Default)]
+pub struct Needs {
+    /// Gear states the run visits (`None`: every state of the model). Loss items idle in all of
+    /// them (no relative motion, no load) are not compiled.
+    pub states: Option<Vec<usize>>,
+    /// Evaluate everything: keep idle items and states, and recompute every loss in full at
+    /// every call instead of caching per-sample terms. Only for measuring what pruning and
+    /// caching gain; results agree to rounding.
+    pub evaluate_all: bool,
+    /// Loss energy per source only (three quadratures) instead of per item: for runs whose
+    /// outputs do not include the energy of each item (the work-precision benchmark).
+    pub energy_per_source_only: bool,
+}
+
+/// Loss terms that change only from one cycle sample to the next (gear state, input speed and
+/// torque), kept apart from what changes at every right-hand-side call (the oil temperature).
+/// Filled by [`LossScene::prepare`]; allocation-free afterwards.
+#[derive(Debug, Clone)]
+pub struct SampleTerms {
+    /// (state, input speed bits, input torque bits) the terms were computed for.
+    key: Option<(usize, u64, u64)>,
+    /// Per sliding entry: loss at η = 1 Pa·s for this sample's torque and speed (W,
+    /// multiplicity included); unused for entries without a power law.
+    slide_unit: Vec<f64>,
+    /// Samples prepared.
+    pub prepared: usize,
 }
 
 /// Operating point of the whole gearbox.
@@ -190,8 +225,16 @@ fn wet_fraction(yc: f64, r: f64, level: f64) -> f64 {
 }
 
 impl LossScene {
-    /// Build every loss model of `gb` once.
+    /// Build the loss models of `gb` for every gear state.
     pub fn compile(gb: &Gearbox) -> Result<LossScene, SceneError> {
+        Self::compile_for(gb, &Needs::default())
+    }
+
+    /// Build the loss models `needs` asks for, once. Items that neither move nor carry load in
+    /// any needed gear state are skipped and listed in [`Self::skipped`] (unless
+    /// `needs.evaluate_all`).
+    pub fn compile_for(gb: &Gearbox, needs: &Needs) -> Result<LossScene, SceneError> {
+        let usage = Usage::of(gb, needs);
         let mut items = Vec::new();
         let mut skipped = Vec::new();
         let mut churn = Vec::new();
@@ -216,6 +259,10 @@ impl LossScene {
                                 -g.immersion * 1e3
                             ),
                         });
+                        continue;
+                    }
+                    if !usage.any(|u, st| u.speeds[st][gi].absolute != 0.0) {
+                        skipped.push(usage.idle(format!("churning of gear {}", g.name), "stands still"));
                         continue;
                     }
                     let model = GearChurning::new(cfg, &churning_gear(gb, gi)).map_err(|e| SceneError {
@@ -252,6 +299,13 @@ impl LossScene {
                             why: "internal mesh: the pocket model (seed 004) covers external meshes only"
                                 .into(),
                         });
+                        continue;
+                    }
+                    if !usage.any(|u, st| u.speeds[st][m.gear1].relative != 0.0) {
+                        skipped.push(usage.idle(
+                            format!("pocketing of mesh {}", m.name),
+                            "has no relative motion (its gears turn as one)",
+                        ));
                         continue;
                     }
                     let (g1, g2) = (&gb.gears[m.gear1], &gb.gears[m.gear2]);
@@ -317,6 +371,17 @@ impl LossScene {
         };
         if let Some(opts) = opts {
             for (mi, m) in gb.meshes.iter().enumerate() {
+                let loaded = |u: &Usage, st: usize| {
+                    u.torques[st][mi] != 0.0
+                        && (u.speeds[st][m.gear1].relative != 0.0 || u.speeds[st][m.gear2].relative != 0.0)
+                };
+                if !usage.any(loaded) {
+                    skipped.push(usage.idle(
+                        format!("sliding of mesh {}", m.name),
+                        "carries no load or has no relative motion",
+                    ));
+                    continue;
+                }
                 let geo = &m.geometry;
                 let (g1, g2) = (&gb.gears[m.gear1], &gb.gears[m.gear2]);
                 let input = SlidingMeshInput {
@@ -340,14 +405,19 @@ impl LossScene {
                     what: what.clone(),
                     why: e.to_string(),
                 })?;
-                let model = match schlenk {
-                    Some(s) => SlideModel::Iso14179(sm, s),
-                    None => SlideModel::Detailed(sm),
+                let (model, law) = match schlenk {
+                    // μ_mz ∝ (F/b/(v ρ))^0.2·η^−0.05 and the closed form is linear in μ
+                    Some(s) => (SlideModel::Iso14179(sm, s), Some(PowerLaw::SCHLENK)),
+                    None => {
+                        let k = sm.power_law();
+                        (SlideModel::Detailed(sm), k)
+                    }
                 };
                 slide.push(SlideEntry {
                     item: items.len(),
                     model,
                     multiplicity: m.multiplicity as f64,
+                    law: if needs.evaluate_all { None } else { law },
                 });
                 slide_meshes.push(mi);
                 let f1 = opts.heat_to_gear1;
@@ -359,22 +429,12 @@ impl LossScene {
             }
         }
 
-        // Per-state kinematic factors. Round-off from the kinematic solve (~1e-16 per unit input)
-        // is snapped to exact zero so a locked set (all members at one speed) has no relative
-        // motion at all.
-        let clean = |v: f64| if v.abs() < 1e-12 { 0.0 } else { v };
+        // Per-state kinematic factors of the compiled entries, and the sliding element sums of
+        // the separable laws per state and power-flow direction (unit torque, speed, viscosity).
         let states = (0..gb.gear_states.len())
             .map(|si| {
-                let speeds: Vec<_> = gb
-                    .gear_speeds(si)
-                    .into_iter()
-                    .map(|s| crate::model::gearbox::GearSpeed {
-                        absolute: clean(s.absolute),
-                        relative: clean(s.relative),
-                    })
-                    .collect();
-                let torques: Vec<f64> = gb.mesh_torques(si).into_iter().map(clean).collect();
-                StateFactors {
+                let (speeds, torques) = (&usage.speeds[si], &usage.torques[si]);
+                let mut f = StateFactors {
                     churn_speed: churn_gears.iter().map(|&gi| speeds[gi].absolute.abs()).collect(),
                     pocket_speed: pocket_meshes
                         .iter()
@@ -387,7 +447,20 @@ impl LossScene {
                             [torques[mi], speeds[m.gear1].relative, speeds[m.gear2].relative]
                         })
                         .collect(),
-                }
+                    slide_unit: Vec::new(),
+                };
+                f.slide_unit = slide
+                    .iter()
+                    .zip(&f.slide)
+                    .map(|(e, k)| match e.law {
+                        Some(_) if usage.needed(si) => [
+                            sliding(e, k, 1.0, 1.0, 1.0, 1.0),
+                            sliding(e, k, -1.0, 1.0, 1.0, 1.0),
+                        ],
+                        _ => [f64::NAN; 2],
+                    })
+                    .collect();
+                f
             })
             .collect();
 
@@ -413,8 +486,77 @@ impl LossScene {
         self.items.is_empty()
     }
 
-    /// Evaluate every loss item (W) at `op` into `out` (length [`Self::len`]). No allocation.
+    /// Evaluate every loss item (W) at `op` into `out` (length [`Self::len`]), everything in
+    /// full. No allocation.
     pub fn evaluate(&self, op: &OperatingPoint, out: &mut [f64]) {
+        self.evaluate_load_independent(op, out);
+        let st = &self.states[op.state];
+        for (e, f) in self.slide.iter().zip(&st.slide) {
+            out[e.item] = sliding(e, f, op.input_torque, op.input_speed, op.oil.mu, op.oil.rho);
+        }
+    }
+
+    /// Empty per-sample terms for this scene (allocates once).
+    pub fn sample_terms(&self) -> SampleTerms {
+        SampleTerms {
+            key: None,
+            slide_unit: vec![0.0; self.slide.len()],
+            prepared: 0,
+        }
+    }
+
+    /// Compute the per-sample terms for gear state `state`, input speed (rad/s) and torque
+    /// (N·m): each separable sliding loss at η = 1 Pa·s, from its per-state unit value scaled by
+    /// two powers. No allocation.
+    pub fn prepare(&self, state: usize, input_speed: f64, input_torque: f64, terms: &mut SampleTerms) {
+        let key = (state, input_speed.to_bits(), input_torque.to_bits());
+        if terms.key == Some(key) {
+            return;
+        }
+        let st = &self.states[state];
+        let (t, w) = (input_torque, input_speed);
+        // P(T, ω) = P(sign(T·ω)·1 N·m, 1 rad/s)·|T|^a·|ω|^b: reversing both T and ω leaves the
+        // power flow and every magnitude unchanged.
+        let dir = usize::from(t * w < 0.0);
+        for ((e, unit), u) in self.slide.iter().zip(&st.slide_unit).zip(&mut terms.slide_unit) {
+            if let Some(law) = e.law {
+                *u = if t == 0.0 || w == 0.0 {
+                    0.0
+                } else {
+                    unit[dir] * t.abs().powf(law.torque) * w.abs().powf(law.speed)
+                };
+            }
+        }
+        terms.key = Some(key);
+        terms.prepared += 1;
+    }
+
+    /// Evaluate every loss item (W) at `op` into `out` using the per-sample terms prepared for
+    /// `op`'s state, speed and torque: sliding losses with a viscosity exponent cost one power
+    /// of η. Terms prepared for another sample are ignored (full evaluation). No allocation.
+    pub fn evaluate_cached(&self, op: &OperatingPoint, terms: &SampleTerms, out: &mut [f64]) {
+        if terms.key != Some((op.state, op.input_speed.to_bits(), op.input_torque.to_bits())) {
+            return self.evaluate(op, out);
+        }
+        self.evaluate_load_independent(op, out);
+        let st = &self.states[op.state];
+        let mut memo = (f64::NAN, 0.0);
+        for ((e, f), u) in self.slide.iter().zip(&st.slide).zip(&terms.slide_unit) {
+            out[e.item] = match e.law {
+                Some(law) => {
+                    let k = law.viscosity;
+                    if k != memo.0 {
+                        memo = (k, op.oil.mu.powf(k));
+                    }
+                    u * memo.1
+                }
+                None => sliding(e, f, op.input_torque, op.input_speed, op.oil.mu, op.oil.rho),
+            };
+        }
+    }
+
+    /// Churning and pocketing at `op` into `out`.
+    fn evaluate_load_independent(&self, op: &OperatingPoint, out: &mut [f64]) {
         let st = &self.states[op.state];
         let w_in = op.input_speed;
         let churn_oil = ChurnOil {
@@ -428,28 +570,106 @@ impl LossScene {
             let rho = e.wet_fraction * op.oil.rho + (1.0 - e.wet_fraction) * self.mixture_density;
             out[e.item] = e.multiplicity * e.model.power(k * w_in, rho);
         }
-        let slide_oil = SlideOil {
-            dynamic_viscosity: op.oil.mu,
-            density: op.oil.rho,
+    }
+}
+
+/// Sliding loss of one entry (W, multiplicity included) with state factors `f`, input
+/// torque `torque` (N·m), input speed `w_in` (rad/s), oil viscosity `mu` (Pa·s), density `rho`.
+fn sliding(e: &SlideEntry, f: &[f64; 3], torque: f64, w_in: f64, mu: f64, rho: f64) -> f64 {
+    // The sliding model takes the torque gear 1 transmits (it drives when t1·ω1 > 0): the
+    // opposite of the torque the mesh applies to it.
+    let t1 = -f[0] * torque;
+    let (w1, w2) = (f[1] * w_in, f[2] * w_in);
+    if t1 == 0.0 || (w1 == 0.0 && w2 == 0.0) {
+        // No load or no relative motion in this state (e.g. a locked planetary set): skipped.
+        return 0.0;
+    }
+    let oil = SlideOil {
+        dynamic_viscosity: mu,
+        density: rho,
+    };
+    let p = match &e.model {
+        SlideModel::Detailed(m) => m.power(t1, w1, w2, oil).total,
+        SlideModel::Iso14179(m, s) => {
+            let mu = m.mu_mz(t1, w1, w2, oil, s);
+            m.closed_form_power(t1, w1, mu).total
+        }
+    };
+    e.multiplicity * p
+}
+
+/// Kinematics of every gear state and which states a run needs.
+struct Usage {
+    /// Per state: gear speeds per unit input speed.
+    speeds: Vec<Vec<crate::model::gearbox::GearSpeed>>,
+    /// Per state: mesh torques per unit input torque.
+    torques: Vec<Vec<f64>>,
+    /// Needed states.
+    used: Vec<usize>,
+    /// Names of the needed states when they are not all of the model's.
+    subset: Option<String>,
+    /// Keep everything.
+    all: bool,
+}
+
+impl Usage {
+    fn of(gb: &Gearbox, needs: &Needs) -> Usage {
+        // Round-off from the kinematic solve (~1e-16 per unit input) is snapped to exact zero so a
+        // locked set (all members at one speed) has no relative motion at all.
+        let clean = |v: f64| if v.abs() < 1e-12 { 0.0 } else { v };
+        let n = gb.gear_states.len();
+        let speeds = (0..n)
+            .map(|si| {
+                gb.gear_speeds(si)
+                    .into_iter()
+                    .map(|s| crate::model::gearbox::GearSpeed {
+                        absolute: clean(s.absolute),
+                        relative: clean(s.relative),
+                    })
+                    .collect()
+            })
+            .collect();
+        let torques = (0..n)
+            .map(|si| gb.mesh_torques(si).into_iter().map(clean).collect())
+            .collect();
+        let mut used: Vec<usize> = match (&needs.states, needs.evaluate_all) {
+            (Some(s), false) => s.iter().copied().filter(|&i| i < n).collect(),
+            _ => (0..n).collect(),
         };
-        for (e, f) in self.slide.iter().zip(&st.slide) {
-            // The sliding model takes the torque gear 1 transmits (it drives when t1·ω1 > 0): the
-            // opposite of the torque the mesh applies to it.
-            let t1 = -f[0] * op.input_torque;
-            let (w1, w2) = (f[1] * w_in, f[2] * w_in);
-            if t1 == 0.0 || (w1 == 0.0 && w2 == 0.0) {
-                // No load or no relative motion (e.g. a locked planetary set): no sliding loss.
-                out[e.item] = 0.0;
-                continue;
-            }
-            let p = match &e.model {
-                SlideModel::Detailed(m) => m.power(t1, w1, w2, slide_oil).total,
-                SlideModel::Iso14179(m, s) => {
-                    let mu = m.mu_mz(t1, w1, w2, slide_oil, s);
-                    m.closed_form_power(t1, w1, mu).total
-                }
-            };
-            out[e.item] = e.multiplicity * p;
+        used.sort_unstable();
+        used.dedup();
+        let subset = (used.len() < n).then(|| {
+            used.iter()
+                .map(|&i| gb.gear_states[i].name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        });
+        Usage {
+            speeds,
+            torques,
+            used,
+            subset,
+            all: needs.evaluate_all,
+        }
+    }
+
+    /// True if state `si` is needed.
+    fn needed(&self, si: usize) -> bool {
+        self.all || self.used.binary_search(&si).is_ok()
+    }
+
+    /// True if `pred` holds in a needed state (always true when everything is kept).
+    fn any(&self, pred: impl Fn(&Usage, usize) -> bool) -> bool {
+        self.all || self.used.iter().any(|&st| pred(self, st))
+    }
+
+    fn idle(&self, what: String, why: &str) -> Skipped {
+        Skipped {
+            what,
+            why: match &self.subset {
+                Some(names) => format!("{why} in every gear state the run uses ({names})"),
+                None => format!("{why} in every gear state"),
+            },
         }
     }
 }

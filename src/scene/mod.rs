@@ -4,5 +4,5 @@ pub mod losses;
 pub mod system;
 pub mod thermal;
 
-pub use losses::{LossItem, LossScene, OperatingPoint, SceneError, Skipped, Source};
+pub use losses::{LossItem, LossScene, Needs, OperatingPoint, SampleTerms, SceneError, Skipped, Source};
 pub use system::{Inputs, RhsFailure, Scene, Work};

@@ -1,8 +1,8 @@
 //! The whole compiled scene: loss items feeding the thermal network, as one ODE right-hand side
 //! `dy/dt = f(t, y)` with its Jacobian–vector product.
 //!
-//! State layout: `y = [T_1 … T_n (K) | E_1 … E_m (J, energy of each loss item) | E_b (J, heat
-//! into boundaries)]`. The energies are quadratures (their columns of the Jacobian are zero), so
+//! State layout: `y = [T_1 … T_n (K) | E_1 … E_e (J, loss energy of each item, or of each source
+//! when per-item energies are not asked for) | E_b (J, heat into boundaries)]`. The energies are quadratures (their columns of the Jacobian are zero), so
 //! `Σ C_i ΔT_i + E_b − Σ E_k = 0` is a linear invariant the integrators preserve to round-off:
 //! the energy balance checks the assembly, not the integration error.
 //!
@@ -13,7 +13,7 @@
 use crate::model::gearbox::Gearbox;
 use crate::physics::oil::OilProperties;
 
-use super::losses::{LossScene, OperatingPoint, SceneError, Skipped};
+use super::losses::{LossScene, Needs, OperatingPoint, SampleTerms, SceneError, Skipped};
 use super::thermal::{NetworkWork, Operating, ThermalScene};
 
 /// Inputs that hold during one cycle interval.
@@ -54,6 +54,10 @@ pub struct Scene {
     /// Oil temperature used for the oil properties instead of the oil node's (K); `None` for the
     /// normal coupled model. Used to measure the viscosity feedback.
     pub frozen_oil_temp: Option<f64>,
+    /// Energy quadrature (offset after the nodes) each loss item adds to.
+    pub energy_slot: Vec<usize>,
+    /// Number of energy quadratures (items, or 3 sources).
+    energies: usize,
     /// Clamp of the oil temperature used for the oil properties (K), if any: lets a runaway be
     /// followed past the oil's valid range without the property laws breaking down (used by the
     /// steady-state fallback to prove that no equilibrium exists in range).
@@ -70,8 +74,12 @@ pub struct Work {
     pub net: NetworkWork,
     /// Loss of each item at the last evaluation, W.
     pub q: Vec<f64>,
+    /// Loss terms of the current sample (torque- and speed-dependent), computed at
+    /// [`Scene::set_inputs`].
+    pub terms: SampleTerms,
     heat: Vec<f64>,
     q2: Vec<f64>,
+    q_base: Vec<f64>,
     heat2: Vec<f64>,
     /// ∂f/∂T_oil for the whole state (column of the Jacobian), cached.
     oil_col: Vec<f64>,
@@ -86,19 +94,35 @@ pub struct Work {
 }
 
 impl Scene {
-    /// Compile the scene of a gearbox with a thermal network.
+    /// Compile the scene of a gearbox with a thermal network, for every gear state.
     pub fn compile(gb: &Gearbox) -> Result<Scene, SceneError> {
+        Self::compile_for(gb, &Needs::default())
+    }
+
+    /// Compile only what `needs` asks for (scene pruning): see [`LossScene::compile_for`].
+    pub fn compile_for(gb: &Gearbox, needs: &Needs) -> Result<Scene, SceneError> {
         let net = gb.thermal.as_ref().ok_or_else(|| SceneError {
             what: "thermal network".into(),
             why: "the model has no [thermal] section; a transient or steady run needs one".into(),
         })?;
-        let losses = LossScene::compile(gb)?;
+        let losses = LossScene::compile_for(gb, needs)?;
         let thermal = ThermalScene::compile(gb, net, &losses.items);
-        let skipped = losses.skipped.clone();
+        let mut skipped = losses.skipped.clone();
+        let (energy_slot, energies) = if needs.energy_per_source_only {
+            skipped.push(Skipped {
+                what: "energy of each loss item".into(),
+                why: "not requested: loss energy is integrated per source".into(),
+            });
+            (losses.items.iter().map(|it| it.source.index()).collect(), 3)
+        } else {
+            ((0..losses.len()).collect(), losses.len())
+        };
         Ok(Scene {
             losses,
             thermal,
             skipped,
+            energy_slot,
+            energies,
             frozen_oil_temp: None,
             oil_temp_clamp: None,
         })
@@ -114,9 +138,49 @@ impl Scene {
         self.losses.len()
     }
 
+    /// Number of loss-energy quadratures in the state.
+    pub fn energies(&self) -> usize {
+        self.energies
+    }
+
+    /// True when the state holds the loss energy of every item.
+    pub fn has_item_energies(&self) -> bool {
+        self.energies == self.items() && self.energy_slot.iter().enumerate().all(|(k, &s)| k == s)
+    }
+
     /// Length of the state vector.
     pub fn n_states(&self) -> usize {
-        self.nodes() + self.items() + 1
+        self.nodes() + self.energies + 1
+    }
+
+    /// Index of the boundary-heat quadrature in the state.
+    pub fn boundary_energy_index(&self) -> usize {
+        self.nodes() + self.energies
+    }
+
+    /// Total loss energy in state `y`, J.
+    pub fn loss_energy(&self, y: &[f64]) -> f64 {
+        let n = self.nodes();
+        y[n..n + self.energies].iter().sum()
+    }
+
+    /// Loss energy per source `[churning, pocketing, sliding]` in state `y`, J.
+    pub fn loss_energy_by_source(&self, y: &[f64]) -> [f64; 3] {
+        let n = self.nodes();
+        let mut by = [0.0; 3];
+        if self.has_item_energies() {
+            for (it, e) in self.losses.items.iter().zip(&y[n..n + self.energies]) {
+                by[it.source.index()] += e;
+            }
+        } else {
+            by.copy_from_slice(&y[n..n + 3]);
+        }
+        by
+    }
+
+    /// Loss energy of item `k` in state `y` (J), when the state holds per-item energies.
+    pub fn item_energy(&self, y: &[f64], k: usize) -> Option<f64> {
+        self.has_item_energies().then(|| y[self.nodes() + k])
     }
 
     /// Initial state: node temperatures (K), zero energies. `initial_temp` overrides every node.
@@ -136,10 +200,12 @@ impl Scene {
             inputs,
             net: self.thermal.work(),
             q: vec![0.0; m],
+            terms: self.losses.sample_terms(),
             heat: vec![0.0; n],
             q2: vec![0.0; m],
+            q_base: vec![0.0; m],
             heat2: vec![0.0; n],
-            oil_col: vec![0.0; n + m + 1],
+            oil_col: vec![0.0; self.n_states()],
             col_key: None,
             sample_id: 0,
             rhs_evals: 0,
@@ -158,12 +224,19 @@ impl Scene {
         }
     }
 
-    /// Switch to new inputs (a new cycle interval): per-sample conductances are recomputed here.
+    /// Switch to new inputs (a new cycle interval): per-sample conductances and loss terms are
+    /// recomputed here.
     pub fn set_inputs(&self, inputs: Inputs, work: &mut Work) {
         work.inputs = inputs;
         work.sample_id = work.sample_id.wrapping_add(1);
         self.thermal
             .sample_conductances(&Self::operating(&inputs), &mut work.net);
+        self.losses.prepare(
+            inputs.state,
+            inputs.input_speed,
+            inputs.input_torque,
+            &mut work.terms,
+        );
     }
 
     /// Oil temperature (K) that sets the oil properties.
@@ -179,7 +252,7 @@ impl Scene {
     pub fn evaluate_losses(&self, y: &[f64], work: &mut Work) {
         let oil = self.thermal.oil_properties(self.oil_temp(y));
         let op = self.op(&work.inputs, oil);
-        self.losses.evaluate(&op, &mut work.q);
+        self.losses.evaluate_cached(&op, &work.terms, &mut work.q);
     }
 
     fn op(&self, inputs: &Inputs, oil: OilProperties) -> OperatingPoint {
@@ -194,18 +267,20 @@ impl Scene {
     /// Terms that depend on T_oil (losses to nodes, rotating-part-in-oil links) at oil
     /// temperature `t_oil`, plus the rest of the network: net heat per node into `heat`, loss per
     /// item into `q`; returns the heat into boundaries.
+    #[allow(clippy::too_many_arguments)]
     fn heat_balance(
         &self,
         y: &[f64],
         t_oil: f64,
         inputs: &Inputs,
+        terms: &SampleTerms,
         net: &NetworkWork,
         q: &mut [f64],
         heat: &mut [f64],
     ) -> f64 {
         let n = self.nodes();
         let oil = self.thermal.oil_properties(t_oil);
-        self.losses.evaluate(&self.op(inputs, oil), q);
+        self.losses.evaluate_cached(&self.op(inputs, oil), terms, q);
         let to_b = self
             .thermal
             .network_heat(&y[..n], &oil, &Self::operating(inputs), net, heat);
@@ -222,15 +297,26 @@ impl Scene {
     pub fn rhs(&self, t: f64, y: &[f64], work: &mut Work, dy: &mut [f64]) {
         work.rhs_evals += 1;
         let n = self.nodes();
-        let m = self.items();
         self.thermal.boundary_temperatures(t, &mut work.net);
         let t_oil = self.oil_temp(y);
-        let to_b = self.heat_balance(y, t_oil, &work.inputs, &work.net, &mut work.q, &mut work.heat);
+        let to_b = self.heat_balance(
+            y,
+            t_oil,
+            &work.inputs,
+            &work.terms,
+            &work.net,
+            &mut work.q,
+            &mut work.heat,
+        );
         for ((d, h), c) in dy.iter_mut().zip(&work.heat).zip(&self.thermal.capacity) {
             *d = h / c;
         }
-        dy[n..n + m].copy_from_slice(&work.q);
-        dy[n + m] = to_b;
+        let e = self.energies;
+        dy[n..n + e].iter_mut().for_each(|x| *x = 0.0);
+        for (q, &slot) in work.q.iter().zip(&self.energy_slot) {
+            dy[n + slot] += q;
+        }
+        dy[n + e] = to_b;
         if !dy.iter().all(|v| v.is_finite()) {
             work.failure = Some(self.diagnose(t, y, &work.q));
         }
@@ -268,7 +354,6 @@ impl Scene {
     /// Jacobian–vector product `out = J(t, y)·v`. Allocation-free.
     pub fn jvp(&self, t: f64, y: &[f64], v: &[f64], work: &mut Work, out: &mut [f64]) {
         let n = self.nodes();
-        let m = self.items();
         self.thermal.boundary_temperatures(t, &mut work.net);
         let oil_i = self.thermal.oil;
         let t_oil = self.oil_temp(y);
@@ -284,8 +369,9 @@ impl Scene {
         for ((o, h), c) in out.iter_mut().zip(&work.heat).zip(&self.thermal.capacity) {
             *o = h / c;
         }
-        out[n..n + m].iter_mut().for_each(|x| *x = 0.0);
-        out[n + m] = to_b;
+        let e = self.energies;
+        out[n..n + e].iter_mut().for_each(|x| *x = 0.0);
+        out[n + e] = to_b;
         if self.frozen_oil_temp.is_some() || v[oil_i] == 0.0 {
             return;
         }
@@ -295,20 +381,36 @@ impl Scene {
             work.jac_evals += 1;
             let h = 1e-4 * (1.0 + t_oil.abs() / 300.0);
             let inputs = work.inputs;
-            let b0 = self.heat_balance(y, t_oil, &inputs, &work.net, &mut work.q2, &mut work.heat2);
+            let b0 = self.heat_balance(
+                y,
+                t_oil,
+                &inputs,
+                &work.terms,
+                &work.net,
+                &mut work.q2,
+                &mut work.heat2,
+            );
             work.oil_col[..n].copy_from_slice(&work.heat2);
-            work.oil_col[n..n + m].copy_from_slice(&work.q2);
-            work.oil_col[n + m] = b0;
+            work.q_base.copy_from_slice(&work.q2);
             // Only the oil properties move (t_oil + h); the node temperatures stay those of y, whose
             // effect is the analytic part above.
-            let b1 = self.heat_balance(y, t_oil + h, &inputs, &work.net, &mut work.q2, &mut work.heat2);
+            let b1 = self.heat_balance(
+                y,
+                t_oil + h,
+                &inputs,
+                &work.terms,
+                &work.net,
+                &mut work.q2,
+                &mut work.heat2,
+            );
             for i in 0..n {
                 work.oil_col[i] = (work.heat2[i] - work.oil_col[i]) / h / self.thermal.capacity[i];
             }
-            for k in 0..m {
-                work.oil_col[n + k] = (work.q2[k] - work.oil_col[n + k]) / h;
+            work.oil_col[n..n + e].iter_mut().for_each(|x| *x = 0.0);
+            for ((q1, q0), &slot) in work.q2.iter().zip(&work.q_base).zip(&self.energy_slot) {
+                work.oil_col[n + slot] += (q1 - q0) / h;
             }
-            work.oil_col[n + m] = (b1 - work.oil_col[n + m]) / h;
+            work.oil_col[n + e] = (b1 - b0) / h;
             work.col_key = Some(key);
         }
         let s = v[oil_i];
@@ -323,6 +425,6 @@ impl Scene {
         self.thermal.boundary_temperatures(t, &mut work.net);
         let t_oil = self.oil_temp(y);
         let inputs = work.inputs;
-        self.heat_balance(y, t_oil, &inputs, &work.net, &mut work.q, heat)
+        self.heat_balance(y, t_oil, &inputs, &work.terms, &work.net, &mut work.q, heat)
     }
 }

@@ -107,6 +107,9 @@ pub struct TransientOptions {
     /// Guards against the diffsol pitfalls of docs/numerics.md (all on by default; the tests
     /// switch each off to show what it prevents).
     pub guards: Guards,
+    /// Evaluate and keep the loss of every item at every output time (`Trajectory::losses`, for
+    /// timeseries.csv and the plots); off when those outputs are not asked for.
+    pub record_losses: bool,
 }
 
 /// Pitfall guards of the driver.
@@ -147,6 +150,7 @@ impl Default for TransientOptions {
             max_steps: 5_000_000,
             initial_temp: None,
             guards: Guards::default(),
+            record_losses: true,
         }
     }
 }
@@ -170,6 +174,8 @@ pub struct Stats {
     pub newton_failures: usize,
     /// Restarts at input jumps.
     pub restarts: usize,
+    /// Cycle samples whose loss terms were prepared (once per distinct input sample).
+    pub samples_prepared: usize,
 }
 
 /// The result: the state at every segment boundary, and the losses there.
@@ -180,7 +186,7 @@ pub struct Trajectory {
     /// State at each time (temperatures K, energies J).
     pub states: Vec<Vec<f64>>,
     /// Loss of each item at each time (W), with the inputs of the segment that starts there (the
-    /// last row: of the last segment).
+    /// last row: of the last segment). Empty when `TransientOptions::record_losses` is off.
     pub losses: Vec<Vec<f64>>,
     /// Segment index whose inputs each row shows.
     pub segment: Vec<usize>,
@@ -296,6 +302,7 @@ pub fn integrate(
     let w = work.borrow();
     traj.stats.rhs_evals = w.rhs_evals;
     traj.stats.jac_evals = w.jac_evals;
+    traj.stats.samples_prepared = w.terms.prepared;
     traj.wall_time_s = start.elapsed().as_secs_f64();
     Ok(traj)
 }
@@ -309,21 +316,17 @@ struct Driver<'s> {
 }
 
 impl Driver<'_> {
+    /// Record the row at time `t`: the state and the losses with the current inputs (those of
+    /// segment `seg`, which the caller has already switched to).
     fn record(&self, traj: &mut Trajectory, t: f64, y: &[f64], seg: usize) {
-        let mut w = self.work.borrow_mut();
-        let saved = w.inputs;
-        let inputs = self.segments[seg].inputs;
-        if inputs != saved {
-            self.scene.set_inputs(inputs, &mut w);
+        if self.opts.record_losses {
+            let mut w = self.work.borrow_mut();
+            self.scene.evaluate_losses(y, &mut w);
+            traj.losses.push(w.q.clone());
         }
-        self.scene.evaluate_losses(y, &mut w);
         traj.times.push(t);
         traj.states.push(y.to_vec());
-        traj.losses.push(w.q.clone());
         traj.segment.push(seg);
-        if inputs != saved {
-            self.scene.set_inputs(saved, &mut w);
-        }
     }
 
     /// Failure at the solver's current state: names the node with the largest weighted rate and
@@ -402,10 +405,8 @@ impl Driver<'_> {
         let mut restarts = 0;
         for (k, seg) in segs.iter().enumerate() {
             if k > 0 {
+                // The inputs were switched to this segment's when the previous row was recorded.
                 let changed = seg.inputs != segs[k - 1].inputs;
-                if changed {
-                    self.scene.set_inputs(seg.inputs, &mut self.work.borrow_mut());
-                }
                 let restart = match self.opts.restart {
                     Restart::AtJumps => changed,
                     Restart::EveryInterval => true,
@@ -476,7 +477,13 @@ impl Driver<'_> {
             if let Some(i) = y.iter().position(|v| !v.is_finite()) {
                 return Err(self.failure(seg.t1, y, format!("state component {i} is not finite")));
             }
+            // The row at t1 shows the inputs of the segment that starts there: switch to them now
+            // (once; the next segment integrates with them).
             let row_seg = if k + 1 < total { k + 1 } else { k };
+            if segs[row_seg].inputs != seg.inputs {
+                self.scene
+                    .set_inputs(segs[row_seg].inputs, &mut self.work.borrow_mut());
+            }
             self.record(traj, seg.t1, y, row_seg);
             progress(k + 1, total);
         }
@@ -507,7 +514,6 @@ pub struct EnergyBalance {
 /// Energy balance between the first and last state of a trajectory.
 pub fn energy_balance(scene: &Scene, traj: &Trajectory) -> EnergyBalance {
     let n = scene.nodes();
-    let m = scene.items();
     let (y0, y1) = match (traj.states.first(), traj.states.last()) {
         (Some(a), Some(b)) => (a, b),
         _ => {
@@ -519,9 +525,10 @@ pub fn energy_balance(scene: &Scene, traj: &Trajectory) -> EnergyBalance {
             }
         }
     };
-    let lost: f64 = y1[n..n + m].iter().sum::<f64>() - y0[n..n + m].iter().sum::<f64>();
+    let lost = scene.loss_energy(y1) - scene.loss_energy(y0);
     let stored: f64 = (0..n).map(|i| scene.thermal.capacity[i] * (y1[i] - y0[i])).sum();
-    let to_b = y1[n + m] - y0[n + m];
+    let b = scene.boundary_energy_index();
+    let to_b = y1[b] - y0[b];
     let scale = lost
         .abs()
         .max(stored.abs())

@@ -173,9 +173,16 @@ impl Schlenk {
         let eta_mpas = viscosity * 1e3;
         let ra_um = roughness * 1e6;
         let x = (f_n_mm / (sum_speed_c * rho_mm)).max(0.0);
-        self.coefficient * x.powf(0.2) * eta_mpas.powf(-0.05) * ra_um.powf(0.25) * self.x_l
+        self.coefficient
+            * x.powf(0.2)
+            * eta_mpas.powf(-SCHLENK_VISCOSITY_EXPONENT)
+            * ra_um.powf(0.25)
+            * self.x_l
     }
 }
+
+/// Exponent of the viscosity in Schlenk's μ_mz (ISO/TR 14179-2): μ_mz ∝ η^(−0.05).
+pub const SCHLENK_VISCOSITY_EXPONENT: f64 = 0.05;
 
 /// Choice of friction law for the detailed model.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -2,7 +2,7 @@
 //! [`SlidingMesh::power`] evaluates them without allocating (physics.md §7).
 
 use super::contact::{self, ContactElement, ContactPath, Sample};
-use super::friction::{ContactState, FrictionLaw, Schlenk};
+use super::friction::{ContactState, FrictionLaw, Schlenk, SCHLENK_VISCOSITY_EXPONENT};
 use super::helical::{self, HelicalDistribution};
 use super::moment_balance::{self, LossForm};
 use super::{
@@ -178,6 +178,40 @@ impl SlidingMesh {
         }
     }
 
+    /// Exponents for which this mesh's loss is exactly a product of powers of torque, speed
+    /// and viscosity, `P(λ_T·T1, λ_ω·ω1, λ_ω·ω2, λ_η·η) = λ_T^a·λ_ω^b·λ_η^c·P(T1, ω1, ω2, η)`
+    /// for λ > 0, or `None` when it is not.
+    ///
+    /// [derived] With the first-order loss form every element contributes `μ_k F_k v_g,k`, with
+    /// F_k ∝ T1 and v_g,k ∝ ω, both independent of η, and the load shares fixed by geometry.
+    /// - ISO TC60, `μ = c·(w·Ra/(η·R·v_Σ))^e` with w ∝ T1 and v_Σ ∝ ω: (1 + e, 1 − e, −e).
+    /// - Schlenk's μ_mz, `∝ (F_bt/b/(v_ΣC ρ))^0.2·η^−0.05`: (1.2, 0.8, −0.05).
+    /// - Constant μ: (1, 1, 0), with either loss form (the moment-balance factor then depends on
+    ///   geometry and the power-flow direction only).
+    ///
+    /// Benedict & Kelley (`log10` of a clamped argument) and the moment-balance form with a
+    /// load- or viscosity-dependent μ (`1/(1 + κμρ)`) are not separable.
+    ///
+    /// The scene uses this to run the element loop once per gear state and power-flow direction
+    /// at compile time; a cycle sample then costs two powers and a right-hand-side call one
+    /// power of η (docs/performance.md).
+    pub fn power_law(&self) -> Option<PowerLaw> {
+        match (self.options.friction, self.options.loss_form) {
+            (FrictionLaw::Constant(_), _) => Some(PowerLaw {
+                torque: 1.0,
+                speed: 1.0,
+                viscosity: 0.0,
+            }),
+            (FrictionLaw::IsoTc60(law), LossForm::FirstOrder) => Some(PowerLaw {
+                torque: 1.0 + law.exponent,
+                speed: 1.0 - law.exponent,
+                viscosity: -law.exponent,
+            }),
+            (FrictionLaw::Schlenk(_), LossForm::FirstOrder) => Some(PowerLaw::SCHLENK),
+            _ => None,
+        }
+    }
+
     /// Mesh sliding loss averaged over one base pitch.
     ///
     /// `torque1` T1 on gear 1 (N·m), `omega1`, `omega2` speeds (rad/s, magnitudes used; planetary:
@@ -286,6 +320,28 @@ impl SlidingMesh {
         }
         (p, pu)
     }
+}
+
+/// Exponents of torque, speed and viscosity of a separable sliding loss
+/// ([`SlidingMesh::power_law`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PowerLaw {
+    /// Exponent of the transmitted torque.
+    pub torque: f64,
+    /// Exponent of the speeds (all scaled together).
+    pub speed: f64,
+    /// Exponent of the dynamic viscosity.
+    pub viscosity: f64,
+}
+
+impl PowerLaw {
+    /// Schlenk's μ_mz with the first-order (or closed-form ISO/TR 14179-2) loss:
+    /// P ∝ T^1.2·ω^0.8·η^−0.05.
+    pub const SCHLENK: PowerLaw = PowerLaw {
+        torque: 1.2,
+        speed: 0.8,
+        viscosity: -SCHLENK_VISCOSITY_EXPONENT,
+    };
 }
 
 /// Operating point of one evaluation.
@@ -746,6 +802,67 @@ mod tests {
         let b = m.closed_form_power(t, w1, mu);
         assert!((a.total / b.total - 1.0).abs() < 1e-10);
         assert!((a.mean_mu - mu).abs() < 1e-15);
+    }
+
+    #[test]
+    fn separable_laws_scale_as_powers_of_torque_speed_and_viscosity() {
+        let iso = FrictionLaw::IsoTc60(super::super::friction::IsoTc60::default());
+        let sch = FrictionLaw::Schlenk(Schlenk::default());
+        let bk = FrictionLaw::BenedictKelley(BenedictKelley::default());
+        let oil = |eta: f64| OilState {
+            dynamic_viscosity: eta,
+            density: 870.0,
+        };
+        let law = |a, b, c| PowerLaw {
+            torque: a,
+            speed: b,
+            viscosity: c,
+        };
+        let (t, w1, w2) = (180.0, 310.0, 207.0);
+        for beta in [0.0, 20f64.to_radians()] {
+            for (friction, form, expect) in [
+                (iso, LossForm::FirstOrder, Some(law(1.25, 0.75, -0.25))),
+                (sch, LossForm::FirstOrder, Some(law(1.2, 0.8, -0.05))),
+                (
+                    FrictionLaw::Constant(0.04),
+                    LossForm::MomentBalance,
+                    Some(law(1.0, 1.0, 0.0)),
+                ),
+                (iso, LossForm::MomentBalance, None),
+                (bk, LossForm::FirstOrder, None),
+            ] {
+                let o = SlidingOptions {
+                    friction,
+                    loss_form: form,
+                    ..SlidingOptions::default()
+                };
+                let m = SlidingMesh::new(&seed_input(beta), &o).unwrap();
+                assert_eq!(m.power_law(), expect, "{friction:?} {form:?}");
+                for sign in [1.0, -1.0] {
+                    let p0 = m.power(sign * t, w1, w2, oil(0.05)).total;
+                    for (lt, lw, le) in [(2.0, 1.0, 1.0), (1.0, 0.3, 1.0), (1.0, 1.0, 7.0), (0.1, 3.0, 0.2)] {
+                        let direct = m.power(sign * t * lt, w1 * lw, w2 * lw, oil(0.05 * le)).total;
+                        if let Some(k) = expect {
+                            let scaled = p0 * lt.powf(k.torque) * lw.powf(k.speed) * le.powf(k.viscosity);
+                            assert!(
+                                (scaled / direct - 1.0).abs() < 1e-12,
+                                "{friction:?} {lt} {lw} {le}: {scaled} {direct}"
+                            );
+                        }
+                    }
+                    if expect.is_none() {
+                        // not a power of η: the exponent fitted from two viscosities misses a third
+                        let p1 = m.power(sign * t, w1, w2, oil(0.5)).total;
+                        let p2 = m.power(sign * t, w1, w2, oil(5.0)).total;
+                        let k = (p1 / p0).ln() / 10f64.ln();
+                        assert!(
+                            (p1 * 10f64.powf(k) / p2 - 1.0).abs() > 1e-9,
+                            "{friction:?} {form:?}"
+                        );
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -28,6 +28,7 @@ pub use contact::{ContactElement, ContactPath, Sample};
 pub use friction::{BenedictKelley, ContactState, FrictionLaw, IsoTc60, Schlenk};
 pub use helical::HelicalDistribution;
 pub use load_sharing::LoadSharing;
+pub use mesh::PowerLaw;
 pub use mesh::SlidingMesh;
 pub use moment_balance::LossForm;
 
