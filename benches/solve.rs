@@ -1,5 +1,6 @@
-//! Criterion benches of the solvers: one right-hand-side evaluation, one equilibrium, and a full
-//! WLTC transient per example model (default solver and tolerance).
+//! Criterion benches of the solvers: one right-hand-side evaluation (with the per-sample loss
+//! cache, and with every loss evaluated in full), one equilibrium, and a full WLTC transient per
+//! example model (default solver and tolerance; for the AT6 also with everything evaluated).
 
 use std::hint::black_box;
 use std::path::Path;
@@ -8,7 +9,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 
 use geartherm::cycle::DriveCycle;
 use geartherm::model;
-use geartherm::scene::{Inputs, Scene};
+use geartherm::scene::{Inputs, Needs, Scene};
 use geartherm::solve::drive::segments;
 use geartherm::solve::equilibrium::equilibrium;
 use geartherm::solve::steady::SteadyOptions;
@@ -45,25 +46,47 @@ fn benches(c: &mut Criterion) {
     c.bench_function("lu/21x21", |b| b.iter(|| black_box(a.clone()).lu()));
     for m in MODELS {
         let gb = model::load(Path::new(m)).unwrap();
-        let scene = Scene::compile(&gb).unwrap();
         let name = Path::new(m).file_stem().unwrap().to_string_lossy().into_owned();
+        let cycle = DriveCycle::resolve("wltc").unwrap();
+        let (_, segs) = segments(&gb, &cycle).unwrap();
+        // As `geartherm run` compiles it: pruned to the cycle's gear states.
+        let needs = Needs {
+            states: Some(segs.iter().map(|s| s.inputs.state).collect()),
+            ..Needs::default()
+        };
+        let scene = Scene::compile_for(&gb, &needs).unwrap();
+        let everything = Scene::compile_for(
+            &gb,
+            &Needs {
+                evaluate_all: true,
+                ..Needs::default()
+            },
+        )
+        .unwrap();
         let inp = point(&gb);
-        let mut work = scene.work(inp);
-        let y = scene.initial_state(None);
-        let mut dy = vec![0.0; y.len()];
-        c.bench_function(&format!("rhs/{name}"), |b| {
-            b.iter(|| scene.rhs(black_box(0.0), black_box(&y), &mut work, &mut dy))
-        });
+        for (label, sc) in [("rhs", &scene), ("rhs_full", &everything)] {
+            let mut work = sc.work(inp);
+            let y = sc.initial_state(None);
+            let mut dy = vec![0.0; y.len()];
+            c.bench_function(&format!("{label}/{name}"), |b| {
+                b.iter(|| sc.rhs(black_box(0.0), black_box(&y), &mut work, &mut dy))
+            });
+        }
         c.bench_function(&format!("equilibrium/{name}"), |b| {
             b.iter(|| equilibrium(&scene, black_box(inp), None, &SteadyOptions::default()).unwrap())
         });
-        let cycle = DriveCycle::resolve("wltc").unwrap();
-        let (_, segs) = segments(&gb, &cycle).unwrap();
         let mut g = c.benchmark_group("wltc");
         g.sample_size(10);
         g.bench_function(&name, |b| {
             b.iter(|| integrate(&scene, &segs, &TransientOptions::default(), &mut |_, _| {}).unwrap())
         });
+        if name.starts_with("at6") {
+            g.bench_function(format!("{name}_evaluate_all"), |b| {
+                b.iter(|| {
+                    integrate(&everything, &segs, &TransientOptions::default(), &mut |_, _| {}).unwrap()
+                })
+            });
+        }
         g.finish();
     }
 }
