@@ -55,7 +55,7 @@ fn loss_evaluation_allocates_nothing() {
 }
 
 #[test]
-fn right_hand_side_and_jacobian_product_allocate_nothing() {
+fn sample_switch_right_hand_side_and_jacobian_product_allocate_nothing() {
     use geartherm::scene::{Inputs, Scene};
     let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     for m in ["at6_lepelletier", "fzg_c", "helical_stage", "pt6_spur_pair"] {
@@ -75,7 +75,13 @@ fn right_hand_side_and_jacobian_product_allocate_nothing() {
         let before = allocs();
         for k in 0..20 {
             y[scene.thermal.oil] += 0.5 * k as f64; // new T_oil: the Jacobian column is recomputed
-            scene.set_inputs(inputs, &mut work);
+            // a new sample: per-sample conductances and loss terms are recomputed
+            let sample = Inputs {
+                input_speed: 250.0 + k as f64,
+                input_torque: if k % 2 == 0 { 150.0 } else { -40.0 },
+                ..inputs
+            };
+            scene.set_inputs(sample, &mut work);
             scene.rhs(k as f64, &y, &mut work, &mut dy);
             for j in 0..scene.nodes() {
                 v.iter_mut().for_each(|x| *x = 0.0);
@@ -87,5 +93,6 @@ fn right_hand_side_and_jacobian_product_allocate_nothing() {
         assert_eq!(after - before, 0, "{m}: rhs/jvp allocated");
         assert!(dy.iter().chain(&jv).all(|x| x.is_finite()), "{m}");
         assert!(work.jac_evals >= 20, "{m}: Jacobian column recomputed per T_oil");
+        assert!(work.terms.prepared >= 20, "{m}: loss terms prepared per sample");
     }
 }

@@ -140,3 +140,38 @@ fn a_shift_every_second_and_a_long_standstill() {
         );
     }
 }
+
+#[test]
+fn explicit_solver_on_a_stiff_network_does_not_finish_where_the_default_does() {
+    // Why the default is implicit although Tsit45 is as fast on the (non-stiff at h = 1 s)
+    // example models (docs/numerics.md): a 0.01 J/K film behind 1e3 W/K has λ ≈ 1e5 /s.
+    let scene = fzg_with(&common::film_network(1e-2, 1e3));
+    let segs = jumpy(300, |_| 0);
+    let implicit = integrate(&scene, &segs, &TransientOptions::default(), &mut |_, _| {}).unwrap();
+    let budget = 100 * implicit.stats.steps;
+    let o = TransientOptions {
+        method: Method::Tsit45,
+        max_steps: budget,
+        ..TransientOptions::default()
+    };
+    match integrate(&scene, &segs, &o, &mut |_, _| {}) {
+        Ok(t) => panic!(
+            "tsit45 finished in {} steps (tr-bdf2: {}): the network is not stiff enough for this test",
+            t.stats.steps, implicit.stats.steps
+        ),
+        Err(e) => {
+            println!(
+                "tr-bdf2: {} steps; tsit45 (budget {budget} steps) failed: {e}",
+                implicit.stats.steps
+            );
+            // Either the step budget runs out or the explicit steps blow up (diffsol's Tsit45
+            // accepts a step whose error norm is NaN); both are named failures at a finite time.
+            assert!(
+                (e.message.contains("step budget") || e.message.contains("not finite"))
+                    && !e.node.is_empty()
+                    && e.time.is_finite(),
+                "{e}"
+            );
+        }
+    }
+}
