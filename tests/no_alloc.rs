@@ -75,7 +75,7 @@ fn sample_switch_right_hand_side_and_jacobian_product_allocate_nothing() {
         let before = allocs();
         for k in 0..20 {
             y[scene.thermal.oil] += 0.5 * k as f64; // new T_oil: the Jacobian column is recomputed
-            // a new sample: per-sample conductances and loss terms are recomputed
+                                                    // a new sample: per-sample conductances and loss terms are recomputed
             let sample = Inputs {
                 input_speed: 250.0 + k as f64,
                 input_torque: if k % 2 == 0 { 150.0 } else { -40.0 },
