@@ -334,3 +334,46 @@ fn usage_errors_exit_1_and_write_nothing() {
     }
     assert_eq!(run(&["--help"]).status.code(), Some(0));
 }
+
+#[test]
+fn per_state_idle_items_of_the_at6() {
+    // What each gear state alone leaves idle (docs/physics.md §8): 3rd locks the Ravigneaux set.
+    let gb = model::load(Path::new(MODELS[0])).unwrap();
+    let all_states = LossScene::compile(&gb).unwrap();
+    let full = all_states.len();
+    // all states together need every item
+    assert!(!all_states
+        .skipped
+        .iter()
+        .any(|s| s.why.contains("every gear state")));
+    let mut idle_by_state = Vec::new();
+    for (i, st) in gb.gear_states.iter().enumerate() {
+        let sc = LossScene::compile_for(
+            &gb,
+            &Needs {
+                states: Some(vec![i]),
+                ..Needs::default()
+            },
+        )
+        .unwrap();
+        let idle: Vec<_> = sc
+            .skipped
+            .iter()
+            .filter(|s| s.why.contains("every gear state the run uses"))
+            .map(|s| s.what.clone())
+            .collect();
+        assert_eq!(sc.len() + idle.len(), full, "state {}", st.name);
+        println!("state {}: {} of {full} items, idle {idle:?}", st.name, sc.len());
+        idle_by_state.push((st.name.clone(), idle.len()));
+    }
+    let count = |n: &str| idle_by_state.iter().find(|(s, _)| s == n).map(|x| x.1);
+    assert_eq!(count("3"), Some(7));
+    assert_eq!(count("2"), Some(0));
+    // every other state leaves one to four meshes unloaded
+    for s in ["1", "4", "5", "6", "R"] {
+        assert!(
+            count(s).is_some_and(|c| (1..=4).contains(&c)),
+            "{s}: {idle_by_state:?}"
+        );
+    }
+}

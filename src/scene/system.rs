@@ -58,6 +58,8 @@ pub struct Scene {
     pub energy_slot: Vec<usize>,
     /// Number of energy quadratures (items, or 3 sources).
     energies: usize,
+    /// True when each item has its own energy quadrature (slot k = item k).
+    item_energies: bool,
     /// Clamp of the oil temperature used for the oil properties (K), if any: lets a runaway be
     /// followed past the oil's valid range without the property laws breaking down (used by the
     /// steady-state fallback to prove that no equilibrium exists in range).
@@ -123,6 +125,7 @@ impl Scene {
             skipped,
             energy_slot,
             energies,
+            item_energies: !needs.energy_per_source_only,
             frozen_oil_temp: None,
             oil_temp_clamp: None,
         })
@@ -145,7 +148,7 @@ impl Scene {
 
     /// True when the state holds the loss energy of every item.
     pub fn has_item_energies(&self) -> bool {
-        self.energies == self.items() && self.energy_slot.iter().enumerate().all(|(k, &s)| k == s)
+        self.item_energies
     }
 
     /// Length of the state vector.
