@@ -9,6 +9,7 @@ pub mod losses;
 pub mod parse;
 pub mod problems;
 pub mod schema;
+pub mod source;
 pub mod thermal;
 pub mod validate;
 

@@ -12,7 +12,8 @@ use super::catalogue;
 use super::gearbox::*;
 use super::problems::Problems;
 use super::schema::*;
-use super::thermal::{validate_thermal, GearInfo};
+use super::source::Source;
+use super::thermal::{validate_thermal, GearInfo, LossItemNames};
 use crate::cycle::{GearTable, VehicleSpec};
 use crate::physics::geometry::{GearGeometry, GearSpec, MeshGeometry, MeshKind};
 use crate::physics::kinematics::{Constraint, GearTrain, KinematicsError};
@@ -776,8 +777,11 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
                 face_width: g.geometry.spec.b,
             })
             .collect();
-        let mesh_names: Vec<&str> = meshes.iter().map(|m| m.name.as_str()).collect();
-        validate_thermal(spec, &infos, &mesh_names, problems)
+        let mut names = LossItemNames::default();
+        names.set(Source::Churning, gears.iter().map(|g| g.name.as_str()));
+        names.set(Source::Pocketing, meshes.iter().map(|m| m.name.as_str()));
+        names.set(Source::Sliding, meshes.iter().map(|m| m.name.as_str()));
+        validate_thermal(spec, &infos, &names, problems)
     });
 
     let vehicle = file.vehicle.as_ref().and_then(|table| {

@@ -18,36 +18,32 @@ use crate::physics::oil::OilProperties;
 /// the AT6 pocketing loss by 0.5 % and compiles the scene in 0.39 s instead of 0.65 s).
 pub const HELIX_POCKET_SLICES: usize = 48;
 
-/// Heat source kind.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Source {
-    /// Oil drag on an immersed gear (load-independent).
-    Churning,
-    /// Oil squeezed out of closing tooth spaces (load-independent).
-    Pocketing,
-    /// Mesh friction (load-dependent).
-    Sliding,
+pub use crate::model::source::{PerSource, Source, N_SOURCES};
+
+/// Sum the values of `items` (W or J, one per item) per source.
+pub fn sum_by_source(items: &[LossItem], values: &[f64]) -> PerSource {
+    let mut by = [0.0; N_SOURCES];
+    for (it, v) in items.iter().zip(values) {
+        by[it.source.index()] += v;
+    }
+    by
 }
 
-impl Source {
-    /// Position in per-source arrays `[churning, pocketing, sliding]`.
-    pub fn index(self) -> usize {
-        match self {
-            Source::Churning => 0,
-            Source::Pocketing => 1,
-            Source::Sliding => 2,
-        }
-    }
-
-    /// Lower-case name.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Source::Churning => "churning",
-            Source::Pocketing => "pocketing",
-            Source::Sliding => "sliding",
-        }
-    }
+/// Where a loss item's heat goes unless a `[[thermal.heat]]` rule says otherwise.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DefaultHeat {
+    /// The oil node (churning, pocketing).
+    Oil,
+    /// The body nodes of the item's gears with their fractions (sliding); a gear in no node
+    /// heats the oil.
+    Gears,
+    /// The body node of a gear on a member (a bearing or seal on that member: its shaft node),
+    /// else the oil node. Gear indices with fractions.
+    Member(Vec<(usize, f64)>),
+    /// Named thermal nodes with fractions, as the model says (e.g. a bearing's shaft and
+    /// housing nodes).
+    Nodes(Vec<(String, f64)>),
 }
 
 /// One loss item: what it is, where its heat goes.
@@ -58,8 +54,11 @@ pub struct LossItem {
     /// Gear name (churning) or mesh name (pocketing, sliding).
     pub name: String,
     /// Gears heated and the fraction each receives (sliding: split between the two gears;
-    /// churning and pocketing: the gear(s) concerned, whose heat goes to the oil by default).
+    /// churning and pocketing: the gear(s) concerned, whose heat goes to the oil by default;
+    /// empty for items that are not gears or meshes).
     pub gears: Vec<(usize, f64)>,
+    /// Default heat destination.
+    pub heat: DefaultHeat,
 }
 
 /// A part of the model the scene left out, and why.
@@ -278,6 +277,7 @@ impl LossScene {
                         source: Source::Churning,
                         name: g.name.clone(),
                         gears: vec![(gi, 1.0)],
+                        heat: DefaultHeat::Oil,
                     });
                 }
             }
@@ -345,6 +345,7 @@ impl LossScene {
                         source: Source::Pocketing,
                         name: m.name.clone(),
                         gears: vec![(m.gear1, 0.5), (m.gear2, 0.5)],
+                        heat: DefaultHeat::Oil,
                     });
                 }
             }
@@ -425,6 +426,7 @@ impl LossScene {
                     source: Source::Sliding,
                     name: m.name.clone(),
                     gears: vec![(m.gear1, f1), (m.gear2, 1.0 - f1)],
+                    heat: DefaultHeat::Gears,
                 });
             }
         }

@@ -4,5 +4,8 @@ pub mod losses;
 pub mod system;
 pub mod thermal;
 
-pub use losses::{LossItem, LossScene, Needs, OperatingPoint, SampleTerms, SceneError, Skipped, Source};
+pub use losses::{
+    sum_by_source, DefaultHeat, LossItem, LossScene, Needs, OperatingPoint, PerSource, SampleTerms,
+    SceneError, Skipped, Source, N_SOURCES,
+};
 pub use system::{Inputs, RhsFailure, Scene, Work};
