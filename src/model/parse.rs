@@ -25,6 +25,8 @@ const SECTIONS: &[&str] = &[
     "losses",
     "thermal",
     "vehicle",
+    "bearings",
+    "seals",
 ];
 
 /// Line and column (1-based) of a byte offset.
@@ -181,6 +183,8 @@ pub fn parse_model(text: &str, problems: &mut Problems) -> Option<ModelFile> {
     let losses = section::<LossesSpec>(&mut table, "losses", false, problems);
     let thermal = section::<super::thermal::ThermalSpec>(&mut table, "thermal", false, problems);
     let vehicle = section::<Table>(&mut table, "vehicle", false, problems);
+    let bearings = array::<super::bearings::BearingSpec>(&mut table, "bearings", false, problems);
+    let seals = array::<super::bearings::SealSpec>(&mut table, "seals", false, problems);
     if problems.len() > before || !problems.is_empty() {
         return None;
     }
@@ -198,6 +202,8 @@ pub fn parse_model(text: &str, problems: &mut Problems) -> Option<ModelFile> {
         losses,
         thermal,
         vehicle,
+        bearings,
+        seals,
     })
 }
 
