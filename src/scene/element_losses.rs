@@ -60,6 +60,7 @@ impl ElementLosses {
     pub fn compile(
         gb: &Gearbox,
         needed: &dyn Fn(usize) -> bool,
+        idle: &dyn Fn(String, &str) -> Skipped,
         keep_idle: bool,
         items: &mut Vec<LossItem>,
         skipped: &mut Vec<Skipped>,
@@ -78,10 +79,10 @@ impl ElementLosses {
                 })
                 .collect();
             if !keep_idle && !(0..n).any(|si| needed(si) && speed[si] != 0.0) {
-                skipped.push(Skipped {
-                    what: format!("bearing {}", b.name),
-                    why: "its rings do not turn relative to each other in any gear state the run uses".into(),
-                });
+                skipped.push(idle(
+                    format!("bearing {}", b.name),
+                    "its rings do not turn relative to each other",
+                ));
                 continue;
             }
             let (multiplicity, heat_gear) = match b.mount {
@@ -129,10 +130,10 @@ impl ElementLosses {
                 })
                 .collect();
             if !keep_idle && !(0..n).any(|si| needed(si) && speed[si] != 0.0) {
-                skipped.push(Skipped {
-                    what: format!("seal {}", s.name),
-                    why: "its shaft does not turn relative to the seal in any gear state the run uses".into(),
-                });
+                skipped.push(idle(
+                    format!("seal {}", s.name),
+                    "its shaft does not turn relative to the seal",
+                ));
                 continue;
             }
             let heat_gear = gb

@@ -474,6 +474,7 @@ impl LossScene {
         let elements = super::element_losses::ElementLosses::compile(
             gb,
             &|si| usage.needed(si),
+            &|what, why| usage.idle(what, why),
             needs.evaluate_all,
             &mut items,
             &mut skipped,

@@ -117,3 +117,6 @@ impl BearingFriction {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{0}")]
 pub struct BearingError(pub String);
+
+#[cfg(test)]
+mod tests;
