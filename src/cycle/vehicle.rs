@@ -9,7 +9,7 @@
 
 use super::error::{CycleError, CycleErrorKind};
 use super::parse::{KMH, RPM};
-use super::schedule::GearTable;
+use super::gears::GearTable;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
