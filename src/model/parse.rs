@@ -25,6 +25,9 @@ const SECTIONS: &[&str] = &[
     "losses",
     "thermal",
     "vehicle",
+    "clutch_packs",
+    "pump",
+    "launch",
 ];
 
 /// Line and column (1-based) of a byte offset.
@@ -181,6 +184,9 @@ pub fn parse_model(text: &str, problems: &mut Problems) -> Option<ModelFile> {
     let losses = section::<LossesSpec>(&mut table, "losses", false, problems);
     let thermal = section::<super::thermal::ThermalSpec>(&mut table, "thermal", false, problems);
     let vehicle = section::<Table>(&mut table, "vehicle", false, problems);
+    let clutch_packs = array::<super::automatic::ClutchPackSpec>(&mut table, "clutch_packs", false, problems);
+    let pump = section::<super::automatic::PumpSpec>(&mut table, "pump", false, problems);
+    let launch = section::<Table>(&mut table, "launch", false, problems);
     if problems.len() > before || !problems.is_empty() {
         return None;
     }
@@ -198,6 +204,9 @@ pub fn parse_model(text: &str, problems: &mut Problems) -> Option<ModelFile> {
         losses,
         thermal,
         vehicle,
+        clutch_packs,
+        pump,
+        launch,
     })
 }
 

@@ -129,10 +129,26 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         lub.sump_volume_l,
         problems,
     );
+    let element_names: Vec<&str> = file.shift_elements.iter().map(|e| e.name.as_str()).collect();
+    let member_names: Vec<&str> = file.members.iter().map(|m| m.name.as_str()).collect();
+    let clutch_packs = super::automatic::validate_clutch_packs(&file.clutch_packs, &element_names, problems);
+    let pump = file
+        .pump
+        .as_ref()
+        .and_then(|p| super::automatic::validate_pump(p, &member_names, problems));
+    let launch = file.launch.as_ref().and_then(|t| {
+        let gt = RatioTable::new(gear_states.iter().map(|g| (g.name.clone(), g.ratio())).collect());
+        super::automatic::validate_launch(t, &gt, problems)
+    });
+    let auto_names = AutoNames {
+        packs: clutch_packs.iter().map(|c| c.name.as_str()).collect(),
+        pump: file.pump.is_some(),
+        converter: file.launch.is_some(),
+    };
     let thermal = file
         .thermal
         .as_ref()
-        .and_then(|spec| thermal(spec, &gears, &meshes, problems));
+        .and_then(|spec| thermal(spec, &gears, &meshes, &auto_names, problems));
     let vehicle = file
         .vehicle
         .as_ref()
@@ -168,7 +184,17 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         losses: losses?,
         thermal,
         vehicle,
+        clutch_packs,
+        pump,
+        launch,
     })
+}
+
+/// Loss-item names of the automatic's own parts (for heat rules).
+struct AutoNames<'a> {
+    packs: Vec<&'a str>,
+    pump: bool,
+    converter: bool,
 }
 
 /// `[thermal]` against the checked gears and the loss items of the model.
@@ -176,6 +202,7 @@ fn thermal(
     spec: &super::thermal::ThermalSpec,
     gears: &[Gear],
     meshes: &[Mesh],
+    auto: &AutoNames<'_>,
     problems: &mut Problems,
 ) -> Option<ThermalNetwork> {
     let infos: Vec<GearInfo<'_>> = gears
@@ -190,6 +217,9 @@ fn thermal(
     names.set(Source::Churning, gears.iter().map(|g| g.name.as_str()));
     names.set(Source::Pocketing, meshes.iter().map(|m| m.name.as_str()));
     names.set(Source::Sliding, meshes.iter().map(|m| m.name.as_str()));
+    names.set(Source::ClutchDrag, auto.packs.iter().copied());
+    names.set(Source::Pump, auto.pump.then_some("pump"));
+    names.set(Source::Converter, auto.converter.then_some("converter"));
     validate_thermal(spec, &infos, &names, problems)
 }
 
