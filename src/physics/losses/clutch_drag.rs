@@ -151,20 +151,29 @@ impl ClutchPack {
         if target <= 2.0 * ri * ri {
             return ri;
         }
-        // Bisection on the monotone g (60 halvings: below 1e-16 relative of the annulus).
+        // Safeguarded Newton on the monotone g (bisection step whenever Newton leaves the
+        // bracket); a few iterations to 1e-12 of the outer radius.
         let (mut lo, mut hi) = (ri, ro);
-        for _ in 0..60 {
-            let mid = 0.5 * (lo + hi);
-            if g(mid, ri) < target {
-                lo = mid;
+        let (g_lo, g_hi) = (2.0 * ri * ri, g(ro, ri));
+        let mut r = ri + (ro - ri) * (target - g_lo) / (g_hi - g_lo);
+        for _ in 0..100 {
+            let f = g(r, ri) - target;
+            if f < 0.0 {
+                lo = r;
             } else {
-                hi = mid;
+                hi = r;
             }
-            if hi - lo <= 1e-13 * ro {
-                break;
+            let d = g_prime(r, ri);
+            let mut next = r - f / d;
+            if !(next > lo && next < hi) || !d.is_finite() || d <= 0.0 {
+                next = 0.5 * (lo + hi);
             }
+            if (next - r).abs() <= 1e-12 * ro || hi - lo <= 1e-12 * ro {
+                return next;
+            }
+            r = next;
         }
-        0.5 * (lo + hi)
+        r
     }
 
     /// Drag of the pack at slip speed `slip` (rad/s, either sign), oil dynamic viscosity `mu`
@@ -191,11 +200,25 @@ impl ClutchPack {
     }
 }
 
+/// dg/dr = (2r·ln x − (r² − r_i²)/r)/ln²x, x = r/r_i (limit 2r_i at r = r_i).
+fn g_prime(r: f64, ri: f64) -> f64 {
+    let x = r / ri;
+    let e = x - 1.0;
+    if e < 1e-6 {
+        // series: r_i·(2 + 2e/3)
+        return ri * (2.0 + 2.0 * e / 3.0);
+    }
+    let l = x.ln();
+    (2.0 * r * l - (r * r - ri * ri) / r) / (l * l)
+}
+
 /// (r² − r_i²)/ln(r/r_i), with its limit 2r_i² at r = r_i.
 fn g(r: f64, ri: f64) -> f64 {
     let x = r / ri;
-    if x - 1.0 < 1e-9 {
-        return 2.0 * ri * ri * (1.0 + 0.5 * (x - 1.0));
+    let e = x - 1.0;
+    if e < 1e-6 {
+        // series: r_i²·(2 + 2e + e²/3)
+        return ri * ri * (2.0 + e * (2.0 + e / 3.0));
     }
     (r * r - ri * ri) / x.ln()
 }
@@ -304,6 +327,19 @@ mod tests {
         q.mist_viscosity_ratio = 0.1;
         let m = q.drag(100.0, mu, rho).torque;
         assert_relative_eq!(m, 8.0 * couette_torque(0.1 * mu, 100.0, 0.15e-3, 0.075, 0.09), max_relative = 1e-12);
+    }
+
+    #[test]
+    fn film_function_and_its_derivative_are_consistent() {
+        let ri = 0.075;
+        for x in [1.0 + 1e-8, 1.0 + 5e-7, 1.0 + 2e-6, 1.01, 1.1, 1.2, 1.5] {
+            let r = ri * x;
+            let h = 1e-7 * r;
+            let fd = (g(r + h, ri) - g(r - h, ri)) / (2.0 * h);
+            assert_relative_eq!(g_prime(r, ri), fd, max_relative = 1e-5);
+        }
+        // continuity across the series switch
+        assert_relative_eq!(g(ri * (1.0 + 0.999e-6), ri), g(ri * (1.0 + 1.001e-6), ri), max_relative = 1e-9);
     }
 
     #[test]
