@@ -14,8 +14,8 @@ use serde::{Deserialize, Serialize};
 use super::gears::GearTable;
 use super::parse::{KMH, RPM};
 use super::vehicle::VehicleProblem;
-use crate::physics::losses::converter::{locked, Converter};
 pub use crate::physics::losses::converter::ConverterPoint as EngineSide;
+use crate::physics::losses::converter::{locked, Converter};
 
 /// Kind of launch device.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
@@ -76,12 +76,19 @@ pub struct LaunchDevice {
 impl LaunchDevice {
     /// Engine side for gear-table index `gear`, vehicle speed `vehicle_speed` (m/s), turbine speed
     /// (rad/s, ≥ 0) and turbine torque demand (N·m). No allocation.
-    pub fn engine_side(&self, gear: usize, vehicle_speed: f64, turbine_speed: f64, turbine_torque: f64) -> EngineSide {
+    pub fn engine_side(
+        &self,
+        gear: usize,
+        vehicle_speed: f64,
+        turbine_speed: f64,
+        turbine_torque: f64,
+    ) -> EngineSide {
         let above = self.lockup_above.get(gear).copied().unwrap_or(f64::INFINITY);
         if vehicle_speed > above && turbine_speed >= self.idle_speed {
             locked(turbine_speed, turbine_torque, self.lockup_slip)
         } else {
-            self.converter.open(turbine_speed, turbine_torque, self.idle_speed)
+            self.converter
+                .open(turbine_speed, turbine_torque, self.idle_speed)
         }
     }
 }
@@ -137,7 +144,12 @@ impl LaunchSpec {
         }
         for (k, &v) in self.torque_ratio.iter().enumerate() {
             if !(v.is_finite() && (0.5..=5.0).contains(&v)) {
-                push(&mut p, format!("launch.torque_ratio[{k}]"), v.to_string(), "must lie in [0.5, 5]".into());
+                push(
+                    &mut p,
+                    format!("launch.torque_ratio[{k}]"),
+                    v.to_string(),
+                    "must lie in [0.5, 5]".into(),
+                );
             }
         }
         let converter = Converter::new(
@@ -233,7 +245,10 @@ lockup = { gears = ["3", "4", "5", "6"], above_kmh = [40.0, 45.0, 50.0, 55.0], s
 
     pub(crate) fn launch() -> LaunchDevice {
         let t: toml::Table = toml::from_str(LAUNCH_TOML).unwrap();
-        LaunchSpec::from_table(&t).unwrap().validate(&at6_gears()).unwrap()
+        LaunchSpec::from_table(&t)
+            .unwrap()
+            .validate(&at6_gears())
+            .unwrap()
     }
 
     #[test]
@@ -258,12 +273,19 @@ lockup = { gears = ["3", "4", "5", "6"], above_kmh = [40.0, 45.0, 50.0, 55.0], s
     fn problems_are_listed_with_paths() {
         let mut t: toml::Table = toml::from_str(LAUNCH_TOML).unwrap();
         t.insert("idle_speed_rpm".into(), toml::Value::Float(50.0));
-        t.insert("torque_ratio".into(), toml::Value::try_from(vec![2.0, 1.0]).unwrap());
+        t.insert(
+            "torque_ratio".into(),
+            toml::Value::try_from(vec![2.0, 1.0]).unwrap(),
+        );
         let mut s = LaunchSpec::from_table(&t).unwrap();
         s.lockup.as_mut().unwrap().gears[1] = "9".into();
         let e = s.validate(&at6_gears()).unwrap_err();
         let paths: Vec<&str> = e.iter().map(|p| p.path.as_str()).collect();
-        for want in ["launch.idle_speed_rpm", "launch.torque_ratio", "launch.lockup.gears[1]"] {
+        for want in [
+            "launch.idle_speed_rpm",
+            "launch.torque_ratio",
+            "launch.lockup.gears[1]",
+        ] {
             assert!(paths.contains(&want), "{want}: {paths:?}");
         }
         t.insert("kindx".into(), toml::Value::Float(1.0));

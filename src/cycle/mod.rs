@@ -23,9 +23,9 @@ pub mod vehicle;
 
 pub use bundled::{bundled_names, resolve};
 pub use error::{CycleError, CycleErrorKind};
-pub use parse::{CycleKind, CycleRow, DriveCycle};
 pub use gears::GearTable;
 pub use launch::{EngineSide, LaunchDevice, LaunchSpec};
+pub use parse::{CycleKind, CycleRow, DriveCycle};
 pub use schedule::{schedule, schedule_with_launch, Interval, Schedule};
 pub use shift::{BoundShift, Shifter};
 pub use vehicle::{

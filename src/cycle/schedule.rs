@@ -99,7 +99,11 @@ impl Schedule {
 /// cycle's gear column if it has one, else from the vehicle's shift strategy, else (a gearbox
 /// with a single gear state) that state. Rig cycles ignore `vehicle`. Gear names are checked
 /// against `gears` (error with the line number).
-pub fn schedule(cycle: &DriveCycle, vehicle: Option<&Vehicle>, gears: &GearTable) -> Result<Schedule, CycleError> {
+pub fn schedule(
+    cycle: &DriveCycle,
+    vehicle: Option<&Vehicle>,
+    gears: &GearTable,
+) -> Result<Schedule, CycleError> {
     schedule_with_launch(cycle, vehicle, gears, None)
 }
 
@@ -533,8 +537,14 @@ mod tests {
         let idle = l.idle_speed;
         for (a, b) in plain.intervals.iter().zip(&s.intervals) {
             // the gearbox side is unchanged
-            assert_eq!((a.gear, a.input_speed, a.input_torque), (b.gear, b.input_speed, b.input_torque));
-            assert_eq!((a.engine_speed, a.converter_loss, a.lockup), (a.input_speed, 0.0, false));
+            assert_eq!(
+                (a.gear, a.input_speed, a.input_torque),
+                (b.gear, b.input_speed, b.input_torque)
+            );
+            assert_eq!(
+                (a.engine_speed, a.converter_loss, a.lockup),
+                (a.input_speed, 0.0, false)
+            );
             // the engine never runs below idle, and never below the turbine
             assert!(b.engine_speed >= idle - 1e-9 && b.engine_speed >= b.input_speed - 1e-9);
             assert!(b.converter_loss >= 0.0);
@@ -547,7 +557,10 @@ mod tests {
             }
         }
         assert!(s.intervals.iter().any(|i| i.lockup));
-        assert!(s.intervals.iter().any(|i| !i.lockup && !i.standstill && i.converter_loss > 0.0));
+        assert!(s
+            .intervals
+            .iter()
+            .any(|i| !i.lockup && !i.standstill && i.converter_loss > 0.0));
     }
 
     #[test]

@@ -121,13 +121,29 @@ pub fn validate_clutch_packs(
                 format!("not a shift element of the model ({})", elements.join(", ")),
             );
         } else if specs[..i].iter().any(|o| o.element == s.element) {
-            problems.push(format!("{p}.element"), format!("\"{}\"", s.element), "has a pack already");
+            problems.push(
+                format!("{p}.element"),
+                format!("\"{}\"", s.element),
+                "has a pack already",
+            );
         }
         let before = problems.len();
         let z = f64::from(s.friction_interfaces);
         problems.in_range(&format!("{p}.friction_interfaces"), z, 1.0, 40.0, "");
-        problems.in_range(&format!("{p}.inner_radius_mm"), s.inner_radius_mm, 5.0, 500.0, " mm");
-        problems.in_range(&format!("{p}.outer_radius_mm"), s.outer_radius_mm, 5.0, 500.0, " mm");
+        problems.in_range(
+            &format!("{p}.inner_radius_mm"),
+            s.inner_radius_mm,
+            5.0,
+            500.0,
+            " mm",
+        );
+        problems.in_range(
+            &format!("{p}.outer_radius_mm"),
+            s.outer_radius_mm,
+            5.0,
+            500.0,
+            " mm",
+        );
         if s.outer_radius_mm <= s.inner_radius_mm {
             problems.push(
                 format!("{p}.outer_radius_mm"),
@@ -136,11 +152,27 @@ pub fn validate_clutch_packs(
             );
         }
         problems.in_range(&format!("{p}.clearance_mm"), s.clearance_mm, 0.005, 2.0, " mm");
-        problems.in_range(&format!("{p}.oil_flow_l_per_min"), s.oil_flow_l_per_min, 0.0, 50.0, " L/min");
+        problems.in_range(
+            &format!("{p}.oil_flow_l_per_min"),
+            s.oil_flow_l_per_min,
+            0.0,
+            50.0,
+            " L/min",
+        );
         if !(s.groove_factor > 0.0 && s.groove_factor <= 1.0) {
-            problems.push(format!("{p}.groove_factor"), s.groove_factor, "must lie in (0, 1]");
+            problems.push(
+                format!("{p}.groove_factor"),
+                s.groove_factor,
+                "must lie in (0, 1]",
+            );
         }
-        problems.in_range(&format!("{p}.mist_viscosity_ratio"), s.mist_viscosity_ratio, 0.0, 1.0, "");
+        problems.in_range(
+            &format!("{p}.mist_viscosity_ratio"),
+            s.mist_viscosity_ratio,
+            0.0,
+            1.0,
+            "",
+        );
         if let (Some(e), true) = (element, problems.len() == before) {
             out.push(ClutchPackModel {
                 name: s.element.clone(),
@@ -191,7 +223,11 @@ pub fn validate_pump(s: &PumpSpec, members: &[&str], problems: &mut Problems) ->
     }
     let curve = Curve::new(lp.torque_nm.clone(), lp.bar.iter().map(|b| b * 1e5).collect());
     if let Err(e) = &curve {
-        problems.push("pump.line_pressure.torque_nm", format!("{:?}", lp.torque_nm), e.to_string());
+        problems.push(
+            "pump.line_pressure.torque_nm",
+            format!("{:?}", lp.torque_nm),
+            e.to_string(),
+        );
     }
     if problems.len() > before {
         return None;
@@ -208,7 +244,11 @@ pub fn validate_pump(s: &PumpSpec, members: &[&str], problems: &mut Problems) ->
 }
 
 /// Check `[launch]` against the gear table.
-pub fn validate_launch(table: &toml::Table, gears: &GearTable, problems: &mut Problems) -> Option<LaunchDevice> {
+pub fn validate_launch(
+    table: &toml::Table,
+    gears: &GearTable,
+    problems: &mut Problems,
+) -> Option<LaunchDevice> {
     match LaunchSpec::from_table(table).and_then(|s| s.validate(gears)) {
         Ok(l) => Some(l),
         Err(list) => {

@@ -102,7 +102,9 @@ impl AutoLosses {
         let pump = gb.pump.as_ref().map(|m| {
             let speed = match m.drive {
                 PumpDrive::Engine => vec![1.0; n],
-                PumpDrive::Member(k) => (0..n).map(|si| gb.gear_states[si].solution.speeds[k].abs()).collect(),
+                PumpDrive::Member(k) => (0..n)
+                    .map(|si| gb.gear_states[si].solution.speeds[k].abs())
+                    .collect(),
             };
             let e = PumpEntry {
                 item: items.len(),
@@ -136,7 +138,13 @@ impl AutoLosses {
 
     /// Values of the temperature-independent items for gear state `state`, input speed (rad/s),
     /// input torque (N·m) and vehicle speed (m/s). No allocation.
-    pub fn sample(&self, state: usize, input_speed: f64, input_torque: f64, vehicle_speed: f64) -> AutoSample {
+    pub fn sample(
+        &self,
+        state: usize,
+        input_speed: f64,
+        input_torque: f64,
+        vehicle_speed: f64,
+    ) -> AutoSample {
         let w = input_speed.abs();
         let (engine_speed, converter) = match &self.launch {
             Some(l) => {
@@ -166,7 +174,14 @@ impl AutoLosses {
     }
 
     /// Prepare `s` for a sample (kept if it is already the one). No allocation.
-    pub fn prepare(&self, state: usize, input_speed: f64, input_torque: f64, vehicle_speed: f64, s: &mut AutoSample) {
+    pub fn prepare(
+        &self,
+        state: usize,
+        input_speed: f64,
+        input_torque: f64,
+        vehicle_speed: f64,
+        s: &mut AutoSample,
+    ) {
         let key = (
             state,
             input_speed.to_bits(),
@@ -199,7 +214,11 @@ impl AutoLosses {
         }
         let fresh;
         let s = match s.key {
-            Some((st, a, b, _)) if st == state && a == input_speed.to_bits() && b == input_torque.to_bits() => s,
+            Some((st, a, b, _))
+                if st == state && a == input_speed.to_bits() && b == input_torque.to_bits() =>
+            {
+                s
+            }
             _ => {
                 fresh = self.sample(state, input_speed, input_torque, 0.0);
                 &fresh

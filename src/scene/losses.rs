@@ -572,8 +572,14 @@ impl LossScene {
             return self.evaluate(op, out);
         }
         self.evaluate_load_independent(op, out);
-        self.auto
-            .evaluate(op.state, op.input_speed, op.input_torque, &op.oil, &terms.auto, out);
+        self.auto.evaluate(
+            op.state,
+            op.input_speed,
+            op.input_torque,
+            &op.oil,
+            &terms.auto,
+            out,
+        );
         let st = &self.states[op.state];
         let mut memo = (f64::NAN, 0.0);
         for ((e, f), u) in self.slide.iter().zip(&st.slide).zip(&terms.slide_unit) {

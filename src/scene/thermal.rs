@@ -103,7 +103,8 @@ impl CoolerTerm {
         if self.two_way && tc > th {
             return (1.0, 0.0);
         }
-        self.thermostat.map_or((1.0, 0.0), |(a, b)| thermostat_opening(th, a, b))
+        self.thermostat
+            .map_or((1.0, 0.0), |(a, b)| thermostat_opening(th, a, b))
     }
 }
 

@@ -253,7 +253,11 @@ mod tests {
         // solution (π·0.38·7.8·0.3⁴ = 0.0754, not 0.00966); its own formula gives 1.18 N·m.
         let t = couette_torque(0.38, 125.6 - 117.8, 2e-3, 0.0, 0.15);
         assert!((t - 1.178).abs() < 0.001, "{t}");
-        assert_relative_eq!(t, PI * 0.38 * 7.8 * 0.3f64.powi(4) / (32.0 * 2e-3), max_relative = 1e-12);
+        assert_relative_eq!(
+            t,
+            PI * 0.38 * 7.8 * 0.3f64.powi(4) / (32.0 * 2e-3),
+            max_relative = 1e-12
+        );
     }
 
     #[test]
@@ -267,7 +271,11 @@ mod tests {
         let want = 8.0 * couette_torque(mu, w, 0.15e-3, 0.075, 0.090);
         assert_relative_eq!(d.torque, want, max_relative = 1e-12);
         // at Δω_c the needed flow equals the supply exactly
-        assert_relative_eq!(p.film_flow(p.outer_radius, wc, mu, rho), p.oil_flow / 8.0, max_relative = 1e-12);
+        assert_relative_eq!(
+            p.film_flow(p.outer_radius, wc, mu, rho),
+            p.oil_flow / 8.0,
+            max_relative = 1e-12
+        );
     }
 
     #[test]
@@ -284,7 +292,11 @@ mod tests {
         let mut m = p;
         m.mist_viscosity_ratio = 0.05;
         let res = m.drag(3.0 * wc, mu, rho).torque;
-        assert_relative_eq!(res, 8.0 * couette_torque(0.05 * mu, 3.0 * wc, 0.15e-3, 0.075, 0.09), max_relative = 1e-12);
+        assert_relative_eq!(
+            res,
+            8.0 * couette_torque(0.05 * mu, 3.0 * wc, 0.15e-3, 0.075, 0.09),
+            max_relative = 1e-12
+        );
         // film radius: Q(r_e) = q on the break-up branch
         let w = 1.04 * wc;
         let re = p.film_radius(w, mu, rho);
@@ -309,7 +321,11 @@ mod tests {
         q = p;
         q.groove_factor = 0.6;
         assert_relative_eq!(q.drag(w, mu, rho).torque, 0.6 * d.torque, max_relative = 1e-12);
-        assert_relative_eq!(p.drag(0.5 * w, mu, rho).torque, 0.5 * d.torque, max_relative = 1e-12);
+        assert_relative_eq!(
+            p.drag(0.5 * w, mu, rho).torque,
+            0.5 * d.torque,
+            max_relative = 1e-12
+        );
         // sign of the slip does not matter, zero slip no drag
         assert_eq!(p.drag(-w, mu, rho), d);
         assert_eq!(p.drag(0.0, mu, rho).torque, 0.0);
@@ -326,7 +342,11 @@ mod tests {
         assert_eq!(q.drag(100.0, mu, rho).torque, 0.0);
         q.mist_viscosity_ratio = 0.1;
         let m = q.drag(100.0, mu, rho).torque;
-        assert_relative_eq!(m, 8.0 * couette_torque(0.1 * mu, 100.0, 0.15e-3, 0.075, 0.09), max_relative = 1e-12);
+        assert_relative_eq!(
+            m,
+            8.0 * couette_torque(0.1 * mu, 100.0, 0.15e-3, 0.075, 0.09),
+            max_relative = 1e-12
+        );
     }
 
     #[test]
@@ -339,7 +359,11 @@ mod tests {
             assert_relative_eq!(g_prime(r, ri), fd, max_relative = 1e-5);
         }
         // continuity across the series switch
-        assert_relative_eq!(g(ri * (1.0 + 0.999e-6), ri), g(ri * (1.0 + 1.001e-6), ri), max_relative = 1e-9);
+        assert_relative_eq!(
+            g(ri * (1.0 + 0.999e-6), ri),
+            g(ri * (1.0 + 1.001e-6), ri),
+            max_relative = 1e-9
+        );
     }
 
     #[test]

@@ -199,17 +199,17 @@ pub(crate) mod tests {
     /// (repository sateesh12/impact-of-uc-on-li-ion, advisor/data/transmission/TX_AUTO4_IDEAL.m,
     /// commit e274847; the SR = 1 point is left out, see the module doc).
     pub(crate) const JDM_SR: [f64; 28] = [
-        0.0, 0.01, 0.02, 0.03, 0.04, 0.05, 0.06, 0.07, 0.08, 0.09, 0.10, 0.15, 0.20, 0.25, 0.30, 0.35, 0.40, 0.45,
-        0.50, 0.55, 0.60, 0.65, 0.70, 0.75, 0.80, 0.85, 0.90, 0.95,
+        0.0, 0.01, 0.02, 0.03, 0.04, 0.05, 0.06, 0.07, 0.08, 0.09, 0.10, 0.15, 0.20, 0.25, 0.30, 0.35, 0.40,
+        0.45, 0.50, 0.55, 0.60, 0.65, 0.70, 0.75, 0.80, 0.85, 0.90, 0.95,
     ];
     pub(crate) const JDM_TR: [f64; 28] = [
-        2.0, 1.99, 1.98, 1.96, 1.95, 1.94, 1.93, 1.92, 1.91, 1.89, 1.88, 1.83, 1.77, 1.72, 1.66, 1.60, 1.55, 1.49,
-        1.43, 1.38, 1.32, 1.26, 1.21, 1.15, 1.10, 1.04, 1.0, 1.0,
+        2.0, 1.99, 1.98, 1.96, 1.95, 1.94, 1.93, 1.92, 1.91, 1.89, 1.88, 1.83, 1.77, 1.72, 1.66, 1.60, 1.55,
+        1.49, 1.43, 1.38, 1.32, 1.26, 1.21, 1.15, 1.10, 1.04, 1.0, 1.0,
     ];
     pub(crate) const JDM_RPM_AT_100NM: [f64; 28] = [
-        1444.0, 1443.0, 1446.0, 1448.0, 1450.0, 1453.0, 1456.0, 1459.0, 1461.0, 1464.0, 1466.0, 1480.0, 1494.0,
-        1509.0, 1525.0, 1549.0, 1574.0, 1604.0, 1637.0, 1678.0, 1722.0, 1775.0, 1833.0, 1899.0, 1973.0, 2107.0,
-        2272.0, 3044.0,
+        1444.0, 1443.0, 1446.0, 1448.0, 1450.0, 1453.0, 1456.0, 1459.0, 1461.0, 1464.0, 1466.0, 1480.0,
+        1494.0, 1509.0, 1525.0, 1549.0, 1574.0, 1604.0, 1637.0, 1678.0, 1722.0, 1775.0, 1833.0, 1899.0,
+        1973.0, 2107.0, 2272.0, 3044.0,
     ];
 
     pub(crate) fn jdm() -> Converter {
@@ -234,7 +234,11 @@ pub(crate) mod tests {
             assert_relative_eq!(p.impeller_torque, 100.0, max_relative = 1e-9);
             assert_relative_eq!(p.speed_ratio, JDM_SR[k], max_relative = 1e-9);
             // efficiency SR·TR
-            assert_relative_eq!(p.loss, 100.0 * wp * (1.0 - JDM_SR[k] * JDM_TR[k]), max_relative = 1e-8);
+            assert_relative_eq!(
+                p.loss,
+                100.0 * wp * (1.0 - JDM_SR[k] * JDM_TR[k]),
+                max_relative = 1e-8
+            );
         }
         // Stall at 1444 rpm absorbs 100 N·m and delivers 200 N·m.
         let p = c.open(0.0, 50.0, 1444.0 * RPM);
@@ -254,7 +258,11 @@ pub(crate) mod tests {
         assert_relative_eq!(b.impeller_speed, 2.0 * a.impeller_speed, max_relative = 1e-9);
         assert_relative_eq!(b.loss, 8.0 * a.loss, max_relative = 1e-8);
         // energy: impeller power = turbine power + loss
-        assert_relative_eq!(a.impeller_torque * a.impeller_speed, a.turbine_torque * 100.0 + a.loss, max_relative = 1e-12);
+        assert_relative_eq!(
+            a.impeller_torque * a.impeller_speed,
+            a.turbine_torque * 100.0 + a.loss,
+            max_relative = 1e-12
+        );
         // low demand at speed: SR beyond the table, towards 1, small loss
         let p = c.open(250.0, 5.0, 80.0);
         assert!(p.speed_ratio > 0.95 && p.speed_ratio < 1.0, "{p:?}");
@@ -267,7 +275,11 @@ pub(crate) mod tests {
         let p = c.open(200.0, 0.0, 80.0);
         assert_eq!((p.impeller_speed, p.loss), (200.0, 0.0));
         let p = c.open(0.0, 0.0, 80.0);
-        assert_relative_eq!(p.loss, (80.0f64 / c.k.at(0.0)).powi(2) * 80.0, max_relative = 1e-12);
+        assert_relative_eq!(
+            p.loss,
+            (80.0f64 / c.k.at(0.0)).powi(2) * 80.0,
+            max_relative = 1e-12
+        );
         // lock-up with slip
         let l = locked(200.0, 150.0, 30.0 * RPM);
         assert_relative_eq!(l.loss, 150.0 * 30.0 * RPM, max_relative = 1e-12);

@@ -91,7 +91,11 @@ mod tests {
         let p = pump(16.0, 15.0, 0.9, 0.85).point(2000.0 * RPM, 0.0);
         assert_relative_eq!(p.torque, 16.0 * 15.0 / (20.0 * PI * 0.85), max_relative = 1e-12);
         // P[kW] = T·n/9549
-        assert_relative_eq!(p.power / 1e3, p.torque * 2000.0 / 9549.296_585_513_72, max_relative = 1e-9);
+        assert_relative_eq!(
+            p.power / 1e3,
+            p.torque * 2000.0 / 9549.296_585_513_72,
+            max_relative = 1e-9
+        );
     }
 
     #[test]
@@ -99,11 +103,31 @@ mod tests {
         let base = pump(16.0, 10.0, 0.9, 0.8);
         let a = base.point(1000.0 * RPM, 50.0);
         // power ∝ speed, ∝ pressure, ∝ displacement, ∝ 1/η_hm; flow ∝ η_v·speed
-        assert_relative_eq!(base.point(2000.0 * RPM, 50.0).power, 2.0 * a.power, max_relative = 1e-12);
-        assert_relative_eq!(pump(16.0, 20.0, 0.9, 0.8).point(1000.0 * RPM, 50.0).power, 2.0 * a.power, max_relative = 1e-12);
-        assert_relative_eq!(pump(32.0, 10.0, 0.9, 0.8).point(1000.0 * RPM, 50.0).power, 2.0 * a.power, max_relative = 1e-12);
-        assert_relative_eq!(pump(16.0, 10.0, 0.9, 0.4).point(1000.0 * RPM, 50.0).power, 2.0 * a.power, max_relative = 1e-12);
-        assert_relative_eq!(pump(16.0, 10.0, 0.45, 0.8).point(1000.0 * RPM, 50.0).flow, 0.5 * a.flow, max_relative = 1e-12);
+        assert_relative_eq!(
+            base.point(2000.0 * RPM, 50.0).power,
+            2.0 * a.power,
+            max_relative = 1e-12
+        );
+        assert_relative_eq!(
+            pump(16.0, 20.0, 0.9, 0.8).point(1000.0 * RPM, 50.0).power,
+            2.0 * a.power,
+            max_relative = 1e-12
+        );
+        assert_relative_eq!(
+            pump(32.0, 10.0, 0.9, 0.8).point(1000.0 * RPM, 50.0).power,
+            2.0 * a.power,
+            max_relative = 1e-12
+        );
+        assert_relative_eq!(
+            pump(16.0, 10.0, 0.9, 0.4).point(1000.0 * RPM, 50.0).power,
+            2.0 * a.power,
+            max_relative = 1e-12
+        );
+        assert_relative_eq!(
+            pump(16.0, 10.0, 0.45, 0.8).point(1000.0 * RPM, 50.0).flow,
+            0.5 * a.flow,
+            max_relative = 1e-12
+        );
         assert_eq!(base.point(0.0, 50.0).power, 0.0);
         assert_eq!(base.point(-1000.0 * RPM, 50.0), a);
         // the line pressure follows the torque table
