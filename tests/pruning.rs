@@ -220,7 +220,10 @@ fn per_source_energies_equal_the_sum_of_item_energies() {
     )
     .unwrap();
     let full = Scene::compile(&gb).unwrap();
-    assert_eq!(lean.n_states(), lean.nodes() + 3 + 1);
+    assert_eq!(
+        lean.n_states(),
+        lean.nodes() + geartherm::model::source::N_SOURCES + 1
+    );
     assert_eq!(full.n_states(), full.nodes() + full.items() + 1);
     assert!(lean.skipped.iter().any(|s| s.what == "energy of each loss item"));
     let opts = TransientOptions {
