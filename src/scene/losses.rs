@@ -140,6 +140,8 @@ pub struct SampleTerms {
     /// Per sliding entry: loss at η = 1 Pa·s for this sample's torque and speed (W,
     /// multiplicity included); unused for entries without a power law.
     slide_unit: Vec<f64>,
+    /// Per bearing: the load- and speed-dependent terms of this sample.
+    bearing: Vec<crate::physics::losses::bearings::LoadTerms>,
     /// Samples prepared.
     pub prepared: usize,
 }
@@ -169,6 +171,8 @@ pub struct LossScene {
     slide: Vec<SlideEntry>,
     states: Vec<StateFactors>,
     mixture_density: f64,
+    /// Bearings and seals.
+    elements: super::element_losses::ElementLosses,
 }
 
 /// A loss model could not be built for a part of the model.
@@ -467,6 +471,14 @@ impl LossScene {
             .collect();
 
         let mixture_density = models.pocketing.map_or(0.0, |p| p.mixture_density);
+        let elements = super::element_losses::ElementLosses::compile(
+            gb,
+            &|si| usage.needed(si),
+            &|what, why| usage.idle(what, why),
+            needs.evaluate_all,
+            &mut items,
+            &mut skipped,
+        );
         Ok(LossScene {
             items,
             skipped,
@@ -475,6 +487,7 @@ impl LossScene {
             slide,
             states,
             mixture_density,
+            elements,
         })
     }
 
@@ -496,6 +509,8 @@ impl LossScene {
         for (e, f) in self.slide.iter().zip(&st.slide) {
             out[e.item] = sliding(e, f, op.input_torque, op.input_speed, op.oil.mu, op.oil.rho);
         }
+        self.elements
+            .evaluate(op.state, op.input_speed, op.input_torque, &op.oil, None, out);
     }
 
     /// Empty per-sample terms for this scene (allocates once).
@@ -503,6 +518,7 @@ impl LossScene {
         SampleTerms {
             key: None,
             slide_unit: vec![0.0; self.slide.len()],
+            bearing: vec![Default::default(); self.elements.bearings()],
             prepared: 0,
         }
     }
@@ -529,6 +545,7 @@ impl LossScene {
                 };
             }
         }
+        self.elements.prepare(state, w, t, &mut terms.bearing);
         terms.key = Some(key);
         terms.prepared += 1;
     }
@@ -555,6 +572,14 @@ impl LossScene {
                 None => sliding(e, f, op.input_torque, op.input_speed, op.oil.mu, op.oil.rho),
             };
         }
+        self.elements.evaluate(
+            op.state,
+            op.input_speed,
+            op.input_torque,
+            &op.oil,
+            Some(&terms.bearing),
+            out,
+        );
     }
 
     /// Churning and pocketing at `op` into `out`.

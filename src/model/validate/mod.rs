@@ -16,6 +16,7 @@ use super::source::Source;
 use super::thermal::{validate_thermal, GearInfo, LossItemNames, ThermalNetwork};
 use crate::cycle::{GearTable as RatioTable, Vehicle, VehicleSpec};
 
+mod bearings;
 mod common;
 mod gears;
 mod geometry;
@@ -123,6 +124,7 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
     let sound = problems.len() == structure_start;
     let (train, gear_states) = shift::validate_gear_states(&ctx, &elements, fixed_rows, io, sound, problems);
     let (gears, level) = lubrication::validate_lubrication(&ctx, &sets, &meshes, &mounts, problems);
+    let (bearings, seals) = bearings::validate_bearings(&ctx, &gears, &sets, level, problems);
     let lub = &file.lubrication;
     let losses = super::losses::validate_losses(
         &file.losses.clone().unwrap_or_default(),
@@ -132,7 +134,7 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
     let thermal = file
         .thermal
         .as_ref()
-        .and_then(|spec| thermal(spec, &gears, &meshes, problems));
+        .and_then(|spec| thermal(spec, &gears, &meshes, (&bearings, &seals), problems));
     let vehicle = file
         .vehicle
         .as_ref()
@@ -168,6 +170,8 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         losses: losses?,
         thermal,
         vehicle,
+        bearings,
+        seals,
     })
 }
 
@@ -176,6 +180,7 @@ fn thermal(
     spec: &super::thermal::ThermalSpec,
     gears: &[Gear],
     meshes: &[Mesh],
+    (bearings, seals): (&[super::bearings::Bearing], &[super::bearings::Seal]),
     problems: &mut Problems,
 ) -> Option<ThermalNetwork> {
     let infos: Vec<GearInfo<'_>> = gears
@@ -190,6 +195,8 @@ fn thermal(
     names.set(Source::Churning, gears.iter().map(|g| g.name.as_str()));
     names.set(Source::Pocketing, meshes.iter().map(|m| m.name.as_str()));
     names.set(Source::Sliding, meshes.iter().map(|m| m.name.as_str()));
+    names.set(Source::Bearing, bearings.iter().map(|b| b.name.as_str()));
+    names.set(Source::Seal, seals.iter().map(|s| s.name.as_str()));
     validate_thermal(spec, &infos, &names, problems)
 }
 
