@@ -86,7 +86,10 @@ fn at6_has_clutch_drag_pump_and_converter_items_that_heat_the_oil() {
     let ix = |s: Source, n: &str| items.iter().position(|i| i.source == s && i.name == n).unwrap();
     // 3rd = A + B engaged: no drag in A and B, drag in the open C, D, E
     assert_eq!(
-        (work.q[ix(Source::ClutchDrag, "A")], work.q[ix(Source::ClutchDrag, "B")]),
+        (
+            work.q[ix(Source::ClutchDrag, "A")],
+            work.q[ix(Source::ClutchDrag, "B")]
+        ),
         (0.0, 0.0)
     );
     for e in ["C", "D", "E"] {

@@ -87,6 +87,8 @@ pub struct Gear {
     pub centre_height: f64,
     /// Depth of the gear's lowest point below the static oil level, m (≤ 0: not immersed).
     pub immersion: f64,
+    /// Axial position of the face-width centre along its member (planets: along the pin), m.
+    pub position: f64,
 }
 
 impl Gear {
@@ -223,6 +225,10 @@ pub struct Gearbox {
     pub pump: Option<super::automatic::PumpModel>,
     /// The launch device (`[launch]`), if any: torque converter with lock-up.
     pub launch: Option<crate::cycle::LaunchDevice>,
+    /// Rolling bearings (`[[bearings]]`).
+    pub bearings: Vec<super::bearings::Bearing>,
+    /// Shaft seals (`[[seals]]`).
+    pub seals: Vec<super::bearings::Seal>,
 }
 
 impl Gearbox {

@@ -116,6 +116,10 @@ pub struct GearSpecFile {
     /// `true` for an internal (ring) gear.
     #[serde(default)]
     pub internal: bool,
+    /// Axial position of the face-width centre along the member (planets: along the pin), mm
+    /// (default 0; bearing loads use it).
+    #[serde(default)]
+    pub position_mm: Option<f64>,
 }
 
 /// External or internal mesh.
@@ -362,4 +366,10 @@ pub struct ModelFile {
     /// `[launch]`: torque converter between engine and gearbox input (checked by the cycle layer).
     #[serde(default)]
     pub launch: Option<toml::Table>,
+    /// `[[bearings]]`.
+    #[serde(default)]
+    pub bearings: Vec<super::bearings::BearingSpec>,
+    /// `[[seals]]`.
+    #[serde(default)]
+    pub seals: Vec<super::bearings::SealSpec>,
 }

@@ -140,6 +140,8 @@ pub struct SampleTerms {
     /// Per sliding entry: loss at η = 1 Pa·s for this sample's torque and speed (W,
     /// multiplicity included); unused for entries without a power law.
     slide_unit: Vec<f64>,
+    /// Per bearing: the load- and speed-dependent terms of this sample.
+    bearing: Vec<crate::physics::losses::bearings::LoadTerms>,
     /// Samples prepared.
     pub prepared: usize,
     /// Pump and converter values of the sample (they need the vehicle speed too).
@@ -172,6 +174,8 @@ pub struct LossScene {
     states: Vec<StateFactors>,
     mixture_density: f64,
     auto: super::automatic::AutoLosses,
+    /// Bearings and seals.
+    elements: super::element_losses::ElementLosses,
 }
 
 /// A loss model could not be built for a part of the model.
@@ -479,6 +483,14 @@ impl LossScene {
         );
 
         let mixture_density = models.pocketing.map_or(0.0, |p| p.mixture_density);
+        let elements = super::element_losses::ElementLosses::compile(
+            gb,
+            &|si| usage.needed(si),
+            &|what, why| usage.idle(what, why),
+            needs.evaluate_all,
+            &mut items,
+            &mut skipped,
+        );
         Ok(LossScene {
             items,
             skipped,
@@ -488,6 +500,7 @@ impl LossScene {
             states,
             mixture_density,
             auto,
+            elements,
         })
     }
 
@@ -512,6 +525,8 @@ impl LossScene {
         for (e, f) in self.slide.iter().zip(&st.slide) {
             out[e.item] = sliding(e, f, op.input_torque, op.input_speed, op.oil.mu, op.oil.rho);
         }
+        self.elements
+            .evaluate(op.state, op.input_speed, op.input_torque, &op.oil, None, out);
     }
 
     /// Empty per-sample terms for this scene (allocates once).
@@ -519,6 +534,7 @@ impl LossScene {
         SampleTerms {
             key: None,
             slide_unit: vec![0.0; self.slide.len()],
+            bearing: vec![Default::default(); self.elements.bearings()],
             prepared: 0,
             auto: Default::default(),
         }
@@ -560,6 +576,7 @@ impl LossScene {
                 };
             }
         }
+        self.elements.prepare(state, w, t, &mut terms.bearing);
         terms.key = Some(key);
         terms.prepared += 1;
     }
@@ -594,6 +611,14 @@ impl LossScene {
                 None => sliding(e, f, op.input_torque, op.input_speed, op.oil.mu, op.oil.rho),
             };
         }
+        self.elements.evaluate(
+            op.state,
+            op.input_speed,
+            op.input_torque,
+            &op.oil,
+            Some(&terms.bearing),
+            out,
+        );
     }
 
     /// Churning and pocketing at `op` into `out`.

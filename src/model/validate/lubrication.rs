@@ -112,6 +112,7 @@ pub(super) fn validate_lubrication(
             carrier: mounts[gi].1,
             centre_height: h,
             immersion,
+            position: g.position_mm.unwrap_or(0.0) * MM,
         });
     }
 

@@ -16,6 +16,7 @@ use super::source::Source;
 use super::thermal::{validate_thermal, GearInfo, LossItemNames, ThermalNetwork};
 use crate::cycle::{GearTable as RatioTable, Vehicle, VehicleSpec};
 
+mod bearings;
 mod common;
 mod gears;
 mod geometry;
@@ -123,6 +124,7 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
     let sound = problems.len() == structure_start;
     let (train, gear_states) = shift::validate_gear_states(&ctx, &elements, fixed_rows, io, sound, problems);
     let (gears, level) = lubrication::validate_lubrication(&ctx, &sets, &meshes, &mounts, problems);
+    let (bearings, seals) = bearings::validate_bearings(&ctx, &gears, &sets, level, problems);
     let lub = &file.lubrication;
     let losses = super::losses::validate_losses(
         &file.losses.clone().unwrap_or_default(),
@@ -148,7 +150,7 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
     let thermal = file
         .thermal
         .as_ref()
-        .and_then(|spec| thermal(spec, &gears, &meshes, &auto_names, problems));
+        .and_then(|spec| thermal(spec, &gears, &meshes, (&bearings, &seals), &auto_names, problems));
     let vehicle = file
         .vehicle
         .as_ref()
@@ -187,6 +189,8 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         clutch_packs,
         pump,
         launch,
+        bearings,
+        seals,
     })
 }
 
@@ -202,6 +206,7 @@ fn thermal(
     spec: &super::thermal::ThermalSpec,
     gears: &[Gear],
     meshes: &[Mesh],
+    (bearings, seals): (&[super::bearings::Bearing], &[super::bearings::Seal]),
     auto: &AutoNames<'_>,
     problems: &mut Problems,
 ) -> Option<ThermalNetwork> {
@@ -220,6 +225,8 @@ fn thermal(
     names.set(Source::ClutchDrag, auto.packs.iter().copied());
     names.set(Source::Pump, auto.pump.then_some("pump"));
     names.set(Source::Converter, auto.converter.then_some("converter"));
+    names.set(Source::Bearing, bearings.iter().map(|b| b.name.as_str()));
+    names.set(Source::Seal, seals.iter().map(|s| s.name.as_str()));
     validate_thermal(spec, &infos, &names, problems)
 }
 
