@@ -51,7 +51,7 @@ def toml_value(v: Any) -> str:
     if isinstance(v, float):
         if not math.isfinite(v):
             raise ValueError(f"{v!r}: model values must be finite")
-        return repr(v)
+        return repr(float(v))  # float(): numpy's float64 repr is np.float64(...)
     if isinstance(v, str):
         return json.dumps(v)  # a JSON string is a TOML basic string
     if isinstance(v, Mapping):
@@ -66,7 +66,12 @@ def toml_value(v: Any) -> str:
 def _frame(csv_text: str):
     import pandas as pd
 
-    return pd.read_csv(io.StringIO(csv_text), float_precision="round_trip")
+    # Numbers must come back exactly as written (shortest round-trip form): pandas < 3 needs
+    # float_precision="round_trip" for that; from pandas 3 it is the default (and the option is
+    # deprecated).
+    if int(pd.__version__.split(".")[0]) < 3:
+        return pd.read_csv(io.StringIO(csv_text), float_precision="round_trip")
+    return pd.read_csv(io.StringIO(csv_text))
 
 
 class RunResult:
