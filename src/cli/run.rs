@@ -250,11 +250,9 @@ pub fn to_text(o: &RunOutcome) -> String {
     ));
     let e = &s.energy_lost_j;
     t.push_str(&format!(
-        "energy lost: churning {:.1} kJ, pocketing {:.2} kJ, sliding {:.1} kJ, total {:.1} kJ\n",
-        e.churning / 1e3,
-        e.pocketing / 1e3,
-        e.sliding / 1e3,
-        e.total / 1e3
+        "energy lost: {}, total {:.1} kJ\n",
+        e.text(1e-3, "kJ", 2),
+        e.sum() / 1e3
     ));
     t.push_str(&format!(
         "energy balance residual {:.2e} (relative); mean efficiency {}\n",

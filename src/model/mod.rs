@@ -3,6 +3,7 @@
 //! `load` is the only place that reads a model file; everything below works on the checked
 //! [`Gearbox`].
 
+pub mod bearings;
 pub mod catalogue;
 pub mod gearbox;
 pub mod losses;
@@ -10,6 +11,7 @@ pub mod overrides;
 pub mod parse;
 pub mod problems;
 pub mod schema;
+pub mod source;
 pub mod thermal;
 pub mod validate;
 

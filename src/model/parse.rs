@@ -25,6 +25,8 @@ const SECTIONS: &[&str] = &[
     "losses",
     "thermal",
     "vehicle",
+    "bearings",
+    "seals",
 ];
 
 /// Line and column (1-based) of a byte offset.
@@ -191,6 +193,8 @@ pub fn parse_table(mut table: Table, problems: &mut Problems) -> Option<ModelFil
     let losses = section::<LossesSpec>(&mut table, "losses", false, problems);
     let thermal = section::<super::thermal::ThermalSpec>(&mut table, "thermal", false, problems);
     let vehicle = section::<Table>(&mut table, "vehicle", false, problems);
+    let bearings = array::<super::bearings::BearingSpec>(&mut table, "bearings", false, problems);
+    let seals = array::<super::bearings::SealSpec>(&mut table, "seals", false, problems);
     if problems.len() > before || !problems.is_empty() {
         return None;
     }
@@ -208,6 +212,8 @@ pub fn parse_table(mut table: Table, problems: &mut Problems) -> Option<ModelFil
         losses,
         thermal,
         vehicle,
+        bearings,
+        seals,
     })
 }
 
