@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use geartherm::cycle::DriveCycle;
 use geartherm::cycle::Schedule;
-use geartherm::model::{self, Gearbox};
+use geartherm::model::Gearbox;
 use geartherm::physics::oil::KELVIN_OFFSET;
 use geartherm::report::files::write_all_atomic;
 use geartherm::report::run::{summary, timeseries_csv, Summary};
@@ -20,6 +20,8 @@ use super::{check_range, invalid, Failure, EXIT_IO, EXIT_NUMERICAL};
 pub struct RunArgs {
     /// Model file (TOML).
     pub model: PathBuf,
+    #[command(flatten)]
+    pub set: super::SetArgs,
     /// Bundled cycle name (wltc, nedc, ftp75, udds, hwfet, us06, artemis_urban, artemis_road,
     /// artemis_motorway130, artemis_motorway150) or a CSV file (vehicle or rig cycle).
     #[arg(long, default_value = "wltc")]
@@ -99,7 +101,7 @@ fn stem(p: &Path) -> String {
 /// Load, check, schedule the cycle, compile the scene for it: everything that can fail with
 /// exit 1.
 pub fn prepare(args: &RunArgs) -> Result<Prepared, Failure> {
-    let gb = model::load(&args.model)?;
+    let gb = args.set.load(&args.model)?;
     let method = Method::parse(&args.solver).ok_or_else(|| {
         invalid(format!(
             "--solver {}: unknown; allowed: {}",

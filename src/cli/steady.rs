@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use geartherm::model::{self, Gearbox};
+use geartherm::model::Gearbox;
 use geartherm::physics::oil::KELVIN_OFFSET;
 use geartherm::report::sources::SourceValues;
 use geartherm::scene::{Inputs, Needs, Scene};
@@ -20,6 +20,8 @@ use super::{check_range, invalid, print_json, state_index, Failure, EXIT_IO, EXI
 pub struct PointArgs {
     /// Model file (TOML).
     pub model: PathBuf,
+    #[command(flatten)]
+    pub set: super::SetArgs,
     /// Gear state name.
     #[arg(long)]
     pub gear: String,
@@ -70,7 +72,7 @@ pub struct MapArgs {
 }
 
 fn prepare(p: &PointArgs) -> Result<(Gearbox, Scene, usize), Failure> {
-    let gb = model::load(&p.model)?;
+    let gb = p.set.load(&p.model)?;
     let state = state_index(&gb, &p.gear)?;
     check_range("--vehicle-speed-kmh", p.vehicle_speed_kmh, 0.0, 400.0, " km/h")?;
     // Scene pruning: only this gear state's active items are compiled.
