@@ -93,7 +93,7 @@ fn at6_has_clutch_drag_pump_and_converter_items_that_heat_the_oil() {
         (0.0, 0.0)
     );
     for e in ["C", "D", "E"] {
-        assert!(q(Source::ClutchDrag, e) > 0.0, "{e}");
+        assert!(work.q[ix(Source::ClutchDrag, e)] > 0.0, "{e}");
     }
     // locked converter (3rd above 35 km/h) with 20 rpm slip: 100 N·m × 20 rpm
     assert!((work.q[ix(Source::Converter, "converter")] - 100.0 * 20.0 * RPM).abs() < 1e-9);

@@ -182,3 +182,12 @@ def test_study_commands_are_stand_alone_cli_lines():
     cmds = geartherm.study_commands(AT6, PARAMS, JOB, PLAN)
     assert len(cmds) == 8
     assert all(c.startswith("geartherm run ") and "--set" in c for c in cmds)
+
+
+def test_a_subset_of_cases_gives_the_same_rows(local_study):
+    sub = geartherm.study(AT6, PARAMS, JOB, PLAN, cases=[5, 1])
+    assert list(sub.case) == [local_study.case[5], local_study.case[1]]
+    for k, i in enumerate([5, 1]):
+        assert sub.iloc[k].equals(local_study.iloc[i]) or all(
+            (a == b) or (a != a and b != b) for a, b in zip(sub.iloc[k], local_study.iloc[i])
+        )

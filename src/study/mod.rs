@@ -68,6 +68,9 @@ pub struct Case {
     pub job: usize,
 }
 
+/// The overrides of a sample and the parameter values shown in its row.
+pub type SampleOverrides = (Vec<Override>, Vec<(String, ParamValue)>);
+
 /// Files of one case (name, contents), written under `cases/<id>/` when asked.
 pub type CaseFiles = Vec<(String, Vec<u8>)>;
 
@@ -298,7 +301,7 @@ impl Study {
     }
 
     /// The overrides of a sample, and the parameter values actually used (integers rounded).
-    pub fn overrides(&self, sample: usize) -> Result<(Vec<Override>, Vec<(String, ParamValue)>), String> {
+    pub fn overrides(&self, sample: usize) -> Result<SampleOverrides, String> {
         let mut ovs = Vec::new();
         let mut used = Vec::new();
         for (j, v) in self.samples[sample].iter().enumerate() {

@@ -268,6 +268,7 @@ def study(
     client=None,
     batch_size: Optional[int] = None,
     threads_per_task: Optional[int] = None,
+    cases: Optional[Sequence[int]] = None,
     name: str = "study",
 ):
     """Run a design study and return one DataFrame row per case.
@@ -283,7 +284,8 @@ def study(
     ``distributed.Client`` the cases are cut into batches (``batch_size``, default about four
     batches per worker thread), each batch is one task carrying the study and the model *text*
     (nothing is read from the workers' disks), and the rows are gathered into one DataFrame in
-    case order. A failing case is a row with ``status`` ``failed`` or ``invalid`` and its
+    case order. ``cases`` restricts the run to these positions in the study's case list (e.g.
+    to rerun failed cases, or to share a plan between machines). A failing case is a row with ``status`` ``failed`` or ``invalid`` and its
     ``message``; it does not stop the study.
     """
     if not isinstance(model, Model):
@@ -293,14 +295,15 @@ def study(
     spec_json = json.dumps(_spec(parameters, job, sampling, name))
     text, file = model.text, model._m.file
     _, ids = _native.study_cases(spec_json, text, file)
-    n = len(ids)
+    todo = list(range(len(ids))) if cases is None else [int(i) for i in cases]
+    n = len(todo)
     if client is None:
-        rows = json.loads(_native.run_cases(spec_json, text, file, list(range(n)), threads_per_task))
+        rows = json.loads(_native.run_cases(spec_json, text, file, todo, threads_per_task))
     else:
         if batch_size is None:
             workers = sum(client.nthreads().values()) or 1
             batch_size = max(1, math.ceil(n / (4 * workers)))
-        batches = [list(range(i, min(i + batch_size, n))) for i in range(0, n, batch_size)]
+        batches = [todo[i : i + batch_size] for i in range(0, n, batch_size)]
         futures = client.map(
             _batch,
             [spec_json] * len(batches),

@@ -202,25 +202,26 @@ impl ClutchPack {
 
 /// dg/dr = (2r·ln x − (r² − r_i²)/r)/ln²x, x = r/r_i (limit 2r_i at r = r_i).
 fn g_prime(r: f64, ri: f64) -> f64 {
-    let x = r / ri;
-    let e = x - 1.0;
+    let d = r - ri;
+    let e = d / ri;
     if e < 1e-6 {
         // series: r_i·(2 + 2e/3)
         return ri * (2.0 + 2.0 * e / 3.0);
     }
-    let l = x.ln();
-    (2.0 * r * l - (r * r - ri * ri) / r) / (l * l)
+    let l = e.ln_1p();
+    (2.0 * r * l - d * (r + ri) / r) / (l * l)
 }
 
-/// (r² − r_i²)/ln(r/r_i), with its limit 2r_i² at r = r_i.
+/// (r² − r_i²)/ln(r/r_i), with its limit 2r_i² at r = r_i (ln_1p and (r − r_i)(r + r_i) keep
+/// it accurate near r_i).
 fn g(r: f64, ri: f64) -> f64 {
-    let x = r / ri;
-    let e = x - 1.0;
+    let d = r - ri;
+    let e = d / ri;
     if e < 1e-6 {
         // series: r_i²·(2 + 2e + e²/3)
         return ri * ri * (2.0 + e * (2.0 + e / 3.0));
     }
-    (r * r - ri * ri) / x.ln()
+    d * (r + ri) / e.ln_1p()
 }
 
 #[cfg(test)]
@@ -354,15 +355,15 @@ mod tests {
         let ri = 0.075;
         for x in [1.0 + 1e-8, 1.0 + 5e-7, 1.0 + 2e-6, 1.01, 1.1, 1.2, 1.5] {
             let r = ri * x;
-            let h = 1e-7 * r;
+            let h = 1e-6 * r;
             let fd = (g(r + h, ri) - g(r - h, ri)) / (2.0 * h);
             assert_relative_eq!(g_prime(r, ri), fd, max_relative = 1e-5);
         }
         // continuity across the series switch
         assert_relative_eq!(
-            g(ri * (1.0 + 0.999e-6), ri),
-            g(ri * (1.0 + 1.001e-6), ri),
-            max_relative = 1e-9
+            g(ri * (1.0 + 0.999_999e-6), ri),
+            g(ri * (1.0 + 1.000_001e-6), ri),
+            max_relative = 1e-10
         );
     }
 
