@@ -84,7 +84,8 @@ fn at6_has_clutch_drag_pump_and_converter_items_that_heat_the_oil() {
     let y = scene.initial_state(Some(40.0 + KELVIN_OFFSET));
     scene.evaluate_losses(&y, &mut work);
     let ix = |s: Source, n: &str| items.iter().position(|i| i.source == s && i.name == n).unwrap();
-    // 3rd = A + B engaged: no drag in A and B, drag in the open C, D, E
+    // 3rd = A + B engaged: no drag in A and B; the open C, D, E drag as their packs at their
+    // slips (|large sun|, |Ravigneaux carrier|, |input − carrier| per unit input speed)
     assert_eq!(
         (
             work.q[ix(Source::ClutchDrag, "A")],
@@ -92,9 +93,23 @@ fn at6_has_clutch_drag_pump_and_converter_items_that_heat_the_oil() {
         ),
         (0.0, 0.0)
     );
-    for e in ["C", "D", "E"] {
-        assert!(work.q[ix(Source::ClutchDrag, e)] > 0.0, "{e}");
+    let oil = scene.thermal.oil_properties(40.0 + KELVIN_OFFSET);
+    let w3 = &gb.gear_states[third].solution.speeds;
+    let m = |n: &str| gb.members.iter().position(|x| x.name == n).unwrap();
+    for (e, slip) in [
+        ("C", w3[m("large_sun")].abs()),
+        ("D", w3[m("rav_carrier")].abs()),
+        ("E", (w3[m("input")] - w3[m("rav_carrier")]).abs()),
+    ] {
+        let pack = gb.clutch_packs.iter().find(|c| c.name == e).unwrap().pack;
+        let want = pack.drag(slip * 2000.0 * RPM, oil.mu, oil.rho).power;
+        assert!(
+            (work.q[ix(Source::ClutchDrag, e)] - want).abs() <= 1e-12 * want.max(1.0),
+            "{e}"
+        );
     }
+    // E slips 685 rpm: below its critical slip at 40 °C, a full film
+    assert!(work.q[ix(Source::ClutchDrag, "E")] > 10.0);
     // locked converter (3rd above 35 km/h) with 20 rpm slip: 100 N·m × 20 rpm
     assert!((work.q[ix(Source::Converter, "converter")] - 100.0 * 20.0 * RPM).abs() < 1e-9);
     // pump at engine speed 2020 rpm and the line pressure of 100 N·m (7 bar)

@@ -109,8 +109,9 @@ pub fn schedule(
 
 /// [`schedule`] with an optional launch device: each interval's engine side (speed, torque,
 /// converter slip loss, lock-up) follows from its gearbox input (= turbine) speed and torque
-/// (rig cycles too: their input is the turbine side, and with vehicle speed 0 the lock-up never
-/// closes). Without a launch device the engine side is the gearbox input.
+/// (rig cycles too: their input is the turbine side; their vehicle speed for the lock-up follows
+/// from the input speed when a vehicle is given, else it is 0 and the lock-up stays open).
+/// Without a launch device the engine side is the gearbox input.
 pub fn schedule_with_launch(
     cycle: &DriveCycle,
     vehicle: Option<&Vehicle>,
@@ -248,7 +249,14 @@ pub fn schedule_with_launch(
     }
     if let Some(l) = launch {
         for i in &mut out {
-            let e = l.engine_side(i.gear, i.vehicle_speed, i.input_speed, i.input_torque);
+            // Rig cycles have no vehicle speed; with a vehicle it follows from the input speed.
+            let v = match (cycle.kind, vehicle) {
+                (CycleKind::Rig, Some(veh)) => {
+                    veh.wheel_radius * i.input_speed / (veh.final_drive_ratio * gears.states[i.gear].1.abs())
+                }
+                _ => i.vehicle_speed,
+            };
+            let e = l.engine_side(i.gear, v, i.input_speed, i.input_torque);
             i.engine_speed = e.impeller_speed;
             i.engine_torque = e.impeller_torque;
             i.converter_loss = e.loss;

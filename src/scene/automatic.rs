@@ -39,6 +39,9 @@ pub struct AutoLosses {
     pump: Option<PumpEntry>,
     converter: Option<usize>,
     launch: Option<LaunchDevice>,
+    /// Per gear state: vehicle speed per unit input speed (m/s per rad/s), when the model has a
+    /// vehicle: r_w/(i_final·|ratio|).
+    vehicle_per_input: Option<Vec<f64>>,
 }
 
 /// Per-sample values of the temperature-independent items.
@@ -128,16 +131,25 @@ impl AutoLosses {
             });
             items.len() - 1
         });
+        let vehicle_per_input = gb.vehicle.as_ref().map(|v| {
+            gb.gear_states
+                .iter()
+                .map(|s| v.wheel_radius / (v.final_drive_ratio * s.ratio().abs()))
+                .collect()
+        });
         AutoLosses {
             packs,
             pump,
             converter,
             launch: gb.launch.clone(),
+            vehicle_per_input,
         }
     }
 
     /// Values of the temperature-independent items for gear state `state`, input speed (rad/s),
-    /// input torque (N·m) and vehicle speed (m/s). No allocation.
+    /// input torque (N·m) and vehicle speed (m/s; used only when the model has no vehicle —
+    /// with one, the vehicle speed follows from the input speed and the gear, exactly the cycle
+    /// interval's mean speed, and single operating points get it too). No allocation.
     pub fn sample(
         &self,
         state: usize,
@@ -146,9 +158,13 @@ impl AutoLosses {
         vehicle_speed: f64,
     ) -> AutoSample {
         let w = input_speed.abs();
+        let v = self
+            .vehicle_per_input
+            .as_ref()
+            .map_or(vehicle_speed, |k| k[state] * w);
         let (engine_speed, converter) = match &self.launch {
             Some(l) => {
-                let e = l.engine_side(state, vehicle_speed, w, input_torque);
+                let e = l.engine_side(state, v, w, input_torque);
                 (e.impeller_speed, e.loss)
             }
             None => (w, 0.0),
@@ -195,7 +211,8 @@ impl AutoLosses {
 
     /// Write every item's loss (W) into `out`: pack drags at `oil`, pump and converter from the
     /// prepared sample `s` if it is for `state`, `input_speed` and `input_torque`, else computed
-    /// with vehicle speed 0 (lock-up open). No allocation.
+    /// (vehicle speed from the input speed when the model has a vehicle, else 0: lock-up open).
+    /// No allocation.
     pub fn evaluate(
         &self,
         state: usize,
