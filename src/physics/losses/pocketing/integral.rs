@@ -27,6 +27,8 @@
 //! width b/n instead would either give K_helical = K_spur exactly (if each slice gets the share
 //! w/b of the face exits — the phase shift drops out of a full-passage integral) or a loss
 //! falling like 1/n² (if every slice had two full face exits), so that reading was rejected.
+//! The scene uses the model's exact n → ∞ limit (`k_helical_continuum`): one spur pocket history
+//! shifted in phase, integrated over the face width in closed form from the Chebyshev tables.
 
 use super::areas::PocketFamily;
 use super::PocketingError;
@@ -471,7 +473,7 @@ impl PocketTable {
         let s = dphi_dy.abs();
         let h = 0.5 * b * s;
         // below this shift the helical and spur values agree to round-off (K − K_spur ~ h²)
-        if !(h > 1e-7 * self.phi_max) {
+        if h.is_nan() || h <= 1e-7 * self.phi_max {
             return (self.k_spur(cd), 0);
         }
         let evals = std::cell::Cell::new(0usize);
