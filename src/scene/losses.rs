@@ -14,9 +14,9 @@ use crate::physics::losses::sliding::friction::Schlenk;
 use crate::physics::losses::sliding::{OilState as SlideOil, PowerLaw, SlidingMesh, SlidingMeshInput};
 use crate::physics::oil::OilProperties;
 
-/// Transverse slices of a helical pocket (physics default 64, itself within 0.3 % of 256; 48 raises
-/// the AT6 pocketing loss by 0.5 % and compiles the scene in 0.39 s instead of 0.65 s).
-pub const HELIX_POCKET_SLICES: usize = 48;
+/// Helical pockets: the exact infinitely-many-slices limit of the connected-slice model (one spur
+/// pocket history summed over phases; was 48 discrete slices, 0.5 % off and 0.35 s per AT6 compile).
+pub const HELIX_POCKET_SLICES: Option<usize> = None;
 
 pub use crate::model::source::{PerSource, Source, N_SOURCES};
 
@@ -292,6 +292,8 @@ impl LossScene {
 
         // Pocketing: external meshes.
         let mut pocket_meshes = Vec::new();
+        // meshes of identical geometry (and C_d) share one K computation
+        let mut pocket_built: Vec<(PocketMeshInput, PocketingMesh)> = Vec::new();
         match &models.pocketing {
             None => skipped.push(Skipped {
                 what: "pocketing".into(),
@@ -335,10 +337,19 @@ impl LossScene {
                         discharge_coefficient: opt.discharge_coefficient,
                         helix_slices: HELIX_POCKET_SLICES,
                     };
-                    let model = PocketingMesh::with_options(&input, &popts).map_err(|e| SceneError {
-                        what: format!("pocketing of mesh {}", m.name),
-                        why: e.to_string(),
-                    })?;
+                    let model = match pocket_built.iter().find(|(i, pm)| {
+                        *i == input && pm.discharge_coefficient() == popts.discharge_coefficient
+                    }) {
+                        Some((_, pm)) => *pm,
+                        None => {
+                            let pm = PocketingMesh::with_options(&input, &popts).map_err(|e| SceneError {
+                                what: format!("pocketing of mesh {}", m.name),
+                                why: e.to_string(),
+                            })?;
+                            pocket_built.push((input, pm));
+                            pm
+                        }
+                    };
                     // Height of the pitch point; planets orbit, so the mesh point sweeps a circle.
                     let (wet, _) = mesh_zone(gb, mi);
                     pocket.push(PocketEntry {
