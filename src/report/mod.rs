@@ -5,3 +5,4 @@ pub mod losses;
 pub mod map;
 pub mod plots;
 pub mod run;
+pub mod validation;

@@ -167,6 +167,11 @@ impl ChangenetGear {
         omega.abs() * self.rp * self.b / oil.kinematic_viscosity
     }
 
+    /// Re_c limits of the low and the high law (the bridge band between them).
+    pub fn bridge(&self) -> (f64, f64) {
+        (self.re_c_low, self.re_c_high)
+    }
+
     /// Moment coefficient C_m (low law, log-linear bridge, high law; see the module docs).
     pub fn moment_coefficient(&self, omega: f64, oil: &OilState) -> f64 {
         let w = omega.abs();

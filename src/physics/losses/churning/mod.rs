@@ -22,6 +22,7 @@
 
 pub mod changenet;
 pub mod immersion;
+pub mod ranges;
 pub mod seetharaman;
 pub mod stavytskyi;
 
@@ -30,6 +31,7 @@ use std::fmt;
 
 pub use changenet::{ChangenetGear, ChangenetParams};
 pub use immersion::Immersion;
+pub use ranges::RangeCheck;
 pub use seetharaman::{CavityTerm, SeetharamanGear, SeetharamanParams};
 pub use stavytskyi::{InletGap, StavytskyiGear, StavytskyiParams};
 
