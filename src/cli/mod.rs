@@ -38,11 +38,15 @@ pub enum Command {
     Check {
         /// Model file (TOML).
         model: PathBuf,
+        #[command(flatten)]
+        set: SetArgs,
     },
     /// Gear states with ratios, member speeds per unit input, meshes with contact ratios, immersion.
     Info {
         /// Model file (TOML).
         model: PathBuf,
+        #[command(flatten)]
+        set: SetArgs,
         /// Print one JSON document instead of tables.
         #[arg(long)]
         json: bool,
@@ -51,6 +55,8 @@ pub enum Command {
     Losses {
         /// Model file (TOML).
         model: PathBuf,
+        #[command(flatten)]
+        set: SetArgs,
         /// Gear state name (e.g. 3, R).
         #[arg(long)]
         gear: String,
@@ -85,6 +91,27 @@ pub enum Command {
         /// Directory with timeseries.csv + summary.json, map.csv, or bench.csv.
         dir: PathBuf,
     },
+}
+
+/// `--set PATH=VALUE`: model values overridden by key path (repeatable).
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct SetArgs {
+    /// Override a model value by its key path, e.g. --set lubrication.oil_level_mm=55,
+    /// --set 'oil.catalogue="fva_3a"', --set 'thermal.links["housing-air"].area_m2=0.9'
+    /// (the value is TOML; repeatable; checked like the file).
+    #[arg(long = "set", value_name = "PATH=VALUE", value_parser = parse_set)]
+    pub set: Vec<model::Override>,
+}
+
+fn parse_set(s: &str) -> Result<model::Override, String> {
+    s.parse()
+}
+
+impl SetArgs {
+    /// Load the model file with these overrides.
+    pub fn load(&self, path: &std::path::Path) -> Result<Gearbox, ModelError> {
+        model::load_with(path, &self.set)
+    }
 }
 
 /// A failure with its exit code and message.
@@ -141,8 +168,8 @@ fn check_range(flag: &str, v: f64, lo: f64, hi: f64, unit: &str) -> Result<(), F
 /// Run a parsed command line.
 pub fn run(cli: Cli) -> Result<(), Failure> {
     match cli.command {
-        Command::Check { model } => {
-            let gb = model::load(&model)?;
+        Command::Check { model, set } => {
+            let gb = set.load(&model)?;
             println!(
                 "{}: ok ({} gears, {} meshes, {} gear states)",
                 model.display(),
@@ -152,8 +179,8 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             );
             Ok(())
         }
-        Command::Info { model, json } => {
-            let gb = model::load(&model)?;
+        Command::Info { model, set, json } => {
+            let gb = set.load(&model)?;
             let report = info::info(&gb);
             if json {
                 print_json(&report)?;
@@ -164,13 +191,14 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         }
         Command::Losses {
             model,
+            set,
             gear,
             speed_rpm,
             torque_nm,
             oil_temp_c,
             json,
         } => {
-            let gb = model::load(&model)?;
+            let gb = set.load(&model)?;
             let state = state_index(&gb, &gear)?;
             check_range("--speed-rpm", speed_rpm, 0.0, 50_000.0, " rpm")?;
             check_range("--torque-nm", torque_nm, 0.0, 1e6, " N m")?;

@@ -88,6 +88,8 @@ pub struct Gear {
     pub centre_height: f64,
     /// Depth of the gear's lowest point below the static oil level, m (≤ 0: not immersed).
     pub immersion: f64,
+    /// Axial position of the face-width centre along its member (planets: along the pin), m.
+    pub position: f64,
 }
 
 impl Gear {
@@ -218,6 +220,10 @@ pub struct Gearbox {
     pub thermal: Option<super::thermal::ThermalNetwork>,
     /// The vehicle (`[vehicle]`), if the model has one.
     pub vehicle: Option<crate::cycle::Vehicle>,
+    /// Rolling bearings (`[[bearings]]`).
+    pub bearings: Vec<super::bearings::Bearing>,
+    /// Shaft seals (`[[seals]]`).
+    pub seals: Vec<super::bearings::Seal>,
 }
 
 impl Gearbox {

@@ -25,6 +25,8 @@ const SECTIONS: &[&str] = &[
     "losses",
     "thermal",
     "vehicle",
+    "bearings",
+    "seals",
 ];
 
 /// Line and column (1-based) of a byte offset.
@@ -140,8 +142,14 @@ fn array<T: DeserializeOwned>(
 /// Parse model-file text. Returns the file when every section deserialized, else `None`, with all
 /// problems found recorded in `problems`.
 pub fn parse_model(text: &str, problems: &mut Problems) -> Option<ModelFile> {
-    let mut table: Table = match text.parse() {
-        Ok(t) => t,
+    let table = parse_document(text, problems)?;
+    parse_table(table, problems)
+}
+
+/// Parse model-file text as a plain TOML document (syntax errors carry line and column).
+pub fn parse_document(text: &str, problems: &mut Problems) -> Option<Table> {
+    match text.parse() {
+        Ok(t) => Some(t),
         Err(e) => {
             let e: toml::de::Error = e;
             let where_ = e
@@ -152,9 +160,13 @@ pub fn parse_model(text: &str, problems: &mut Problems) -> Option<ModelFile> {
                 })
                 .unwrap_or_else(|| "unknown position".into());
             problems.push("", "", format!("TOML syntax error at {where_}: {}", e.message()));
-            return None;
+            None
         }
-    };
+    }
+}
+
+/// A parsed TOML document → [`ModelFile`], every section's type errors reported at once.
+pub fn parse_table(mut table: Table, problems: &mut Problems) -> Option<ModelFile> {
     let unknown: Vec<String> = table
         .keys()
         .filter(|k| !SECTIONS.contains(&k.as_str()))
@@ -181,6 +193,8 @@ pub fn parse_model(text: &str, problems: &mut Problems) -> Option<ModelFile> {
     let losses = section::<LossesSpec>(&mut table, "losses", false, problems);
     let thermal = section::<super::thermal::ThermalSpec>(&mut table, "thermal", false, problems);
     let vehicle = section::<Table>(&mut table, "vehicle", false, problems);
+    let bearings = array::<super::bearings::BearingSpec>(&mut table, "bearings", false, problems);
+    let seals = array::<super::bearings::SealSpec>(&mut table, "seals", false, problems);
     if problems.len() > before || !problems.is_empty() {
         return None;
     }
@@ -198,6 +212,8 @@ pub fn parse_model(text: &str, problems: &mut Problems) -> Option<ModelFile> {
         losses,
         thermal,
         vehicle,
+        bearings,
+        seals,
     })
 }
 

@@ -116,6 +116,10 @@ pub struct GearSpecFile {
     /// `true` for an internal (ring) gear.
     #[serde(default)]
     pub internal: bool,
+    /// Axial position of the face-width centre along the member (planets: along the pin), mm
+    /// (default 0; bearing loads use it).
+    #[serde(default)]
+    pub position_mm: Option<f64>,
 }
 
 /// External or internal mesh.
@@ -356,4 +360,10 @@ pub struct ModelFile {
     /// `[vehicle]` (reserved: vehicle and shift strategy; read by the transient issue).
     #[serde(default)]
     pub vehicle: Option<toml::Table>,
+    /// `[[bearings]]`.
+    #[serde(default)]
+    pub bearings: Vec<super::bearings::BearingSpec>,
+    /// `[[seals]]`.
+    #[serde(default)]
+    pub seals: Vec<super::bearings::SealSpec>,
 }

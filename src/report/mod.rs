@@ -5,4 +5,5 @@ pub mod losses;
 pub mod map;
 pub mod plots;
 pub mod run;
+pub mod sources;
 pub mod validation;

@@ -9,7 +9,9 @@ use std::fmt::Write as _;
 use serde::Serialize;
 
 use crate::physics::oil::KELVIN_OFFSET;
-use crate::scene::{OperatingPoint, RangeLog, RangeWarning, Scene, Skipped, Source};
+use crate::scene::{sum_by_source, OperatingPoint, RangeLog, RangeWarning, Scene, Skipped, Source, N_SOURCES};
+
+use super::sources::{csv_columns, SourceValues};
 use crate::solve::transient::{energy_balance, Stats, Trajectory};
 
 /// Per-row context the solver does not know: vehicle speed, gear name, input speed and torque,
@@ -59,19 +61,6 @@ pub struct NodeInfo {
     pub boundary: bool,
 }
 
-/// Energy per source, J.
-#[derive(Debug, Clone, Copy, Serialize, Default)]
-pub struct SourceEnergy {
-    /// Churning.
-    pub churning: f64,
-    /// Pocketing.
-    pub pocketing: f64,
-    /// Sliding.
-    pub sliding: f64,
-    /// Sum.
-    pub total: f64,
-}
-
 /// `summary.json`.
 #[derive(Debug, Clone, Serialize)]
 pub struct Summary {
@@ -93,8 +82,8 @@ pub struct Summary {
     pub stats: Stats,
     /// Cycle duration, s.
     pub duration_s: f64,
-    /// Energy lost per source, J.
-    pub energy_lost_j: SourceEnergy,
+    /// Energy lost per source, J (`<source>` keys and `total`).
+    pub energy_lost_j: SourceValues,
     /// Energy per item, J.
     pub energy_by_item_j: Vec<ItemEnergy>,
     /// Heat stored in the nodes, J.
@@ -155,16 +144,11 @@ pub fn summary(
     let n = scene.nodes();
     let last = traj.states.last().cloned().unwrap_or_default();
     let by = if last.is_empty() {
-        [0.0; 3]
+        [0.0; N_SOURCES]
     } else {
         scene.loss_energy_by_source(&last)
     };
-    let mut per_source = SourceEnergy {
-        churning: by[0],
-        pocketing: by[1],
-        sliding: by[2],
-        ..SourceEnergy::default()
-    };
+    let per_source = SourceValues::new(by, "", true);
     // Per-item energies only when the scene integrates them (an output that can be switched off).
     let items = scene
         .losses
@@ -182,7 +166,6 @@ pub fn summary(
             })
         })
         .collect();
-    per_source.total = per_source.churning + per_source.pocketing + per_source.sliding;
     let bal = energy_balance(scene, traj);
 
     // Output energy and the loss energy while driving (positive output power), by the trapezoidal
@@ -279,15 +262,12 @@ pub fn timeseries_csv(
     for it in &scene.losses.items {
         let _ = write!(s, ",loss_{}_{}_w", it.source.as_str(), it.name);
     }
-    s.push_str(",churning_w,pocketing_w,sliding_w,total_loss_w,efficiency\n");
+    let _ = writeln!(s, ",{},total_loss_w,efficiency", csv_columns());
     for (k, t) in traj.times.iter().enumerate() {
         let r = &rows[k];
         let y = &traj.states[k];
-        let mut by = [0.0; 3];
-        for (q, it) in traj.losses[k].iter().zip(&scene.losses.items) {
-            by[it.source.index()] += q;
-        }
-        let total = by[0] + by[1] + by[2];
+        let by = sum_by_source(&scene.losses.items, &traj.losses[k]);
+        let total: f64 = by.iter().sum();
         // The input supplies the transmitted torque and the losses: T_in = T_out/i + P_loss/ω_in
         // (physics spec §9). The loss items themselves are evaluated at the loss-free torque
         // (docs/physics.md §10, "Mesh loads").
@@ -314,7 +294,10 @@ pub fn timeseries_csv(
             s.push(',');
             num(&mut s, *q);
         }
-        let _ = write!(s, ",{},{},{},{}", by[0], by[1], by[2], total);
+        for v in by {
+            let _ = write!(s, ",{v}");
+        }
+        let _ = write!(s, ",{total}");
         s.push(',');
         if r.output_power_w > 0.0 {
             num(&mut s, r.output_power_w / (r.output_power_w + total));

@@ -18,36 +18,32 @@ use crate::physics::oil::OilProperties;
 /// the AT6 pocketing loss by 0.5 % and compiles the scene in 0.39 s instead of 0.65 s).
 pub const HELIX_POCKET_SLICES: usize = 48;
 
-/// Heat source kind.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Source {
-    /// Oil drag on an immersed gear (load-independent).
-    Churning,
-    /// Oil squeezed out of closing tooth spaces (load-independent).
-    Pocketing,
-    /// Mesh friction (load-dependent).
-    Sliding,
+pub use crate::model::source::{PerSource, Source, N_SOURCES};
+
+/// Sum the values of `items` (W or J, one per item) per source.
+pub fn sum_by_source(items: &[LossItem], values: &[f64]) -> PerSource {
+    let mut by = [0.0; N_SOURCES];
+    for (it, v) in items.iter().zip(values) {
+        by[it.source.index()] += v;
+    }
+    by
 }
 
-impl Source {
-    /// Position in per-source arrays `[churning, pocketing, sliding]`.
-    pub fn index(self) -> usize {
-        match self {
-            Source::Churning => 0,
-            Source::Pocketing => 1,
-            Source::Sliding => 2,
-        }
-    }
-
-    /// Lower-case name.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Source::Churning => "churning",
-            Source::Pocketing => "pocketing",
-            Source::Sliding => "sliding",
-        }
-    }
+/// Where a loss item's heat goes unless a `[[thermal.heat]]` rule says otherwise.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DefaultHeat {
+    /// The oil node (churning, pocketing).
+    Oil,
+    /// The body nodes of the item's gears with their fractions (sliding); a gear in no node
+    /// heats the oil.
+    Gears,
+    /// The body node of a gear on a member (a bearing or seal on that member: its shaft node),
+    /// else the oil node. Gear indices with fractions.
+    Member(Vec<(usize, f64)>),
+    /// Named thermal nodes with fractions, as the model says (e.g. a bearing's shaft and
+    /// housing nodes).
+    Nodes(Vec<(String, f64)>),
 }
 
 /// One loss item: what it is, where its heat goes.
@@ -58,8 +54,11 @@ pub struct LossItem {
     /// Gear name (churning) or mesh name (pocketing, sliding).
     pub name: String,
     /// Gears heated and the fraction each receives (sliding: split between the two gears;
-    /// churning and pocketing: the gear(s) concerned, whose heat goes to the oil by default).
+    /// churning and pocketing: the gear(s) concerned, whose heat goes to the oil by default;
+    /// empty for items that are not gears or meshes).
     pub gears: Vec<(usize, f64)>,
+    /// Default heat destination.
+    pub heat: DefaultHeat,
 }
 
 /// A part of the model the scene left out, and why.
@@ -143,6 +142,8 @@ pub struct SampleTerms {
     /// Per sliding entry: loss at η = 1 Pa·s for this sample's torque and speed (W,
     /// multiplicity included); unused for entries without a power law.
     slide_unit: Vec<f64>,
+    /// Per bearing: the load- and speed-dependent terms of this sample.
+    bearing: Vec<crate::physics::losses::bearings::LoadTerms>,
     /// Samples prepared.
     pub prepared: usize,
 }
@@ -177,6 +178,8 @@ pub struct LossScene {
     pub warnings: Vec<super::ranges::RangeWarning>,
     /// Gear-state names (for reports that know a state by name).
     pub state_names: Vec<String>,
+    /// Bearings and seals.
+    elements: super::element_losses::ElementLosses,
 }
 
 /// A loss model could not be built for a part of the model.
@@ -288,6 +291,7 @@ impl LossScene {
                         source: Source::Churning,
                         name: g.name.clone(),
                         gears: vec![(gi, 1.0)],
+                        heat: DefaultHeat::Oil,
                     });
                 }
             }
@@ -367,6 +371,7 @@ impl LossScene {
                         source: Source::Pocketing,
                         name: m.name.clone(),
                         gears: vec![(m.gear1, 0.5), (m.gear2, 0.5)],
+                        heat: DefaultHeat::Oil,
                     });
                 }
             }
@@ -447,6 +452,7 @@ impl LossScene {
                     source: Source::Sliding,
                     name: m.name.clone(),
                     gears: vec![(m.gear1, f1), (m.gear2, 1.0 - f1)],
+                    heat: DefaultHeat::Gears,
                 });
             }
         }
@@ -487,6 +493,14 @@ impl LossScene {
             .collect();
 
         let mixture_density = models.pocketing.and_then(|p| p.mixture_density);
+        let elements = super::element_losses::ElementLosses::compile(
+            gb,
+            &|si| usage.needed(si),
+            &|what, why| usage.idle(what, why),
+            needs.evaluate_all,
+            &mut items,
+            &mut skipped,
+        );
         Ok(LossScene {
             items,
             skipped,
@@ -497,6 +511,7 @@ impl LossScene {
             mixture_density,
             warnings,
             state_names: gb.gear_states.iter().map(|s| s.name.clone()).collect(),
+            elements,
         })
     }
 
@@ -518,6 +533,8 @@ impl LossScene {
         for (e, f) in self.slide.iter().zip(&st.slide) {
             out[e.item] = sliding(e, f, op.input_torque, op.input_speed, op.oil.mu, op.oil.rho);
         }
+        self.elements
+            .evaluate(op.state, op.input_speed, op.input_torque, &op.oil, None, out);
     }
 
     /// Empty per-sample terms for this scene (allocates once).
@@ -525,6 +542,7 @@ impl LossScene {
         SampleTerms {
             key: None,
             slide_unit: vec![0.0; self.slide.len()],
+            bearing: vec![Default::default(); self.elements.bearings()],
             prepared: 0,
         }
     }
@@ -551,6 +569,7 @@ impl LossScene {
                 };
             }
         }
+        self.elements.prepare(state, w, t, &mut terms.bearing);
         terms.key = Some(key);
         terms.prepared += 1;
     }
@@ -577,6 +596,14 @@ impl LossScene {
                 None => sliding(e, f, op.input_torque, op.input_speed, op.oil.mu, op.oil.rho),
             };
         }
+        self.elements.evaluate(
+            op.state,
+            op.input_speed,
+            op.input_torque,
+            &op.oil,
+            Some(&terms.bearing),
+            out,
+        );
     }
 
     /// Every churning model with its loss item and its gear's speed (rad/s) in gear state

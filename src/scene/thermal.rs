@@ -15,7 +15,7 @@ use crate::physics::thermal::{
     HTable, AIR_50C, OIL_CONDUCTIVITY, OIL_SPECIFIC_HEAT,
 };
 
-use super::losses::{LossItem, Source};
+use super::losses::{DefaultHeat, LossItem};
 
 /// Endpoint of a compiled link: a state (capacity node) or a boundary.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -256,9 +256,22 @@ impl ThermalScene {
                     });
                 let mut to: Vec<(usize, f64)> = match rule {
                     Some(r) => r.to.clone(),
-                    None => match it.source {
-                        Source::Churning | Source::Pocketing => vec![(net.oil_node, 1.0)],
-                        Source::Sliding => it.gears.iter().map(|&(g, f)| (body(g), f)).collect(),
+                    None => match &it.heat {
+                        DefaultHeat::Oil => vec![(net.oil_node, 1.0)],
+                        DefaultHeat::Gears => it.gears.iter().map(|&(g, f)| (body(g), f)).collect(),
+                        DefaultHeat::Member(gears) => gears.iter().map(|&(g, f)| (body(g), f)).collect(),
+                        DefaultHeat::Nodes(nodes) => nodes
+                            .iter()
+                            .map(|(name, f)| {
+                                (
+                                    net.nodes
+                                        .iter()
+                                        .position(|x| &x.name == name)
+                                        .unwrap_or(net.oil_node),
+                                    *f,
+                                )
+                            })
+                            .collect(),
                     },
                 };
                 // Merge duplicates (both gears in one node).
