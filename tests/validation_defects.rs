@@ -61,7 +61,9 @@ fn at6_planet_churning_is_the_orbit_average_of_every_planet() {
             continue;
         }
         let gi = it.gears[0].0;
-        let Some((r, n)) = planet_orbit(&gb, gi) else { continue };
+        let Some((r, n)) = planet_orbit(&gb, gi) else {
+            continue;
+        };
         let g = churning_gear(&gb, gi);
         let w = speeds[gi].absolute * op.input_speed;
         let m = 3600;
@@ -70,17 +72,31 @@ fn at6_planet_churning_is_the_orbit_average_of_every_planet() {
             let phi = (i as f64 + 0.5) / m as f64 * 2.0 * std::f64::consts::PI;
             let h = g.immersion_depth - r * (1.0 - phi.cos());
             if h > 0.0 {
-                let gh = geartherm::physics::losses::churning::ChurningGear { immersion_depth: h, ..g };
+                let gh = geartherm::physics::losses::churning::ChurningGear {
+                    immersion_depth: h,
+                    ..g
+                };
                 sum += GearChurning::new(&cfg, &gh).unwrap().power(w, &oil).total;
             }
         }
         let expect = f64::from(n) * sum / m as f64;
         let deepest = GearChurning::new(&cfg, &g).unwrap().power(w, &oil).total;
-        println!("{}: {:.3} W (brute force {expect:.3} W; one planet at its deepest {deepest:.3} W)", it.name, out[k]);
-        assert!((out[k] / expect - 1.0).abs() < 0.01, "{}: {} vs {expect}", it.name, out[k]);
+        println!(
+            "{}: {:.3} W (brute force {expect:.3} W; one planet at its deepest {deepest:.3} W)",
+            it.name, out[k]
+        );
+        assert!(
+            (out[k] / expect - 1.0).abs() < 0.01,
+            "{}: {} vs {expect}",
+            it.name,
+            out[k]
+        );
         // Before the fix the item was one planet at its deepest immersion all the time.
         assert!((out[k] / deepest - 1.0).abs() > 0.2, "{}", it.name);
-        let (_, share) = (r, geartherm::scene::planet_churning::wet_share(g.immersion_depth, r));
+        let (_, share) = (
+            r,
+            geartherm::scene::planet_churning::wet_share(g.immersion_depth, r),
+        );
         assert!(out[k] < f64::from(n) * share * deepest, "{}", it.name);
         checked += 1;
     }
@@ -92,7 +108,11 @@ fn fzg_low_oil(extra_losses: &str) -> PathBuf {
     let text = std::fs::read_to_string(root().join("models/fzg_c.toml")).unwrap();
     let text = text.replace("oil_level_mm = 150.0", "oil_level_mm = 120.0");
     let text = format!("{text}\n[losses]\n{extra_losses}\n");
-    let dir = std::env::temp_dir().join(format!("gt_defects_{}_{}", std::process::id(), extra_losses.len()));
+    let dir = std::env::temp_dir().join(format!(
+        "gt_defects_{}_{}",
+        std::process::id(),
+        extra_losses.len()
+    ));
     std::fs::create_dir_all(&dir).unwrap();
     let p = dir.join("fzg_low.toml");
     std::fs::write(&p, text).unwrap();
@@ -104,8 +124,14 @@ fn a_mesh_above_the_oil_is_reported_not_charged_with_an_unsourced_density() {
     let gb = geartherm::model::load(&fzg_low_oil("")).unwrap();
     let scene = LossScene::compile(&gb).unwrap();
     assert!(scene.items.iter().all(|it| it.source != Source::Pocketing));
-    assert!(scene.skipped.iter().any(|s| s.what.contains("pocketing") && s.why.contains("unknown")));
-    assert!(scene.warnings.iter().any(|w| w.item.contains("pocketing") && w.seen.contains("100 %")));
+    assert!(scene
+        .skipped
+        .iter()
+        .any(|s| s.what.contains("pocketing") && s.why.contains("unknown")));
+    assert!(scene
+        .warnings
+        .iter()
+        .any(|w| w.item.contains("pocketing") && w.seen.contains("100 %")));
     // A density given in the model file is a documented choice: the item is counted.
     let gb = geartherm::model::load(&fzg_low_oil("pocketing_mixture_density_kg_m3 = 10.0")).unwrap();
     let scene = LossScene::compile(&gb).unwrap();
@@ -117,7 +143,16 @@ fn a_mesh_above_the_oil_is_reported_not_charged_with_an_unsourced_density() {
 fn changenet_in_its_bridge_band_is_warned_in_json_and_on_stderr() {
     // FZG wheel at 80 °C: Re_c 6000–9000 at 1370–2050 rpm, i.e. pinion 2055–3075 rpm.
     let out = Command::new(env!("CARGO_BIN_EXE_geartherm"))
-        .args(["losses", "models/fzg_c.toml", "--gear", "1", "--speed-rpm", "2500", "--torque-nm", "100"])
+        .args([
+            "losses",
+            "models/fzg_c.toml",
+            "--gear",
+            "1",
+            "--speed-rpm",
+            "2500",
+            "--torque-nm",
+            "100",
+        ])
         .args(["--oil-temp-c", "80", "--json"])
         .current_dir(root())
         .output()
@@ -125,17 +160,34 @@ fn changenet_in_its_bridge_band_is_warned_in_json_and_on_stderr() {
     assert!(out.status.success());
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let w = v["warnings"].as_array().unwrap();
-    assert!(w.iter().any(|x| x["item"] == "churning of gear wheel" && x["range"].as_str().unwrap().contains("6000–9000")));
+    assert!(
+        w.iter()
+            .any(|x| x["item"] == "churning of gear wheel"
+                && x["range"].as_str().unwrap().contains("6000–9000"))
+    );
     let err = String::from_utf8_lossy(&out.stderr);
     let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("warning:")).collect();
     assert_eq!(lines.len(), w.len(), "{err}");
     // Below the band: no range warning for the wheel.
     let out = Command::new(env!("CARGO_BIN_EXE_geartherm"))
-        .args(["losses", "models/fzg_c.toml", "--gear", "1", "--speed-rpm", "1000", "--torque-nm", "100"])
+        .args([
+            "losses",
+            "models/fzg_c.toml",
+            "--gear",
+            "1",
+            "--speed-rpm",
+            "1000",
+            "--torque-nm",
+            "100",
+        ])
         .args(["--oil-temp-c", "80", "--json"])
         .current_dir(root())
         .output()
         .unwrap();
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert!(v["warnings"].as_array().unwrap().iter().all(|x| x["item"] != "churning of gear wheel"));
+    assert!(v["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|x| x["item"] != "churning of gear wheel"));
 }

@@ -30,12 +30,21 @@ pub fn validate(a: &ValidateArgs) -> Result<(), Failure> {
     }
     let rows = run_all(&a.dir).map_err(|e| invalid(format!("validate: {e}")))?;
     if rows.is_empty() {
-        return Err(invalid(format!("validate: {}: no case.toml found", a.dir.display())));
+        return Err(invalid(format!(
+            "validate: {}: no case.toml found",
+            a.dir.display()
+        )));
     }
-    if let Some(r) = rows.iter().find(|r| !(r.predicted.is_finite() && r.relative_error.is_finite())) {
+    if let Some(r) = rows
+        .iter()
+        .find(|r| !(r.predicted.is_finite() && r.relative_error.is_finite()))
+    {
         return Err(Failure {
             code: super::EXIT_NUMERICAL,
-            message: format!("validate: case {} point {} model {}: non-finite result", r.case, r.point, r.model),
+            message: format!(
+                "validate: case {} point {} model {}: non-finite result",
+                r.case, r.point, r.model
+            ),
         });
     }
     let sum = summarise(&rows);

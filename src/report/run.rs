@@ -9,7 +9,9 @@ use std::fmt::Write as _;
 use serde::Serialize;
 
 use crate::physics::oil::KELVIN_OFFSET;
-use crate::scene::{sum_by_source, OperatingPoint, RangeLog, RangeWarning, Scene, Skipped, Source, N_SOURCES};
+use crate::scene::{
+    sum_by_source, OperatingPoint, RangeLog, RangeWarning, Scene, Skipped, Source, N_SOURCES,
+};
 
 use super::sources::{csv_columns, SourceValues};
 use crate::solve::transient::{energy_balance, Stats, Trajectory};

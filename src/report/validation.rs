@@ -23,7 +23,8 @@ fn quote(s: &str) -> String {
 
 /// `validation.csv`: one row per case, point and model choice.
 pub fn rows_csv(rows: &[Row]) -> String {
-    let mut s = String::from("case,point,model,quantity,speed_rpm,predicted,reference,kind,relative_error,source\n");
+    let mut s =
+        String::from("case,point,model,quantity,speed_rpm,predicted,reference,kind,relative_error,source\n");
     for r in rows {
         let _ = writeln!(
             s,

@@ -286,6 +286,18 @@ impl LossScene {
                         item: items.len(),
                         models,
                     });
+                    if cfg.model == crate::physics::losses::churning::ChurningModel::Stavytskyi {
+                        let out = crate::physics::losses::churning::ranges::stavytskyi_geometry(
+                            &churning_gear(gb, gi),
+                        );
+                        if !out.is_empty() {
+                            warnings.push(super::ranges::RangeWarning {
+                                item: format!("churning of gear {}", g.name),
+                                range: crate::physics::losses::churning::ranges::STAVYTSKYI_TESTED.into(),
+                                seen: out.join(", "),
+                            });
+                        }
+                    }
                     churn_gears.push(gi);
                     items.push(LossItem {
                         source: Source::Churning,
@@ -638,7 +650,8 @@ impl LossScene {
         for (e, k) in self.pocket.iter().zip(&st.pocket_speed) {
             // The share above the oil pumps an unknown density unless the model file gives one;
             // it is then not counted (and reported in `warnings`).
-            let rho = e.wet_fraction * op.oil.rho + (1.0 - e.wet_fraction) * self.mixture_density.unwrap_or(0.0);
+            let rho =
+                e.wet_fraction * op.oil.rho + (1.0 - e.wet_fraction) * self.mixture_density.unwrap_or(0.0);
             out[e.item] = e.multiplicity * e.model.power(k * w_in, rho);
         }
     }

@@ -107,8 +107,18 @@ mod tests {
     use crate::physics::losses::churning::OilState;
 
     fn planet(h: f64) -> ChurningGear {
-        ChurningGear::from_basic_rack(17, 1.75e-3, 20f64.to_radians(), 20f64.to_radians(), 0.0, 20e-3, h, None, None)
-            .unwrap()
+        ChurningGear::from_basic_rack(
+            17,
+            1.75e-3,
+            20f64.to_radians(),
+            20f64.to_radians(),
+            0.0,
+            20e-3,
+            h,
+            None,
+            None,
+        )
+        .unwrap()
     }
 
     /// Brute-force orbit average: midpoint rule over 20 000 carrier angles.
@@ -143,12 +153,21 @@ mod tests {
             for (h_max, r) in [(0.008, 0.0475), (0.02, 0.05)] {
                 let q: f64 = orbit_samples(h_max, r, planet(0.0).tip_radius, 4)
                     .iter()
-                    .map(|&(h, wt)| wt * GearChurning::new(&cfg, &planet(h)).unwrap().power(300.0, &oil).total)
+                    .map(|&(h, wt)| {
+                        wt * GearChurning::new(&cfg, &planet(h))
+                            .unwrap()
+                            .power(300.0, &oil)
+                            .total
+                    })
                     .sum();
                 let b = brute(&cfg, h_max, r, 4, 300.0, &oil);
                 assert!((q / b - 1.0).abs() < 0.01, "{model:?} h {h_max}: {q} vs {b}");
                 // far below N × the churning at the deepest position
-                let deepest = 4.0 * GearChurning::new(&cfg, &planet(h_max)).unwrap().power(300.0, &oil).total;
+                let deepest = 4.0
+                    * GearChurning::new(&cfg, &planet(h_max))
+                        .unwrap()
+                        .power(300.0, &oil)
+                        .total;
                 assert!(q < 0.5 * deepest, "{q} {deepest}");
             }
         }

@@ -94,7 +94,11 @@ impl RangeLog {
                     format!("{} {}–{}", c.quantity(), sig(lo), sig(hi))
                 };
                 out.push(RangeWarning {
-                    item: format!("{} of gear {}", scene.items[k].source.as_str(), scene.items[k].name),
+                    item: format!(
+                        "{} of gear {}",
+                        scene.items[k].source.as_str(),
+                        scene.items[k].name
+                    ),
                     range: c.range().into(),
                     seen: format!("{span} at {n} of {} points", self.points),
                 });

@@ -36,12 +36,12 @@ fn legend(models: &[String], cases: &[String]) -> Vec<LegendEntry> {
         .enumerate()
         .map(|(i, m)| LegendEntry::new(m.clone(), Swatch::Fill(style::series_colour(i))))
         .collect();
-    e.extend(
-        cases
-            .iter()
-            .enumerate()
-            .map(|(i, c)| LegendEntry::new(c.clone(), Swatch::MarkerLine(RGBColor(90, 90, 90), Marker::nth(i)))),
-    );
+    e.extend(cases.iter().enumerate().map(|(i, c)| {
+        LegendEntry::new(
+            c.clone(),
+            Swatch::MarkerLine(RGBColor(90, 90, 90), Marker::nth(i)),
+        )
+    }));
     e
 }
 
@@ -52,10 +52,16 @@ pub fn draw_parity(root: &Canvas, rows: &[&Row], title: &str) -> DrawResult {
     let (plot, side) = root.split_horizontally(w - 420);
     let rows: Vec<&Row> = rows.iter().copied().filter(|r| r.kind != Kind::Trend).collect();
     if rows.is_empty() {
-        style::draw_note_centre(&plot, "no reference values")?;
+        style::draw_note_centre(
+            &plot,
+            "no reference values in watts (trend checks only: see validation.csv)",
+        )?;
         return Ok(());
     }
-    let vals = rows.iter().flat_map(|r| [r.predicted, r.reference]).filter(|v| *v > 0.0);
+    let vals = rows
+        .iter()
+        .flat_map(|r| [r.predicted, r.reference])
+        .filter(|v| *v > 0.0);
     let lo = vals.clone().fold(f64::INFINITY, f64::min) / 1.5;
     let hi = vals.fold(0.0, f64::max) * 1.5;
     let mut ch = ChartBuilder::on(&plot)
@@ -64,6 +70,11 @@ pub fn draw_parity(root: &Canvas, rows: &[&Row], title: &str) -> DrawResult {
         .y_label_area_size(100)
         .build_cartesian_2d((lo..hi).log_scale(), (lo..hi).log_scale())?;
     ch.configure_mesh()
+        .x_labels(8)
+        .y_labels(8)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.0}"))
+        .light_line_style(WHITE)
         .x_desc("reference, W")
         .y_desc("geartherm, W")
         .label_style(style::text(22))
@@ -75,7 +86,12 @@ pub fn draw_parity(root: &Canvas, rows: &[&Row], title: &str) -> DrawResult {
         ch.draw_series(LineSeries::new(line(f), c.stroke_width(1)))?;
     }
     for f in [1.2, 0.8] {
-        ch.draw_series(DashedLineSeries::new(line(f), 8, 6, RGBColor(160, 160, 160).stroke_width(1)))?;
+        ch.draw_series(DashedLineSeries::new(
+            line(f),
+            8,
+            6,
+            RGBColor(160, 160, 160).stroke_width(1),
+        ))?;
     }
     let (ms, cs) = (models(&rows), cases(&rows));
     for r in &rows {
@@ -83,11 +99,23 @@ pub fn draw_parity(root: &Canvas, rows: &[&Row], title: &str) -> DrawResult {
         let k = cs.iter().position(|c| *c == r.case).unwrap_or(0);
         let (x, y) = ch.backend_coord(&(r.reference, r.predicted));
         let (bx, by) = plot.get_base_pixel();
-        style::draw_marker_px(&plot, (x - bx, y - by), Marker::nth(k), 7, style::series_colour(i).filled())?;
+        style::draw_marker_px(
+            &plot,
+            (x - bx, y - by),
+            Marker::nth(k),
+            7,
+            style::series_colour(i).filled(),
+        )?;
     }
     let mut entries = legend(&ms, &cs);
-    entries.push(LegendEntry::new("±10 %", Swatch::Line(RGBColor(120, 120, 120), 1)));
-    entries.push(LegendEntry::new("±20 %", Swatch::Dashed(RGBColor(160, 160, 160), 1)));
+    entries.push(LegendEntry::new(
+        "±10 %",
+        Swatch::Line(RGBColor(120, 120, 120), 1),
+    ));
+    entries.push(LegendEntry::new(
+        "±20 %",
+        Swatch::Dashed(RGBColor(160, 160, 160), 1),
+    ));
     style::draw_legend_column(&side, Some("model / case"), &entries, 40)?;
     Ok(())
 }
@@ -99,7 +127,10 @@ pub fn draw_error_vs_speed(root: &Canvas, rows: &[&Row], title: &str) -> DrawRes
     let (plot, side) = root.split_horizontally(w - 420);
     let rows: Vec<&Row> = rows.iter().copied().filter(|r| r.kind != Kind::Trend).collect();
     if rows.is_empty() {
-        style::draw_note_centre(&plot, "no reference values")?;
+        style::draw_note_centre(
+            &plot,
+            "no reference values in watts (trend checks only: see validation.csv)",
+        )?;
         return Ok(());
     }
     let (x0, x1) = style::padded_range(rows.iter().map(|r| r.speed_rpm), 0.05);
@@ -120,7 +151,10 @@ pub fn draw_error_vs_speed(root: &Canvas, rows: &[&Row], title: &str) -> DrawRes
         .draw()?;
     ch.draw_series(LineSeries::new(vec![(x0, 0.0), (x1, 0.0)], BLACK.stroke_width(2)))?;
     for v in [10.0, -10.0] {
-        ch.draw_series(LineSeries::new(vec![(x0, v), (x1, v)], RGBColor(120, 120, 120).stroke_width(1)))?;
+        ch.draw_series(LineSeries::new(
+            vec![(x0, v), (x1, v)],
+            RGBColor(120, 120, 120).stroke_width(1),
+        ))?;
     }
     for v in [20.0, -20.0] {
         ch.draw_series(DashedLineSeries::new(
@@ -136,7 +170,13 @@ pub fn draw_error_vs_speed(root: &Canvas, rows: &[&Row], title: &str) -> DrawRes
         let k = cs.iter().position(|c| *c == r.case).unwrap_or(0);
         let (x, y) = ch.backend_coord(&(r.speed_rpm, 100.0 * r.relative_error));
         let (bx, by) = plot.get_base_pixel();
-        style::draw_marker_px(&plot, (x - bx, y - by), Marker::nth(k), 7, style::series_colour(i).filled())?;
+        style::draw_marker_px(
+            &plot,
+            (x - bx, y - by),
+            Marker::nth(k),
+            7,
+            style::series_colour(i).filled(),
+        )?;
     }
     style::draw_legend_column(&side, Some("model / case"), &legend(&ms, &cs), 40)?;
     Ok(())

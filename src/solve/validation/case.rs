@@ -71,27 +71,27 @@ impl Quantity {
         let off = |k: &'static str| (k, s("off"));
         match self {
             Quantity::Sliding => {
-                let det = |f: &'static str, ls: &'static str| {
+                // Every key explicit, so a label means the same whatever the defaults are.
+                let det = |f: &'static str, ls: &'static str, hd: &'static str| {
                     vec![
                         off("churning"),
                         off("pocketing"),
                         ("sliding", s("detailed")),
                         ("friction", s(f)),
                         ("load_sharing", s(ls)),
+                        ("helical_distribution", s(hd)),
                     ]
                 };
-                let uniform_line = {
-                    let mut v = det("schlenk", "uniform");
-                    v.push(("helical_distribution", s("uniform")));
-                    v
-                };
                 vec![
-                    ("iso_tc60", det("iso_tc60", "uniform")),
-                    ("benedict_kelley", det("benedict_kelley", "uniform")),
-                    ("schlenk", det("schlenk", "uniform")),
-                    ("schlenk 33:67", det("schlenk", "33:67")),
-                    ("schlenk ramp", det("schlenk", "ramp")),
-                    ("schlenk uniform line", uniform_line),
+                    ("iso_tc60", det("iso_tc60", "uniform", "uniform")),
+                    ("benedict_kelley", det("benedict_kelley", "uniform", "uniform")),
+                    ("schlenk", det("schlenk", "uniform", "uniform")),
+                    ("schlenk 33:67", det("schlenk", "33:67", "uniform")),
+                    ("schlenk ramp", det("schlenk", "ramp", "uniform")),
+                    (
+                        "schlenk niemann_richer",
+                        det("schlenk", "uniform", "niemann_richer"),
+                    ),
                     (
                         "iso14179",
                         vec![off("churning"), off("pocketing"), ("sliding", s("iso14179"))],
@@ -264,8 +264,11 @@ impl Case {
 
     /// The gearbox with the case's overrides and then `keys` written over `[losses]`.
     pub fn gearbox(&self, keys: &[(&str, toml::Value)]) -> Result<Gearbox, String> {
-        let mut all: Vec<(&str, toml::Value)> =
-            self.overrides.iter().map(|(k, v)| (k.as_str(), v.clone())).collect();
+        let mut all: Vec<(&str, toml::Value)> = self
+            .overrides
+            .iter()
+            .map(|(k, v)| (k.as_str(), v.clone()))
+            .collect();
         all.extend(keys.iter().cloned());
         super::load_with(&self.model_path, &all)
     }

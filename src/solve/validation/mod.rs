@@ -52,7 +52,11 @@ pub enum ValidationError {
     Case { path: PathBuf, msg: String },
     /// The model file (with a choice applied) does not load or compile.
     #[error("{}: model choice {choice}: {msg}", path.display())]
-    Model { path: PathBuf, choice: String, msg: String },
+    Model {
+        path: PathBuf,
+        choice: String,
+        msg: String,
+    },
 }
 
 /// Every case directory under `dir` (those holding a `case.toml`), sorted.
@@ -136,7 +140,15 @@ pub fn run_case(c: &Case) -> Result<Vec<Row>, ValidationError> {
 }
 
 /// The case's quantity (W) at one point.
-fn value(gb: &Gearbox, scene: &LossScene, c: &Case, gear: &str, rpm: f64, torque: f64, temp_c: f64) -> Result<f64, String> {
+fn value(
+    gb: &Gearbox,
+    scene: &LossScene,
+    c: &Case,
+    gear: &str,
+    rpm: f64,
+    torque: f64,
+    temp_c: f64,
+) -> Result<f64, String> {
     let state = gb
         .state_index(gear)
         .ok_or_else(|| format!("gear state \"{gear}\" not in the model"))?;

@@ -49,7 +49,10 @@ pub fn summarise(rows: &[Row]) -> Vec<SummaryRow> {
     }
     keys.into_iter()
         .map(|(case, model)| {
-            let sel: Vec<&Row> = rows.iter().filter(|r| r.case == case && r.model == model).collect();
+            let sel: Vec<&Row> = rows
+                .iter()
+                .filter(|r| r.case == case && r.model == model)
+                .collect();
             let e: Vec<f64> = sel.iter().map(|r| r.relative_error).collect();
             let abs: Vec<f64> = e.iter().map(|x| x.abs()).collect();
             SummaryRow {

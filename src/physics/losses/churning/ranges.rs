@@ -12,7 +12,7 @@
 //! - Seetharaman–Kahraman: face Reynolds number above the laminar–turbulent transition: the mixed
 //!   plate law there is derived (White), not part of seed 000's fitted or tested range.
 
-use super::{GearChurning, OilState};
+use super::{ChurningGear, GearChurning, OilState};
 
 /// One kind of out-of-range use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -63,6 +63,28 @@ impl RangeCheck {
     }
 }
 
+/// The range of the gears Stavytskyi's model was compared with (Blok 1962, seed 001 §3 and
+/// table 1): module 1.5–5 mm, face width 14–24 mm, 20–102 teeth (helix 25°, h/r_a 0.55).
+pub const STAVYTSKYI_TESTED: &str =
+    "Stavytskyi compared with Blok's gears only: module 1.5–5 mm, face width 14–24 mm, 20–102 teeth (seed 001 §3, table 1)";
+
+/// What lies outside [`STAVYTSKYI_TESTED`] for gear `g` (empty when inside).
+pub fn stavytskyi_geometry(g: &ChurningGear) -> Vec<String> {
+    let mut v = Vec::new();
+    let m = g.normal_module * 1e3;
+    if !(1.5..=5.0).contains(&m) {
+        v.push(format!("module {m:.2} mm"));
+    }
+    let b = g.face_width * 1e3;
+    if !(14.0..=24.0).contains(&b) {
+        v.push(format!("face width {b:.1} mm"));
+    }
+    if !(20..=102).contains(&g.teeth) {
+        v.push(format!("{} teeth", g.teeth));
+    }
+    v
+}
+
 impl GearChurning {
     /// The out-of-range use at ω (rad/s) and `oil`, with the value of [`RangeCheck::quantity`];
     /// `None` inside the range (or not immersed, or at rest).
@@ -105,10 +127,24 @@ mod tests {
     }
 
     #[test]
+    fn stavytskyi_geometry_outside_blok_is_listed() {
+        // FZG wheel: m 4.5 mm inside, b 14 mm inside, 24 teeth inside.
+        assert!(stavytskyi_geometry(&fzg_wheel(0.05)).is_empty());
+        let g = ChurningGear {
+            face_width: 40e-3,
+            normal_module: 1e-3,
+            ..fzg_wheel(0.05)
+        };
+        assert_eq!(stavytskyi_geometry(&g).len(), 2);
+    }
+
+    #[test]
     fn changenet_bridge_is_reported_only_inside_the_band() {
         let g = model(ChurningModel::Changenet);
         let oil = oil();
-        let GearChurning::Changenet(c) = g else { unreachable!() };
+        let GearChurning::Changenet(c) = g else {
+            unreachable!()
+        };
         // speed at Re_c = 7500 and at 3000 / 12000
         let w = |re: f64| re / c.critical_reynolds(1.0, &oil);
         let (k, v) = g.out_of_range(w(7500.0), &oil).unwrap();
@@ -123,7 +159,9 @@ mod tests {
     fn stavytskyi_above_the_filling_limit_is_reported() {
         let g = model(ChurningModel::Stavytskyi);
         let oil = oil();
-        let GearChurning::Stavytskyi(s) = g else { unreachable!() };
+        let GearChurning::Stavytskyi(s) = g else {
+            unreachable!()
+        };
         let w0 = s.filling_limit_speed(&oil).unwrap();
         assert!(g.out_of_range(0.9 * w0, &oil).is_none());
         let (k, rpm) = g.out_of_range(1.1 * w0, &oil).unwrap();
@@ -135,7 +173,9 @@ mod tests {
     fn seetharaman_turbulent_faces_are_reported() {
         let g = model(ChurningModel::Seetharaman);
         let oil = oil();
-        let GearChurning::Seetharaman(s) = g else { unreachable!() };
+        let GearChurning::Seetharaman(s) = g else {
+            unreachable!()
+        };
         let w_t = 5e5 / s.face_reynolds(1.0, &oil);
         assert!(g.out_of_range(0.5 * w_t, &oil).is_none());
         assert_eq!(
