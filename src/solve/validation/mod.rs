@@ -165,7 +165,7 @@ fn value(
         .items
         .iter()
         .zip(&out)
-        .filter(|(it, _)| it.source == want && c.item.as_ref().is_none_or(|n| *n == it.name))
+        .filter(|(it, _)| it.source == want && c.item.as_ref().map_or(true, |n| *n == it.name))
         .map(|(_, w)| *w)
         .sum();
     if v.is_finite() {
