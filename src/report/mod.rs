@@ -6,4 +6,5 @@ pub mod map;
 pub mod plots;
 pub mod run;
 pub mod sources;
+pub mod study;
 pub mod validation;

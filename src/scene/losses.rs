@@ -146,6 +146,8 @@ pub struct SampleTerms {
     bearing: Vec<crate::physics::losses::bearings::LoadTerms>,
     /// Samples prepared.
     pub prepared: usize,
+    /// Pump and converter values of the sample (they need the vehicle speed too).
+    pub auto: super::automatic::AutoSample,
 }
 
 /// Operating point of the whole gearbox.
@@ -178,6 +180,7 @@ pub struct LossScene {
     pub warnings: Vec<super::ranges::RangeWarning>,
     /// Gear-state names (for reports that know a state by name).
     pub state_names: Vec<String>,
+    auto: super::automatic::AutoLosses,
     /// Bearings and seals.
     elements: super::element_losses::ElementLosses,
 }
@@ -504,6 +507,15 @@ impl LossScene {
             })
             .collect();
 
+        // The automatic's own parts: open clutch packs, pump, converter.
+        let auto = super::automatic::AutoLosses::compile(
+            gb,
+            &|st| usage.needed(st),
+            needs.evaluate_all,
+            &mut items,
+            &mut skipped,
+        );
+
         let mixture_density = models.pocketing.and_then(|p| p.mixture_density);
         let elements = super::element_losses::ElementLosses::compile(
             gb,
@@ -523,6 +535,7 @@ impl LossScene {
             mixture_density,
             warnings,
             state_names: gb.gear_states.iter().map(|s| s.name.clone()).collect(),
+            auto,
             elements,
         })
     }
@@ -541,6 +554,9 @@ impl LossScene {
     /// full. No allocation.
     pub fn evaluate(&self, op: &OperatingPoint, out: &mut [f64]) {
         self.evaluate_load_independent(op, out);
+        let none = super::automatic::AutoSample::default();
+        self.auto
+            .evaluate(op.state, op.input_speed, op.input_torque, &op.oil, &none, out);
         let st = &self.states[op.state];
         for (e, f) in self.slide.iter().zip(&st.slide) {
             out[e.item] = sliding(e, f, op.input_torque, op.input_speed, op.oil.mu, op.oil.rho);
@@ -556,6 +572,7 @@ impl LossScene {
             slide_unit: vec![0.0; self.slide.len()],
             bearing: vec![Default::default(); self.elements.bearings()],
             prepared: 0,
+            auto: Default::default(),
         }
     }
 
@@ -563,6 +580,20 @@ impl LossScene {
     /// (N·m): each separable sliding loss at η = 1 Pa·s, from its per-state unit value scaled by
     /// two powers. No allocation.
     pub fn prepare(&self, state: usize, input_speed: f64, input_torque: f64, terms: &mut SampleTerms) {
+        self.prepare_at(state, input_speed, input_torque, 0.0, terms);
+    }
+
+    /// [`Self::prepare`] with the vehicle speed (m/s), which the converter's lock-up needs.
+    pub fn prepare_at(
+        &self,
+        state: usize,
+        input_speed: f64,
+        input_torque: f64,
+        vehicle_speed: f64,
+        terms: &mut SampleTerms,
+    ) {
+        self.auto
+            .prepare(state, input_speed, input_torque, vehicle_speed, &mut terms.auto);
         let key = (state, input_speed.to_bits(), input_torque.to_bits());
         if terms.key == Some(key) {
             return;
@@ -594,6 +625,14 @@ impl LossScene {
             return self.evaluate(op, out);
         }
         self.evaluate_load_independent(op, out);
+        self.auto.evaluate(
+            op.state,
+            op.input_speed,
+            op.input_torque,
+            &op.oil,
+            &terms.auto,
+            out,
+        );
         let st = &self.states[op.state];
         let mut memo = (f64::NAN, 0.0);
         for ((e, f), u) in self.slide.iter().zip(&st.slide).zip(&terms.slide_unit) {

@@ -1,7 +1,7 @@
 //! From a gearbox and a drive (or rig) cycle to the solver's input segments and the per-row
 //! inputs of the outputs: the glue between `cycle` and the transient driver.
 
-use crate::cycle::{schedule, CycleError, DriveCycle, GearTable, Schedule};
+use crate::cycle::{schedule_with_launch, CycleError, DriveCycle, GearTable, Schedule};
 use crate::model::Gearbox;
 use crate::report::run::RowInputs;
 use crate::scene::Inputs;
@@ -21,7 +21,7 @@ pub fn gear_table(gb: &Gearbox) -> GearTable {
 
 /// Schedule a cycle on a gearbox and turn it into solver segments.
 pub fn segments(gb: &Gearbox, cycle: &DriveCycle) -> Result<(Schedule, Vec<Segment>), CycleError> {
-    let sched = schedule(cycle, gb.vehicle.as_ref(), &gear_table(gb))?;
+    let sched = schedule_with_launch(cycle, gb.vehicle.as_ref(), &gear_table(gb), gb.launch.as_ref())?;
     let segs = sched
         .intervals
         .iter()
