@@ -330,6 +330,20 @@ impl LossScene {
                         });
                         continue;
                     }
+                    // (Before the idle check: a mesh above the oil is unknown in every state.) Height of the pitch point; planets orbit, so the mesh point sweeps a circle.
+                    let (wet, _) = mesh_zone(gb, mi);
+                    if wet < 1.0 && opt.mixture_density.is_none() {
+                        let w = super::ranges::above_oil_warning(&m.name, wet);
+                        let dry = wet <= 0.0;
+                        warnings.push(w);
+                        if dry {
+                            skipped.push(Skipped {
+                                what: format!("pocketing of mesh {}", m.name),
+                                why: "mesh zone entirely above the oil: pumped density unknown (set [losses] pocketing_mixture_density_kg_m3)".into(),
+                            });
+                            continue;
+                        }
+                    }
                     if !usage.any(|u, st| u.speeds[st][m.gear1].relative != 0.0) {
                         skipped.push(usage.idle(
                             format!("pocketing of mesh {}", m.name),
@@ -361,20 +375,6 @@ impl LossScene {
                         what: format!("pocketing of mesh {}", m.name),
                         why: e.to_string(),
                     })?;
-                    // Height of the pitch point; planets orbit, so the mesh point sweeps a circle.
-                    let (wet, _) = mesh_zone(gb, mi);
-                    if wet < 1.0 && opt.mixture_density.is_none() {
-                        let w = super::ranges::above_oil_warning(&m.name, wet);
-                        let dry = wet <= 0.0;
-                        warnings.push(w);
-                        if dry {
-                            skipped.push(Skipped {
-                                what: format!("pocketing of mesh {}", m.name),
-                                why: "mesh zone entirely above the oil: pumped density unknown (set [losses] pocketing_mixture_density_kg_m3)".into(),
-                            });
-                            continue;
-                        }
-                    }
                     pocket.push(PocketEntry {
                         item: items.len(),
                         model,
