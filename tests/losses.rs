@@ -132,7 +132,7 @@ fn detailed_sliding_agrees_with_the_iso_tr_14179_closed_form_in_magnitude() {
     ] {
         let det = with_losses(
             file,
-            "churning = \"off\"\npocketing = \"off\"\nsliding = \"detailed\"",
+            "churning = \"off\"\npocketing = \"off\"\nsliding = \"detailed\"\nfriction = \"iso_tc60\"\nhelical_distribution = \"niemann_richer\"",
         );
         let iso = with_losses(
             file,

@@ -240,7 +240,7 @@ fn at6_wltc_cold_start_warms_up_with_viscosity_feedback() {
     assert!(bal.relative <= 1e-9);
     assert!(t1 > t0 + 1.0, "oil must warm up");
     // Direction: the warmer oil has the lower viscosity. The ISO TC60 mesh friction rises as the
-    // viscosity falls (μ ∝ η^−0.05), but the bearings' rolling friction falls with it
+    // viscosity falls (μ_mz ∝ η^−0.05 Schlenk, the default; ISO TC60 ∝ η^−0.25), but the bearings' rolling friction falls with it
     // (SKF M_rr ∝ (ν n)^0.6, Palmgren M0 ∝ (ν n)^(2/3)) and, with the AT6's eleven bearings,
     // dominates (docs/physics.md §Bearings): the coupled run loses less energy than the frozen
     // one (−1.5 % over the WLTC).

@@ -9,6 +9,7 @@ mod bench;
 mod run;
 mod steady;
 mod study;
+mod validate;
 
 use geartherm::model::{self, Gearbox, ModelError};
 use geartherm::physics::oil::KELVIN_OFFSET;
@@ -86,6 +87,9 @@ pub enum Command {
     /// Work-precision study: every solver over rtol 1e-3 … 1e-10 against a 1e-12 reference;
     /// writes bench.csv, bench.json and work_precision.png.
     Bench(bench::BenchArgs),
+    /// Every reference case under DIR with every applicable loss model: validation.csv,
+    /// per-source summary, parity and error-vs-speed plots (docs/validation.md).
+    Validate(validate::ValidateArgs),
     /// PNG plots and report.md from an existing output directory (a run, a map or a bench).
     Report {
         /// Directory with timeseries.csv + summary.json, map.csv, or bench.csv.
@@ -211,6 +215,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
                 oil: gb.oil.properties(oil_temp_c + KELVIN_OFFSET),
             };
             let report = losses::losses(&gb, &scene, &op, oil_temp_c);
+            geartherm::scene::ranges::print_warnings(&report.warnings);
             if json {
                 print_json(&report)?;
             } else {
@@ -247,10 +252,12 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         }
         Command::Bench(args) => bench::bench(&args),
         Command::Study(args) => study::study(&args),
+        Command::Validate(args) => validate::validate(&args),
         Command::Steady(args) => steady::steady(&args),
         Command::Map(args) => steady::map(&args),
         Command::Run(args) => {
             let outcome = run::run(&args)?;
+            geartherm::scene::ranges::print_warnings(&outcome.summary.warnings);
             if args.json {
                 print_json(&outcome.summary)?;
             } else {

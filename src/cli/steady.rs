@@ -120,6 +120,7 @@ struct SteadyReport {
     ptc_iterations: usize,
     method: &'static str,
     residual_w: f64,
+    warnings: Vec<geartherm::scene::RangeWarning>,
 }
 
 /// Run `steady`.
@@ -164,7 +165,22 @@ pub fn steady(a: &SteadyArgs) -> Result<(), Failure> {
         ptc_iterations: eq.solution.ptc_iterations,
         method: eq.solution.method,
         residual_w: eq.solution.residual_w,
+        warnings: {
+            let mut log = geartherm::scene::RangeLog::new(&scene.losses);
+            let t_oil = eq.solution.temperatures[scene.thermal.oil];
+            log.check(
+                &scene.losses,
+                &geartherm::scene::OperatingPoint {
+                    state,
+                    input_speed: a.speed_rpm * std::f64::consts::PI / 30.0,
+                    input_torque: a.torque_nm,
+                    oil: scene.thermal.oil_properties(t_oil),
+                },
+            );
+            log.warnings(&scene.losses)
+        },
     };
+    geartherm::scene::ranges::print_warnings(&r.warnings);
     if a.json {
         return print_json(&r);
     }

@@ -14,8 +14,9 @@ use crate::physics::losses::sliding::{friction::Schlenk, SlidingOptions};
 pub struct PocketingOptions {
     /// Discharge coefficient C_d.
     pub discharge_coefficient: f64,
-    /// Density of the oil–air mixture pumped by a mesh above the oil level, kg/m³.
-    pub mixture_density: f64,
+    /// Density pumped by the part of a mesh zone above the oil level, kg/m³; `None` (default):
+    /// unknown, that part is not counted and is reported in `warnings` (docs/validation.md).
+    pub mixture_density: Option<f64>,
 }
 
 /// Sliding-loss model choice.

@@ -284,6 +284,9 @@ pub struct LossesSpec {
     /// Spur load sharing: `uniform` (default), `33:67`, `45:55`, `ramp`.
     #[serde(default)]
     pub load_sharing: Option<String>,
+    /// Line-load distribution of helical meshes: `niemann_richer` (default) or `uniform`.
+    #[serde(default)]
+    pub helical_distribution: Option<String>,
     /// `first_order` (default, μ·F·v_g) or `moment_balance` (seed 003).
     #[serde(default)]
     pub loss_form: Option<String>,
@@ -299,7 +302,7 @@ pub struct LossesSpec {
     /// Pocketing discharge coefficient C_d (default 0.65).
     #[serde(default)]
     pub pocketing_discharge_coefficient: Option<f64>,
-    /// Density of the oil–air mixture pumped by a mesh above the oil level, kg/m³ (default 10).
+    /// Density of the oil–air mixture pumped by a mesh above the oil level, kg/m³ (no default: unknown, not counted, warned).
     #[serde(default)]
     pub pocketing_mixture_density_kg_m3: Option<f64>,
     /// Seetharaman–Kahraman: face transition Reynolds number (default 5e5).

@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 use serde::Serialize;
 
 use crate::model::Gearbox;
-use crate::scene::{sum_by_source, LossScene, OperatingPoint, Skipped, Source};
+use crate::scene::{sum_by_source, LossScene, OperatingPoint, RangeLog, RangeWarning, Skipped, Source};
 
 use super::sources::SourceValues;
 
@@ -51,6 +51,8 @@ pub struct LossReport {
     pub items: Vec<ItemReport>,
     /// What the scene left out.
     pub skipped: Vec<Skipped>,
+    /// Loss models used outside their fitted range at this point, items not counted.
+    pub warnings: Vec<RangeWarning>,
 }
 
 /// Evaluate the scene at `op` and build the report.
@@ -93,6 +95,11 @@ pub fn losses(gb: &Gearbox, scene: &LossScene, op: &OperatingPoint, oil_temp_c: 
             })
             .collect(),
         skipped: scene.skipped.clone(),
+        warnings: {
+            let mut log = RangeLog::new(scene);
+            log.check(scene, op);
+            log.warnings(scene)
+        },
     }
 }
 

@@ -7,3 +7,4 @@ pub mod plots;
 pub mod run;
 pub mod sources;
 pub mod study;
+pub mod validation;

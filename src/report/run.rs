@@ -9,7 +9,9 @@ use std::fmt::Write as _;
 use serde::Serialize;
 
 use crate::physics::oil::KELVIN_OFFSET;
-use crate::scene::{sum_by_source, Scene, Skipped, Source, N_SOURCES};
+use crate::scene::{
+    sum_by_source, OperatingPoint, RangeLog, RangeWarning, Scene, Skipped, Source, N_SOURCES,
+};
 
 use super::sources::{csv_columns, SourceValues};
 use crate::solve::transient::{energy_balance, Stats, Trajectory};
@@ -92,6 +94,27 @@ pub struct Summary {
     pub skipped: Vec<Skipped>,
     /// True when the oil properties were frozen (viscosity feedback off).
     pub frozen_viscosity: bool,
+    /// Loss models used outside their fitted range over the output rows, and items not counted
+    /// (docs/validation.md).
+    pub warnings: Vec<RangeWarning>,
+}
+
+/// Range warnings over the output rows of a run (gear state by name, oil temperature of the row).
+pub fn run_warnings(scene: &Scene, traj: &Trajectory, rows: &[RowInputs]) -> Vec<RangeWarning> {
+    let mut log = RangeLog::new(&scene.losses);
+    for (r, y) in rows.iter().zip(&traj.states) {
+        let Some(state) = scene.losses.state_names.iter().position(|n| *n == r.gear) else {
+            continue;
+        };
+        let op = OperatingPoint {
+            state,
+            input_speed: r.input_speed_rpm * std::f64::consts::PI / 30.0,
+            input_torque: r.input_torque_nm,
+            oil: scene.thermal.oil_properties(scene.oil_temp(y)),
+        };
+        log.check(&scene.losses, &op);
+    }
+    log.warnings(&scene.losses)
 }
 
 /// Build the summary of a run.
@@ -200,6 +223,7 @@ pub fn summary(
         oil_node: scene.thermal.names[scene.thermal.oil].clone(),
         skipped: scene.skipped.clone(),
         frozen_viscosity: scene.frozen_oil_temp.is_some(),
+        warnings: run_warnings(scene, traj, rows),
     }
 }
 

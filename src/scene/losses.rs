@@ -87,7 +87,9 @@ struct StateFactors {
 #[derive(Debug, Clone)]
 struct ChurnEntry {
     item: usize,
-    model: GearChurning,
+    /// One model per immersion the gear takes, with its weight (a fixed-axis gear: one, weight 1;
+    /// a planet set: the orbit-average quadrature with the planets counted, `planet_churning`).
+    models: Vec<(GearChurning, f64)>,
 }
 
 #[derive(Debug, Clone)]
@@ -172,7 +174,12 @@ pub struct LossScene {
     pocket: Vec<PocketEntry>,
     slide: Vec<SlideEntry>,
     states: Vec<StateFactors>,
-    mixture_density: f64,
+    /// Density pumped by the part of a mesh zone above the oil (`None`: unknown, not counted).
+    mixture_density: Option<f64>,
+    /// Warnings known at compile time (e.g. pocketing of meshes above the oil not counted).
+    pub warnings: Vec<super::ranges::RangeWarning>,
+    /// Gear-state names (for reports that know a state by name).
+    pub state_names: Vec<String>,
     auto: super::automatic::AutoLosses,
     /// Bearings and seals.
     elements: super::element_losses::ElementLosses,
@@ -188,7 +195,8 @@ pub struct SceneError {
     pub why: String,
 }
 
-fn churning_gear(gb: &Gearbox, gi: usize) -> ChurningGear {
+/// Churning data of gear `gi` (immersion at its lowest position; planets: the lowest orbit point).
+pub fn churning_gear(gb: &Gearbox, gi: usize) -> ChurningGear {
     let g = &gb.gears[gi];
     let geo = &g.geometry;
     let (tip, root) = if geo.is_internal() {
@@ -246,6 +254,7 @@ impl LossScene {
         let mut churn = Vec::new();
         let mut pocket = Vec::new();
         let mut slide = Vec::new();
+        let mut warnings = Vec::new();
         let models = &gb.losses;
 
         // Churning: one item per gear that reaches the oil.
@@ -271,14 +280,27 @@ impl LossScene {
                         skipped.push(usage.idle(format!("churning of gear {}", g.name), "stands still"));
                         continue;
                     }
-                    let model = GearChurning::new(cfg, &churning_gear(gb, gi)).map_err(|e| SceneError {
-                        what: format!("churning of gear {}", g.name),
-                        why: e.to_string(),
-                    })?;
+                    let models = super::planet_churning::models(cfg, gb, gi, &churning_gear(gb, gi))
+                        .map_err(|e| SceneError {
+                            what: format!("churning of gear {}", g.name),
+                            why: e.to_string(),
+                        })?;
                     churn.push(ChurnEntry {
                         item: items.len(),
-                        model,
+                        models,
                     });
+                    if cfg.model == crate::physics::losses::churning::ChurningModel::Stavytskyi {
+                        let out = crate::physics::losses::churning::ranges::stavytskyi_geometry(
+                            &churning_gear(gb, gi),
+                        );
+                        if !out.is_empty() {
+                            warnings.push(super::ranges::RangeWarning {
+                                item: format!("churning of gear {}", g.name),
+                                range: crate::physics::losses::churning::ranges::STAVYTSKYI_TESTED.into(),
+                                seen: out.join(", "),
+                            });
+                        }
+                    }
                     churn_gears.push(gi);
                     items.push(LossItem {
                         source: Source::Churning,
@@ -309,6 +331,20 @@ impl LossScene {
                                 .into(),
                         });
                         continue;
+                    }
+                    // (Before the idle check: a mesh above the oil is unknown in every state.) Height of the pitch point; planets orbit, so the mesh point sweeps a circle.
+                    let (wet, _) = mesh_zone(gb, mi);
+                    if wet < 1.0 && opt.mixture_density.is_none() {
+                        let w = super::ranges::above_oil_warning(&m.name, wet);
+                        let dry = wet <= 0.0;
+                        warnings.push(w);
+                        if dry {
+                            skipped.push(Skipped {
+                                what: format!("pocketing of mesh {}", m.name),
+                                why: "mesh zone entirely above the oil: pumped density unknown (set [losses] pocketing_mixture_density_kg_m3)".into(),
+                            });
+                            continue;
+                        }
                     }
                     if !usage.any(|u, st| u.speeds[st][m.gear1].relative != 0.0) {
                         skipped.push(usage.idle(
@@ -350,8 +386,6 @@ impl LossScene {
                             pm
                         }
                     };
-                    // Height of the pitch point; planets orbit, so the mesh point sweeps a circle.
-                    let (wet, _) = mesh_zone(gb, mi);
                     pocket.push(PocketEntry {
                         item: items.len(),
                         model,
@@ -493,7 +527,7 @@ impl LossScene {
             &mut skipped,
         );
 
-        let mixture_density = models.pocketing.map_or(0.0, |p| p.mixture_density);
+        let mixture_density = models.pocketing.and_then(|p| p.mixture_density);
         let elements = super::element_losses::ElementLosses::compile(
             gb,
             &|si| usage.needed(si),
@@ -510,6 +544,8 @@ impl LossScene {
             slide,
             states,
             mixture_density,
+            warnings,
+            state_names: gb.gear_states.iter().map(|s| s.name.clone()).collect(),
             auto,
             elements,
         })
@@ -632,6 +668,20 @@ impl LossScene {
         );
     }
 
+    /// Every churning model with its loss item and its gear's speed (rad/s) in gear state
+    /// `state` at input speed `input_speed` (for range checks; planets: one per orbit node).
+    pub fn churning_models(
+        &self,
+        state: usize,
+        input_speed: f64,
+    ) -> impl Iterator<Item = (usize, &GearChurning, f64)> + '_ {
+        let st = &self.states[state];
+        self.churn
+            .iter()
+            .zip(&st.churn_speed)
+            .flat_map(move |(e, k)| e.models.iter().map(move |(m, _)| (e.item, m, k * input_speed)))
+    }
+
     /// Churning and pocketing at `op` into `out`.
     fn evaluate_load_independent(&self, op: &OperatingPoint, out: &mut [f64]) {
         let st = &self.states[op.state];
@@ -641,10 +691,17 @@ impl LossScene {
             kinematic_viscosity: op.oil.nu,
         };
         for (e, k) in self.churn.iter().zip(&st.churn_speed) {
-            out[e.item] = e.model.power(k * w_in, &churn_oil).total;
+            out[e.item] = e
+                .models
+                .iter()
+                .map(|(m, wt)| wt * m.power(k * w_in, &churn_oil).total)
+                .sum();
         }
         for (e, k) in self.pocket.iter().zip(&st.pocket_speed) {
-            let rho = e.wet_fraction * op.oil.rho + (1.0 - e.wet_fraction) * self.mixture_density;
+            // The share above the oil pumps an unknown density unless the model file gives one;
+            // it is then not counted (and reported in `warnings`).
+            let rho =
+                e.wet_fraction * op.oil.rho + (1.0 - e.wet_fraction) * self.mixture_density.unwrap_or(0.0);
             out[e.item] = e.multiplicity * e.model.power(k * w_in, rho);
         }
     }

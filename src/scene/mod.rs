@@ -4,6 +4,8 @@ pub mod automatic;
 pub mod bearing_loads;
 pub mod element_losses;
 pub mod losses;
+pub mod planet_churning;
+pub mod ranges;
 pub mod system;
 pub mod thermal;
 
@@ -11,4 +13,5 @@ pub use losses::{
     sum_by_source, DefaultHeat, LossItem, LossScene, Needs, OperatingPoint, PerSource, SampleTerms,
     SceneError, Skipped, Source, N_SOURCES,
 };
+pub use ranges::{RangeLog, RangeWarning};
 pub use system::{Inputs, RhsFailure, Scene, Work};
