@@ -268,10 +268,12 @@ fn summary_only_and_evaluate_all_runs_agree_with_the_default_run() {
             MODELS[0],
             "--cycle",
             "artemis_urban",
+            // 1e-11: with the automatic's clutch drag and converter the RHS has kinks, and at
+            // 1e-9 the three integration paths differ by 1e-6 K from integration error alone.
             "--rtol",
-            "1e-9",
+            "1e-11",
             "--atol",
-            "1e-9",
+            "1e-11",
             "--quiet",
             "--out",
             dir.to_str().unwrap(),
