@@ -165,7 +165,7 @@ impl ClutchPack {
             }
             let d = g_prime(r, ri);
             let mut next = r - f / d;
-            if !(next > lo && next < hi) || !d.is_finite() || d <= 0.0 {
+            if !(next > lo && next < hi && d.is_finite() && d > 0.0) {
                 next = 0.5 * (lo + hi);
             }
             if (next - r).abs() <= 1e-12 * ro || hi - lo <= 1e-12 * ro {

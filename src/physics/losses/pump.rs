@@ -93,7 +93,7 @@ mod tests {
         // P[kW] = T·n/9549
         assert_relative_eq!(
             p.power / 1e3,
-            p.torque * 2000.0 / 9549.296_585_513_72,
+            p.torque * 2000.0 / 9_549.296_585_513_72,
             max_relative = 1e-9
         );
     }
