@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 mod bench;
 mod run;
 mod steady;
+mod study;
 
 use geartherm::model::{self, Gearbox, ModelError};
 use geartherm::physics::oil::KELVIN_OFFSET;
@@ -79,6 +80,9 @@ pub enum Command {
     Steady(steady::SteadyArgs),
     /// Equilibria over a speed × torque grid (map.csv and heat maps).
     Map(steady::MapArgs),
+    /// Design study: every sample of a parameter plan on cycles or operating points, in
+    /// parallel; resumable; writes study.csv, study.parquet, main_effects.png, pareto.png.
+    Study(study::StudyArgs),
     /// Work-precision study: every solver over rtol 1e-3 … 1e-10 against a 1e-12 reference;
     /// writes bench.csv, bench.json and work_precision.png.
     Bench(bench::BenchArgs),
@@ -242,6 +246,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             Ok(())
         }
         Command::Bench(args) => bench::bench(&args),
+        Command::Study(args) => study::study(&args),
         Command::Steady(args) => steady::steady(&args),
         Command::Map(args) => steady::map(&args),
         Command::Run(args) => {

@@ -6,3 +6,4 @@ pub mod map;
 pub mod plots;
 pub mod run;
 pub mod sources;
+pub mod study;

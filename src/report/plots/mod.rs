@@ -23,6 +23,7 @@ pub mod energy;
 pub mod heatmap;
 pub mod index;
 pub mod losses;
+pub mod study;
 pub mod style;
 pub mod temperatures;
 pub mod work_precision;
