@@ -310,7 +310,13 @@ fn summary_only_and_evaluate_all_runs_agree_with_the_default_run() {
             sd["temperatures_c"]["sump"]["final"].as_f64().unwrap(),
             other["temperatures_c"]["sump"]["final"].as_f64().unwrap(),
         );
-        assert!((a - b).abs() < 1e-6, "{a} vs {b}");
+        // The runs integrate different state vectors (energy per item, per source, or of every
+        // item), so their step sequences differ and they agree to the global integration error,
+        // which grows with the warm-up: 1e-6 K held for the 2.5 K warm-up of the gear losses
+        // alone; with the automatic's own losses the sump warms 56 K (23 → 79 °C) and the runs
+        // differ by 1.3e-6 K at rtol = atol = 1e-9. Bound: 5e-8 of the warm-up.
+        let rise = a - 23.0;
+        assert!((a - b).abs() < 1e-6_f64.max(5e-8 * rise), "{a} vs {b}");
     }
 }
 
