@@ -75,16 +75,12 @@ impl Converter {
             sr.first().copied().unwrap_or(f64::NAN),
             sr.last().copied().unwrap_or(f64::NAN),
         );
-        if let Some(v) = k
-            .iter()
-            .chain(&tr)
-            .find(|v| v.partial_cmp(&&0.0) != Some(std::cmp::Ordering::Greater))
-        {
+        if let Some(v) = k.iter().chain(&tr).find(|v| v.is_nan() || **v <= 0.0) {
             return Err(ConverterError::NotPositive(*v));
         }
         let k = Curve::new(sr.clone(), k)?;
         let tr = Curve::new(sr, tr)?;
-        if first != 0.0 || last.partial_cmp(&1.0) != Some(std::cmp::Ordering::Less) {
+        if first != 0.0 || last.is_nan() || last >= 1.0 {
             return Err(ConverterError::SpeedRatios(first, last));
         }
         Ok(Converter { k, tr, sr_last: last })
