@@ -99,7 +99,7 @@ fn run_outputs_follow_the_contract() {
         "rtol",
         "energy_lost_j",
         "energy_balance_relative",
-        "mean_efficiency",
+        "cycle_efficiency",
         "temperatures_c",
         "skipped",
     ] {
@@ -112,7 +112,7 @@ fn run_outputs_follow_the_contract() {
     let sum =
         e["churning"].as_f64().unwrap() + e["pocketing"].as_f64().unwrap() + e["sliding"].as_f64().unwrap();
     assert!((sum - e["total"].as_f64().unwrap()).abs() < 1e-6 * sum);
-    let eta = s["mean_efficiency"].as_f64().unwrap();
+    let eta = s["cycle_efficiency"].as_f64().unwrap();
     assert!(eta > 0.9 && eta < 1.0, "{eta}");
     assert!(
         !s["skipped"].as_array().unwrap().is_empty(),

@@ -182,7 +182,7 @@ fn write_run(dir: &Path, spec: &RunSpec) {
     let summary = format!(
         r#"{{"model":"test box","cycle":"WLTC-like","solver":"bdf","rtol":1e-6,"atol":1e-6,"wall_time_s":0.42,
         "steps":1234,"energy_lost_j":{{"churning":1.0e5,"pocketing":5.0e4,"sliding":2.0e5,"total":3.5e5}},
-        "energy_by_item_j":[{}],"energy_balance_relative":2.5e-7,"mean_efficiency":0.962,
+        "energy_by_item_j":[{}],"energy_balance_relative":2.5e-7,"cycle_efficiency":0.962,
         "temperatures_c":{{{}}},"nodes":[{}],"oil_node":"oil_sump",
         "skipped":[{{"what":"gear g5","why":"never engaged in this cycle"}}],"extra_key":{{"x":1}}}}"#,
         items_json.join(","),
