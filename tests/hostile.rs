@@ -5,12 +5,34 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
+/// The binary under test; `GEARTHERM_BIN` points the suite at another build (to show that
+/// each test fails on a build without the fixes).
 fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_geartherm"))
+    match std::env::var_os("GEARTHERM_BIN") {
+        Some(p) => Command::new(p),
+        None => Command::new(env!("CARGO_BIN_EXE_geartherm")),
+    }
 }
 
+/// Run with a 10 s limit: a command still running then is killed and the test fails (a hang).
 fn run(args: &[&str]) -> Output {
-    bin().args(args).output().expect("binary runs")
+    use std::process::Stdio;
+    let mut child = bin()
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("binary runs");
+    let t = Instant::now();
+    while child.try_wait().expect("wait").is_none() {
+        if t.elapsed() > Duration::from_secs(10) {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("hang: geartherm {} still running after 10 s", args.join(" "));
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    child.wait_with_output().expect("output")
 }
 
 fn code(o: &Output) -> i32 {
