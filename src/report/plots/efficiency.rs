@@ -124,7 +124,14 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
         if seg.len() == 1 {
             chart.draw_series(std::iter::once(Circle::new(seg[0], 3, line_colour.filled())))?;
         } else {
-            chart.draw_series(LineSeries::new(decimate(&seg, 1200), line_colour.stroke_width(2)))?;
+            // Two-point paths, not one polyline: plotters joins the segments of a wide polyline
+            // with unlimited mitres, and the sharp spikes of this curve turned them into lines
+            // across the whole figure (over the title, below the axis).
+            let pts = decimate(&seg, 1200);
+            chart.draw_series(
+                pts.windows(2)
+                    .map(|w| PathElement::new(vec![w[0], w[1]], line_colour.stroke_width(2))),
+            )?;
         }
     }
     if pairs.is_empty() {
