@@ -14,7 +14,10 @@ fn bin() -> Command {
 
 fn names(d: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(d)
-        .map(|r| r.map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect())
+        .map(|r| {
+            r.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                .collect()
+        })
         .unwrap_or_default();
     v.sort();
     v
@@ -56,7 +59,8 @@ fn complete_run(out: &Path) {
 /// The target holds exactly the complete set, with a summary that parses.
 fn assert_whole(out: &Path) {
     assert_eq!(names(out), FULL, "a mixed or partial result set");
-    let s: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    let s: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
     assert!(s["cycle_efficiency"].is_f64());
 }
 
@@ -74,11 +78,19 @@ fn a_run_killed_at_any_moment_leaves_the_previous_result_whole_and_the_next_run_
         assert_whole(&out);
         if !st.success() {
             // Killed before its commit: the previous result, byte for byte.
-            assert_eq!(std::fs::read(out.join("summary.json")).unwrap(), before, "after {delay_ms} ms");
+            assert_eq!(
+                std::fs::read(out.join("summary.json")).unwrap(),
+                before,
+                "after {delay_ms} ms"
+            );
         }
     }
     complete_run(&out);
-    assert_eq!(names(d.path()), ["o"], "stale temporaries and lock removed by the next run");
+    assert_eq!(
+        names(d.path()),
+        ["o"],
+        "stale temporaries and lock removed by the next run"
+    );
 }
 
 #[test]

@@ -43,31 +43,37 @@ fn hostile_number() -> impl Strategy<Value = String> {
 
 /// Mutate one `key = value` line of a model: replace its value, delete the line, or duplicate it.
 fn mutated_model() -> impl Strategy<Value = String> {
-    (0..MODELS.len(), any::<prop::sample::Index>(), 0u8..3, hostile_number()).prop_map(|(m, idx, op, num)| {
-        let lines: Vec<&str> = MODELS[m].lines().collect();
-        let candidates: Vec<usize> = lines
-            .iter()
-            .enumerate()
-            .filter(|(_, l)| l.contains('=') && !l.trim_start().starts_with('#'))
-            .map(|(i, _)| i)
-            .collect();
-        let k = candidates[idx.index(candidates.len())];
-        let mut out: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
-        match op {
-            0 => {
-                let key = out[k].split('=').next().unwrap_or("").to_string();
-                out[k] = format!("{key}= {num}");
+    (
+        0..MODELS.len(),
+        any::<prop::sample::Index>(),
+        0u8..3,
+        hostile_number(),
+    )
+        .prop_map(|(m, idx, op, num)| {
+            let lines: Vec<&str> = MODELS[m].lines().collect();
+            let candidates: Vec<usize> = lines
+                .iter()
+                .enumerate()
+                .filter(|(_, l)| l.contains('=') && !l.trim_start().starts_with('#'))
+                .map(|(i, _)| i)
+                .collect();
+            let k = candidates[idx.index(candidates.len())];
+            let mut out: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+            match op {
+                0 => {
+                    let key = out[k].split('=').next().unwrap_or("").to_string();
+                    out[k] = format!("{key}= {num}");
+                }
+                1 => {
+                    out.remove(k);
+                }
+                _ => {
+                    let dup = out[k].clone();
+                    out.insert(k, dup);
+                }
             }
-            1 => {
-                out.remove(k);
-            }
-            _ => {
-                let dup = out[k].clone();
-                out.insert(k, dup);
-            }
-        }
-        out.join("\n")
-    })
+            out.join("\n")
+        })
 }
 
 proptest! {

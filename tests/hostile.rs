@@ -90,7 +90,10 @@ fn an_impossible_vehicle_speed_is_refused_with_its_line() {
     assert!(t.elapsed() < Duration::from_secs(10), "took {:?}", t.elapsed());
     assert_eq!(code(&o), 1, "{}", stderr(&o));
     let e = stderr(&o);
-    assert!(e.contains("line 3") && e.contains("speed_kmh") && e.contains("500"), "{e}");
+    assert!(
+        e.contains("line 3") && e.contains("speed_kmh") && e.contains("500"),
+        "{e}"
+    );
     assert!(!out.exists(), "nothing written");
 }
 
@@ -99,9 +102,20 @@ fn an_impossible_vehicle_speed_is_refused_with_its_line() {
 fn time_steps_below_a_millisecond_are_refused() {
     let d = tempfile::tempdir().unwrap();
     let c = write(d.path(), "c.csv", "time_s,speed_kmh\n0,0\n1e-12,10\n2e-12,0\n");
-    let o = run(&["run", "models/fzg_c.toml", "--cycle", s(&c), "--out", s(&d.path().join("o"))]);
+    let o = run(&[
+        "run",
+        "models/fzg_c.toml",
+        "--cycle",
+        s(&c),
+        "--out",
+        s(&d.path().join("o")),
+    ]);
     assert_eq!(code(&o), 1, "{}", stderr(&o));
-    assert!(stderr(&o).contains("line 3") && stderr(&o).contains("0.001"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("line 3") && stderr(&o).contains("0.001"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 /// Nonsense: FZG C at 1450 rpm, 0.1 N·m printed efficiency −1.7576.
@@ -161,7 +175,10 @@ fn losses_never_print_null_numbers() {
                 }
                 assert!(v["total_w"].is_f64(), "{m}");
                 let e = &v["efficiency"];
-                assert!(e.is_null() || (0.0..=1.0).contains(&e.as_f64().unwrap()), "{m}: {e}");
+                assert!(
+                    e.is_null() || (0.0..=1.0).contains(&e.as_f64().unwrap()),
+                    "{m}: {e}"
+                );
             }
             c => {
                 assert!(c == 1 || c == 2, "{m}: exit {c}: {}", stderr(&o));
@@ -193,7 +210,14 @@ fn io_failures_on_inputs_exit_3() {
     assert_eq!(code(&o), 3, "{}", stderr(&o));
     let o = run(&["info", s(d.path())]);
     assert_eq!(code(&o), 3, "a directory as model: {}", stderr(&o));
-    let o = run(&["run", "models/fzg_c.toml", "--cycle", s(d.path()), "--out", s(&d.path().join("o"))]);
+    let o = run(&[
+        "run",
+        "models/fzg_c.toml",
+        "--cycle",
+        s(d.path()),
+        "--out",
+        s(&d.path().join("o")),
+    ]);
     assert_eq!(code(&o), 3, "a directory as cycle: {}", stderr(&o));
     assert!(!d.path().join("o").exists());
 }
@@ -207,7 +231,11 @@ fn report_on_malformed_or_non_finite_inputs_exits_1_and_keeps_the_directory() {
     std::fs::create_dir(&dir).unwrap();
     let header = "time_s,vehicle_speed_kmh,gear,input_speed_rpm,input_torque_nm,output_power_w,temp_oil_c,\
                   churning_w,pocketing_w,sliding_w,total_loss_w,efficiency\n";
-    write(&dir, "timeseries.csv", &format!("{header}0,0,1,0,0,0,23,0,0,0,0,\n1,10,1,1000,10,1000,NaN,1,0,0,1,0.99\n"));
+    write(
+        &dir,
+        "timeseries.csv",
+        &format!("{header}0,0,1,0,0,0,23,0,0,0,0,\n1,10,1,1000,10,1000,NaN,1,0,0,1,0.99\n"),
+    );
     write(
         &dir,
         "summary.json",
@@ -218,7 +246,11 @@ fn report_on_malformed_or_non_finite_inputs_exits_1_and_keeps_the_directory() {
     assert_eq!(code(&o), 1, "NaN cell: {}", stderr(&o));
     assert!(stderr(&o).contains("temp_oil_c"), "{}", stderr(&o));
     assert_eq!(names(&dir), before, "nothing written");
-    write(&dir, "timeseries.csv", &format!("{header}0,0,1,0,0,0,23,0,0,0,0,\n1,10,1,1000,10,1000,24,1,0,0,1,0.99\n"));
+    write(
+        &dir,
+        "timeseries.csv",
+        &format!("{header}0,0,1,0,0,0,23,0,0,0,0,\n1,10,1,1000,10,1000,24,1,0,0,1,0.99\n"),
+    );
     write(&dir, "summary.json", "{ not json");
     let o = run(&["report", s(&dir)]);
     assert_eq!(code(&o), 1, "malformed JSON: {}", stderr(&o));
@@ -231,13 +263,35 @@ fn a_rerun_replaces_the_whole_result_set() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("o");
     let c = write(d.path(), "c.csv", "time_s,speed_kmh\n0,0\n30,50\n60,0\n");
-    let o = run(&["run", "models/at6_lepelletier.toml", "--cycle", s(&c), "--out", s(&out), "--report", "--quiet"]);
+    let o = run(&[
+        "run",
+        "models/at6_lepelletier.toml",
+        "--cycle",
+        s(&c),
+        "--out",
+        s(&out),
+        "--report",
+        "--quiet",
+    ]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     assert!(out.join("efficiency.png").is_file());
-    let o = run(&["run", "models/at6_lepelletier.toml", "--cycle", s(&c), "--out", s(&out), "--summary-only", "--quiet"]);
+    let o = run(&[
+        "run",
+        "models/at6_lepelletier.toml",
+        "--cycle",
+        s(&c),
+        "--out",
+        s(&out),
+        "--summary-only",
+        "--quiet",
+    ]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     assert_eq!(names(&out), [".geartherm-output", "summary.json"]);
-    assert_eq!(names(d.path()), ["c.csv", "o"], "no temporaries beside the target");
+    assert_eq!(
+        names(d.path()),
+        ["c.csv", "o"],
+        "no temporaries beside the target"
+    );
 }
 
 /// Partial files: `map` exited 2 yet wrote map.csv. A map whose points fail writes nothing.
@@ -298,7 +352,11 @@ fn an_oversized_map_is_refused_with_the_limit() {
         "10:100:2",
     ]);
     assert_eq!(code(&o), 1);
-    assert!(stderr(&o).contains("2000"), "the per-axis limit is stated: {}", stderr(&o));
+    assert!(
+        stderr(&o).contains("2000"),
+        "the per-axis limit is stated: {}",
+        stderr(&o)
+    );
 }
 
 /// Messages: errors in `[vehicle]` said only `vehicle: invalid type`.
@@ -328,7 +386,15 @@ fn outputs_get_the_usual_mode() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("o");
     let c = write(d.path(), "c.csv", "time_s,speed_kmh\n0,0\n20,40\n40,0\n");
-    let o = run(&["run", "models/fzg_c.toml", "--cycle", s(&c), "--out", s(&out), "--quiet"]);
+    let o = run(&[
+        "run",
+        "models/fzg_c.toml",
+        "--cycle",
+        s(&c),
+        "--out",
+        s(&out),
+        "--quiet",
+    ]);
     if code(&o) != 0 {
         // FZG C has no vehicle: use a rig cycle.
         let c = write(
@@ -336,7 +402,16 @@ fn outputs_get_the_usual_mode() {
             "r.csv",
             "time_s,input_speed_rpm,input_torque_nm,gear\n0,1000,50,1\n20,1000,50,1\n",
         );
-        let o = run(&["run", "models/fzg_c.toml", "--cycle", s(&c), "--out", s(&out), "--quiet", "--report"]);
+        let o = run(&[
+            "run",
+            "models/fzg_c.toml",
+            "--cycle",
+            s(&c),
+            "--out",
+            s(&out),
+            "--quiet",
+            "--report",
+        ]);
         assert_eq!(code(&o), 0, "{}", stderr(&o));
     }
     let probe = d.path().join("probe");
@@ -359,7 +434,17 @@ fn a_second_writer_is_refused_while_the_first_writes() {
         "r.csv",
         "time_s,input_speed_rpm,input_torque_nm,gear\n0,1000,50,1\n3600,3000,150,1\n7200,1000,50,1\n",
     );
-    let args = ["run", "models/fzg_c.toml", "--cycle", s(&c), "--out", s(&out), "--quiet", "--rtol", "1e-9"];
+    let args = [
+        "run",
+        "models/fzg_c.toml",
+        "--cycle",
+        s(&c),
+        "--out",
+        s(&out),
+        "--quiet",
+        "--rtol",
+        "1e-9",
+    ];
     let mut first = bin().args(args).spawn().unwrap();
     // Wait for the first to take the lock.
     let lock = d.path().join(".o.geartherm-lock");
@@ -372,7 +457,14 @@ fn a_second_writer_is_refused_while_the_first_writes() {
     assert!(st.success());
     if lock.exists() || code(&second) != 0 {
         assert_eq!(code(&second), 3, "{}", stderr(&second));
-        assert!(stderr(&second).contains("another geartherm"), "{}", stderr(&second));
+        assert!(
+            stderr(&second).contains("another geartherm"),
+            "{}",
+            stderr(&second)
+        );
     }
-    assert_eq!(names(&out), [".geartherm-output", "summary.json", "timeseries.csv"]);
+    assert_eq!(
+        names(&out),
+        [".geartherm-output", "summary.json", "timeseries.csv"]
+    );
 }

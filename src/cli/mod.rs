@@ -188,7 +188,14 @@ fn report(dir: &std::path::Path) -> Result<(), Failure> {
         )));
     }
     let out = geartherm::report::files::OutputDir::begin(dir)?;
-    out.carry_over(&["timeseries.csv", "summary.json", "map.csv", "map.json", "bench.csv", "bench.json"])?;
+    out.carry_over(&[
+        "timeseries.csv",
+        "summary.json",
+        "map.csv",
+        "map.json",
+        "bench.csv",
+        "bench.json",
+    ])?;
     let mut written = Vec::new();
     if out.path().join("timeseries.csv").is_file() {
         written.extend(plots::render_run(out.path()).map_err(fail)?);

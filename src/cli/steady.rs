@@ -222,7 +222,11 @@ fn check_equilibrium(scene: &Scene, eq: &geartherm::solve::equilibrium::Equilibr
     }
     for (it, q) in scene.losses.items.iter().zip(&eq.losses) {
         if !q.is_finite() {
-            return Err(format!("loss item {}:{} is not finite", it.source.as_str(), it.name));
+            return Err(format!(
+                "loss item {}:{} is not finite",
+                it.source.as_str(),
+                it.name
+            ));
         }
     }
     let total: f64 = eq.by_source.iter().sum();

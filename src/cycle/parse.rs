@@ -180,9 +180,12 @@ impl DriveCycle {
             }
             let time = num(c_time)?;
             if !(0.0..=MAX_TIME_S).contains(&time) {
-                return Err(err(CycleErrorKind::Time, format!("time must lie in [0, {MAX_TIME_S:e}] s"))
-                    .at_line(line)
-                    .at_value(TIME, rec.get(c_time).copied().unwrap_or("")));
+                return Err(err(
+                    CycleErrorKind::Time,
+                    format!("time must lie in [0, {MAX_TIME_S:e}] s"),
+                )
+                .at_line(line)
+                .at_value(TIME, rec.get(c_time).copied().unwrap_or("")));
             }
             if let Some(prev) = rows.last() {
                 if time < prev.time + MIN_TIME_STEP_S {
@@ -200,9 +203,11 @@ impl DriveCycle {
             let bounded = |c: usize, lo: f64, hi: f64, unit: &str| -> Result<f64, CycleError> {
                 let v = num(c)?;
                 if !(lo..=hi).contains(&v) {
-                    Err(err(CycleErrorKind::Value, format!("must lie in [{lo}, {hi}] {unit}"))
-                        .at_line(line)
-                        .at_value(&names[c], rec.get(c).copied().unwrap_or("")))
+                    Err(
+                        err(CycleErrorKind::Value, format!("must lie in [{lo}, {hi}] {unit}"))
+                            .at_line(line)
+                            .at_value(&names[c], rec.get(c).copied().unwrap_or("")),
+                    )
                 } else {
                     Ok(v)
                 }

@@ -152,13 +152,21 @@ pub fn is_plain_name(name: &str) -> bool {
     !name.is_empty()
         && name.chars().count() <= MAX_NAME_LEN
         && name.trim() == name
-        && !name.chars().any(|c| c.is_control() || NAME_FORBIDDEN.contains(&c))
+        && !name
+            .chars()
+            .any(|c| c.is_control() || NAME_FORBIDDEN.contains(&c))
 }
 
 /// Every `name` key of the file (except the free-text `model.name` and `oil.name`) must be an
 /// identifier ([`is_plain_name`]); one problem per bad name, with its key path.
 fn check_names(value: &Value, path: &str, problems: &mut Problems) {
-    let join = |k: &str| if path.is_empty() { k.to_string() } else { format!("{path}.{k}") };
+    let join = |k: &str| {
+        if path.is_empty() {
+            k.to_string()
+        } else {
+            format!("{path}.{k}")
+        }
+    };
     match value {
         Value::Table(t) => {
             for (k, v) in t {
@@ -317,7 +325,9 @@ centre_height_mm = {}
         assert!(!is_plain_name("a|b"));
         assert!(!is_plain_name(&"x".repeat(MAX_NAME_LEN + 1)));
         let mut p = Problems::default();
-        let v: Value = toml::from_str("[model]\nname = \"free text, ok\"\n[[gears]]\nname = \"a\\nb,c\\\"d\"\n").unwrap();
+        let v: Value =
+            toml::from_str("[model]\nname = \"free text, ok\"\n[[gears]]\nname = \"a\\nb,c\\\"d\"\n")
+                .unwrap();
         check_names(&v, "", &mut p);
         let all: Vec<String> = p.as_slice().iter().map(|x| x.to_string()).collect();
         assert_eq!(all.len(), 1, "{all:?}");

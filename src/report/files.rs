@@ -121,9 +121,9 @@ impl DirLock {
                 .truncate(false)
                 .open(&lock)
                 .map_err(io_at(&lock))?;
-            match file.try_lock() {
-                Ok(()) => {}
-                Err(fs::TryLockError::WouldBlock) => {
+            match try_lock(&file) {
+                Ok(true) => {}
+                Ok(false) => {
                     let mut s = String::new();
                     let _ = file.read_to_string(&mut s);
                     let holder = s.trim().parse::<u32>().ok().map(|p| p.to_string());
@@ -133,7 +133,7 @@ impl DirLock {
                         holder,
                     });
                 }
-                Err(fs::TryLockError::Error(e)) => return Err(io_at(&lock)(e)),
+                Err(e) => return Err(io_at(&lock)(e)),
             }
             if same_file(&file, &lock) {
                 let _ = file.set_len(0);
@@ -142,9 +142,47 @@ impl DirLock {
                 return Ok(DirLock { file, path: lock });
             }
         }
-        Err(io_at(&lock)(std::io::Error::other("lock file keeps being replaced")))
+        Err(io_at(&lock)(std::io::Error::other(
+            "lock file keeps being replaced",
+        )))
     }
 }
+
+/// Exclusive, non-blocking `flock`: Ok(false) when another process holds it. (std's
+/// `File::try_lock` needs Rust 1.89; the crate keeps 1.80.)
+#[cfg(unix)]
+fn try_lock(file: &File) -> std::io::Result<bool> {
+    use std::os::unix::io::AsRawFd;
+    // SAFETY: flock on a file descriptor owned by `file` for the duration of the call.
+    let r = unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) };
+    if r == 0 {
+        return Ok(true);
+    }
+    let e = std::io::Error::last_os_error();
+    if e.kind() == std::io::ErrorKind::WouldBlock {
+        Ok(false)
+    } else {
+        Err(e)
+    }
+}
+
+#[cfg(unix)]
+fn unlock(file: &File) {
+    use std::os::unix::io::AsRawFd;
+    // SAFETY: as in `try_lock`.
+    unsafe {
+        libc::flock(file.as_raw_fd(), libc::LOCK_UN);
+    }
+}
+
+/// Non-Unix systems: no advisory lock (the transaction itself still holds).
+#[cfg(not(unix))]
+fn try_lock(_file: &File) -> std::io::Result<bool> {
+    Ok(true)
+}
+
+#[cfg(not(unix))]
+fn unlock(_file: &File) {}
 
 #[cfg(unix)]
 fn same_file(file: &File, path: &Path) -> bool {
@@ -164,7 +202,7 @@ impl Drop for DirLock {
     fn drop(&mut self) {
         // Unlink while still holding the lock; a waiter that opened the old inode re-checks.
         let _ = fs::remove_file(&self.path);
-        let _ = self.file.unlock();
+        unlock(&self.file);
     }
 }
 
@@ -251,7 +289,10 @@ impl OutputDir {
 
     /// Swap the new result set in. On error the target keeps the previous result.
     pub fn commit(mut self) -> Result<PathBuf, OutputError> {
-        self.write(MARKER, b"written by geartherm; this directory is replaced as a whole by the next run into it\n")?;
+        self.write(
+            MARKER,
+            b"written by geartherm; this directory is replaced as a whole by the next run into it\n",
+        )?;
         sync_dir_files(&self.staging);
         if self.target.exists() {
             if !exchange(&self.staging, &self.target) {
@@ -325,9 +366,7 @@ fn clean_stale(parent: &Path, name: &str, target: &Path) -> Result<(), OutputErr
 fn is_ours(name: &str) -> bool {
     name == MARKER
         || KNOWN_OUTPUTS.contains(&name)
-        || KNOWN_OUTPUTS
-            .iter()
-            .any(|k| name.starts_with(&format!(".{k}.")))
+        || KNOWN_OUTPUTS.iter().any(|k| name.starts_with(&format!(".{k}.")))
 }
 
 fn check_replaceable(target: &Path) -> Result<(), OutputError> {

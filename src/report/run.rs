@@ -306,15 +306,31 @@ pub fn timeseries_csv(
 /// The first non-finite number a run would write, named (`time 12.5 s, node oil`), or `Ok`.
 /// Checked before anything is written: a run whose numbers are not all finite fails (exit 2)
 /// instead of writing blanks or `null`s.
-pub fn check_finite(scene: &Scene, traj: &Trajectory, rows: &[RowInputs], sum: &Summary) -> Result<(), String> {
+pub fn check_finite(
+    scene: &Scene,
+    traj: &Trajectory,
+    rows: &[RowInputs],
+    sum: &Summary,
+) -> Result<(), String> {
     for (k, t) in traj.times.iter().enumerate() {
-        if let Some(i) = traj.states[k].iter().take(scene.nodes()).position(|v| !v.is_finite()) {
-            return Err(format!("temperature of node {} at t = {t} s is not finite", scene.thermal.names[i]));
+        if let Some(i) = traj.states[k]
+            .iter()
+            .take(scene.nodes())
+            .position(|v| !v.is_finite())
+        {
+            return Err(format!(
+                "temperature of node {} at t = {t} s is not finite",
+                scene.thermal.names[i]
+            ));
         }
         if let Some(q) = traj.losses.get(k) {
             if let Some(i) = q.iter().position(|v| !v.is_finite()) {
                 let it = &scene.losses.items[i];
-                return Err(format!("loss item {}:{} at t = {t} s is not finite", it.source.as_str(), it.name));
+                return Err(format!(
+                    "loss item {}:{} at t = {t} s is not finite",
+                    it.source.as_str(),
+                    it.name
+                ));
             }
         }
         if let Some(r) = rows.get(k) {
@@ -350,7 +366,10 @@ impl Summary {
             ("cycle_efficiency".into(), self.cycle_efficiency.unwrap_or(0.0)),
         ];
         for it in &self.energy_by_item_j {
-            named.push((format!("energy_by_item_j {}:{}", it.source.as_str(), it.name), it.j));
+            named.push((
+                format!("energy_by_item_j {}:{}", it.source.as_str(), it.name),
+                it.j,
+            ));
         }
         for (n, t) in &self.temperatures_c {
             named.push((format!("temperatures_c.{n}.min"), t.min));

@@ -164,7 +164,10 @@ pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
             let field = record.get(c).unwrap_or("");
             parse_num(field).ok_or_else(|| PlotError::Csv {
                 path: path.to_path_buf(),
-                msg: format!("line {line}, column `{}`: `{field}` is not a finite number", &headers[c]),
+                msg: format!(
+                    "line {line}, column `{}`: `{field}` is not a finite number",
+                    &headers[c]
+                ),
             })
         };
         ts.time_s.push(num(c_time)?);

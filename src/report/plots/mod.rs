@@ -80,8 +80,7 @@ fn temp_in(dir: &Path, name: &str, suffix: &str) -> Result<NamedTempFile, PlotEr
     // The usual mode (0666 less the umask), not tempfile's owner-only 0600.
     #[cfg(unix)]
     b.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    b.tempfile_in(dir)
-        .map_err(|e| io_err(&dir.join(name), e))
+    b.tempfile_in(dir).map_err(|e| io_err(&dir.join(name), e))
 }
 
 /// Render a 1600×1000 PNG into a temporary file in `dir` that becomes `name` on commit.
@@ -187,7 +186,9 @@ pub fn render_map(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
                 as Box<dyn FnOnce() -> Result<Staged, PlotError> + Send>
         })
         .collect();
-    jobs.push(Box::new(move || stage_text(dir, "report.md", &map_index::markdown(grid))));
+    jobs.push(Box::new(move || {
+        stage_text(dir, "report.md", &map_index::markdown(grid))
+    }));
     commit(stage_parallel(jobs)?)
 }
 
