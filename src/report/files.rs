@@ -530,9 +530,9 @@ mod tests {
         let d = tempfile::tempdir().unwrap();
         let old = d.path().join(".run.geartherm-old-1-2");
         fs::create_dir(&old).unwrap();
-        fs::write(old.join("a.txt"), b"one").unwrap();
+        fs::write(old.join("summary.json"), b"one").unwrap();
         let out = OutputDir::begin(&d.path().join("run")).unwrap();
-        assert_eq!(fs::read(d.path().join("run/a.txt")).unwrap(), b"one");
+        assert_eq!(fs::read(d.path().join("run/summary.json")).unwrap(), b"one");
         drop(out);
     }
 

@@ -144,7 +144,8 @@ fn write_run(dir: &Path, spec: &RunSpec) {
             };
             by_src[*s] += p;
             if spec.with_gaps && k == 0 && r % 40 == 3 {
-                csv.push_str(",NaN");
+                // A gap is an empty cell (`NaN` and `inf` cells are rejected: never written).
+                csv.push(',');
             } else {
                 let _ = write!(csv, ",{p}");
             }
@@ -400,7 +401,9 @@ fn maps_render() {
         let dir = tempfile::tempdir().unwrap();
         write_map(dir.path(), nx, ny, shuffle);
         let paths = render_map(dir.path()).unwrap_or_else(|e| panic!("{nx}x{ny}: {e}"));
-        assert_eq!(paths.len(), 3);
+        assert_eq!(paths.len(), 4, "three heat maps and report.md");
+        let md = fs::read_to_string(dir.path().join("report.md")).unwrap();
+        assert!(md.contains("map_oil_temp.png") && md.contains("Converged points"), "{md}");
         for name in ["map_efficiency.png", "map_total_loss.png", "map_oil_temp.png"] {
             assert_png_ok(&dir.path().join(name));
         }
