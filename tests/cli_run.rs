@@ -169,7 +169,7 @@ fn run_outputs_follow_the_contract() {
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
     names.sort();
-    assert_eq!(names, ["summary.json", "timeseries.csv"]);
+    assert_eq!(names, [".geartherm-output", "summary.json", "timeseries.csv"]);
 }
 
 fn assert_invalid_and_nothing_written(args: &[&str], dir: &Path, expect: &[&str]) {

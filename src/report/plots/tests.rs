@@ -403,7 +403,10 @@ fn maps_render() {
         let paths = render_map(dir.path()).unwrap_or_else(|e| panic!("{nx}x{ny}: {e}"));
         assert_eq!(paths.len(), 4, "three heat maps and report.md");
         let md = fs::read_to_string(dir.path().join("report.md")).unwrap();
-        assert!(md.contains("map_oil_temp.png") && md.contains("Converged points"), "{md}");
+        assert!(
+            md.contains("map_oil_temp.png") && md.contains("Converged points"),
+            "{md}"
+        );
         for name in ["map_efficiency.png", "map_total_loss.png", "map_oil_temp.png"] {
             assert_png_ok(&dir.path().join(name));
         }
