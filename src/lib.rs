@@ -1,6 +1,7 @@
 //! geartherm: gearbox thermal simulator.
 //!
-//! Layers (an arrow = "may use"): `cli` → `report` → `solve` → `scene` → `model` → `physics`.
+//! Layers (an arrow = "may use"): `cli` (and the Python binding in `python/`) → `study` →
+//! `report` → `solve` → `scene` → `model` → `physics`.
 //! `physics` is pure (SI units, no I/O); `model` reads and validates model files; the CLI lives in
 //! `src/main.rs` and `src/cli/`.
 
@@ -10,3 +11,4 @@ pub mod physics;
 pub mod report;
 pub mod scene;
 pub mod solve;
+pub mod study;

@@ -20,7 +20,11 @@ fn example_models() -> Vec<PathBuf> {
     let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("models"))
         .unwrap()
         .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml") && !p.ends_with("oils.toml"))
+        .filter(|p| {
+            p.extension().is_some_and(|e| e == "toml")
+                && !p.ends_with("oils.toml")
+                && !p.ends_with("bearings.toml")
+        })
         .collect();
     v.sort();
     v

@@ -239,11 +239,13 @@ fn at6_wltc_cold_start_warms_up_with_viscosity_feedback() {
     );
     assert!(bal.relative <= 1e-9);
     assert!(t1 > t0 + 1.0, "oil must warm up");
-    // Direction: the warmer oil has the lower viscosity; the ISO TC60 mesh friction rises as the
-    // viscosity falls (μ ∝ η^−0.05) and dominates the churning change over this 23–26 °C range
-    // (docs/physics.md §8), so the coupled run loses more energy than the frozen one.
+    // Direction: the warmer oil has the lower viscosity. The ISO TC60 mesh friction rises as the
+    // viscosity falls (μ_mz ∝ η^−0.05 Schlenk, the default; ISO TC60 ∝ η^−0.25), but the bearings' rolling friction falls with it
+    // (SKF M_rr ∝ (ν n)^0.6, Palmgren M0 ∝ (ν n)^(2/3)) and, with the AT6's eleven bearings,
+    // dominates (docs/physics.md §Bearings): the coupled run loses less energy than the frozen
+    // one (−1.5 % over the WLTC).
     assert!(
-        bal.lost > fb.lost * 1.001,
+        bal.lost < fb.lost * 0.999,
         "coupled {} vs frozen {}",
         bal.lost,
         fb.lost
@@ -304,7 +306,12 @@ fn pitfall_5_restarting_bdf_only_at_jumps_keeps_its_order() {
 fn pitfall_6_derivative_refreshed_after_an_input_jump() {
     // ESDIRK34 starts each step from the stored derivative (first stage explicit): a stale dy
     // after a jump puts the pre-jump heat into the first stage of the new interval.
-    let scene = fzg_model_scene();
+    // The gear-only FZG scene this pitfall was calibrated on (bearings and seals add smooth
+    // load-dependent heat; with them the stale/refreshed error ratio is 4.2 instead of 5.8).
+    let mut gb = model::load(std::path::Path::new("models/fzg_c.toml")).unwrap();
+    gb.bearings.clear();
+    gb.seals.clear();
+    let scene = Scene::compile(&gb).unwrap();
     let segs = jumpy(300, |_| 0);
     let reference = run(&scene, &segs, &opts(Method::Esdirk34, 1e-11));
     let mut o = opts(Method::Esdirk34, 1e-6);

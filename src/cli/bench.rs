@@ -37,6 +37,7 @@ pub struct BenchArgs {
 pub fn bench(args: &BenchArgs) -> Result<(), Failure> {
     let run_args = RunArgs {
         model: args.model.clone(),
+        set: Default::default(),
         cycle: args.cycle.clone(),
         out: None,
         solver: DEFAULT_METHOD.name().into(),

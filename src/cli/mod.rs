@@ -8,6 +8,8 @@ use clap::{Parser, Subcommand};
 mod bench;
 mod run;
 mod steady;
+mod study;
+mod validate;
 
 use geartherm::model::{self, Gearbox, ModelError};
 use geartherm::physics::oil::KELVIN_OFFSET;
@@ -37,11 +39,15 @@ pub enum Command {
     Check {
         /// Model file (TOML).
         model: PathBuf,
+        #[command(flatten)]
+        set: SetArgs,
     },
     /// Gear states with ratios, member speeds per unit input, meshes with contact ratios, immersion.
     Info {
         /// Model file (TOML).
         model: PathBuf,
+        #[command(flatten)]
+        set: SetArgs,
         /// Print one JSON document instead of tables.
         #[arg(long)]
         json: bool,
@@ -50,6 +56,8 @@ pub enum Command {
     Losses {
         /// Model file (TOML).
         model: PathBuf,
+        #[command(flatten)]
+        set: SetArgs,
         /// Gear state name (e.g. 3, R).
         #[arg(long)]
         gear: String,
@@ -73,14 +81,41 @@ pub enum Command {
     Steady(steady::SteadyArgs),
     /// Equilibria over a speed × torque grid (map.csv and heat maps).
     Map(steady::MapArgs),
+    /// Design study: every sample of a parameter plan on cycles or operating points, in
+    /// parallel; resumable; writes study.csv, study.parquet, main_effects.png, pareto.png.
+    Study(study::StudyArgs),
     /// Work-precision study: every solver over rtol 1e-3 … 1e-10 against a 1e-12 reference;
     /// writes bench.csv, bench.json and work_precision.png.
     Bench(bench::BenchArgs),
+    /// Every reference case under DIR with every applicable loss model: validation.csv,
+    /// per-source summary, parity and error-vs-speed plots (docs/validation.md).
+    Validate(validate::ValidateArgs),
     /// PNG plots and report.md from an existing output directory (a run, a map or a bench).
     Report {
         /// Directory with timeseries.csv + summary.json, map.csv, or bench.csv.
         dir: PathBuf,
     },
+}
+
+/// `--set PATH=VALUE`: model values overridden by key path (repeatable).
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct SetArgs {
+    /// Override a model value by its key path, e.g. --set lubrication.oil_level_mm=55,
+    /// --set 'oil.catalogue="fva_3a"', --set 'thermal.links["housing-air"].area_m2=0.9'
+    /// (the value is TOML; repeatable; checked like the file).
+    #[arg(long = "set", value_name = "PATH=VALUE", value_parser = parse_set)]
+    pub set: Vec<model::Override>,
+}
+
+fn parse_set(s: &str) -> Result<model::Override, String> {
+    s.parse()
+}
+
+impl SetArgs {
+    /// Load the model file with these overrides.
+    pub fn load(&self, path: &std::path::Path) -> Result<Gearbox, ModelError> {
+        model::load_with(path, &self.set)
+    }
 }
 
 /// A failure with its exit code and message.
@@ -218,8 +253,8 @@ fn report(dir: &std::path::Path) -> Result<(), Failure> {
 /// Run a parsed command line.
 pub fn run(cli: Cli) -> Result<(), Failure> {
     match cli.command {
-        Command::Check { model } => {
-            let gb = model::load(&model)?;
+        Command::Check { model, set } => {
+            let gb = set.load(&model)?;
             println!(
                 "{}: ok ({} gears, {} meshes, {} gear states)",
                 model.display(),
@@ -229,8 +264,8 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             );
             Ok(())
         }
-        Command::Info { model, json } => {
-            let gb = model::load(&model)?;
+        Command::Info { model, set, json } => {
+            let gb = set.load(&model)?;
             let report = info::info(&gb);
             if json {
                 print_json(&report)?;
@@ -241,13 +276,14 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         }
         Command::Losses {
             model,
+            set,
             gear,
             speed_rpm,
             torque_nm,
             oil_temp_c,
             json,
         } => {
-            let gb = model::load(&model)?;
+            let gb = set.load(&model)?;
             let state = state_index(&gb, &gear)?;
             check_range("--speed-rpm", speed_rpm, 0.0, 50_000.0, " rpm")?;
             check_range("--torque-nm", torque_nm, 0.0, 1e6, " N m")?;
@@ -282,6 +318,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
                     ),
                 });
             }
+            geartherm::scene::ranges::print_warnings(&report.warnings);
             if json {
                 print_json(&report)?;
             } else {
@@ -291,10 +328,13 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         }
         Command::Report { dir } => report(&dir),
         Command::Bench(args) => bench::bench(&args),
+        Command::Study(args) => study::study(&args),
+        Command::Validate(args) => validate::validate(&args),
         Command::Steady(args) => steady::steady(&args),
         Command::Map(args) => steady::map(&args),
         Command::Run(args) => {
             let outcome = run::run(&args)?;
+            geartherm::scene::ranges::print_warnings(&outcome.summary.warnings);
             if args.json {
                 print_json(&outcome.summary)?;
             } else {

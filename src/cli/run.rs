@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use geartherm::cycle::DriveCycle;
 use geartherm::cycle::Schedule;
-use geartherm::model::{self, Gearbox};
+use geartherm::model::Gearbox;
 use geartherm::physics::oil::KELVIN_OFFSET;
 use geartherm::report::files::OutputDir;
 use geartherm::report::run::{check_finite, summary, timeseries_csv, Summary};
@@ -20,6 +20,8 @@ use super::{check_range, invalid, Failure, EXIT_IO, EXIT_NUMERICAL};
 pub struct RunArgs {
     /// Model file (TOML).
     pub model: PathBuf,
+    #[command(flatten)]
+    pub set: super::SetArgs,
     /// Bundled cycle name (wltc, nedc, ftp75, udds, hwfet, us06, artemis_urban, artemis_road,
     /// artemis_motorway130, artemis_motorway150) or a CSV file (vehicle or rig cycle).
     #[arg(long, default_value = "wltc")]
@@ -103,7 +105,7 @@ fn stem(p: &Path) -> String {
 /// Load, check, schedule the cycle, compile the scene for it: everything that can fail with
 /// exit 1.
 pub fn prepare(args: &RunArgs) -> Result<Prepared, Failure> {
-    let gb = model::load(&args.model)?;
+    let gb = args.set.load(&args.model)?;
     let method = Method::parse(&args.solver).ok_or_else(|| {
         invalid(format!(
             "--solver {}: unknown; allowed: {}",
@@ -264,11 +266,9 @@ pub fn to_text(o: &RunOutcome) -> String {
     ));
     let e = &s.energy_lost_j;
     t.push_str(&format!(
-        "energy lost: churning {:.1} kJ, pocketing {:.2} kJ, sliding {:.1} kJ, total {:.1} kJ\n",
-        e.churning / 1e3,
-        e.pocketing / 1e3,
-        e.sliding / 1e3,
-        e.total / 1e3
+        "energy lost: {}, total {:.1} kJ\n",
+        e.text(1e-3, "kJ", 2),
+        e.sum() / 1e3
     ));
     t.push_str(&format!(
         "energy balance residual {:.2e} (relative); cycle efficiency (energy-weighted) {}\n",

@@ -5,8 +5,9 @@ use std::collections::BTreeMap;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use geartherm::model::{self, Gearbox};
+use geartherm::model::Gearbox;
 use geartherm::physics::oil::KELVIN_OFFSET;
+use geartherm::report::sources::SourceValues;
 use geartherm::scene::{Inputs, Needs, Scene};
 use geartherm::solve::equilibrium::equilibrium;
 use geartherm::solve::steady::SteadyOptions;
@@ -19,6 +20,8 @@ use super::{check_range, invalid, print_json, state_index, Failure, EXIT_IO, EXI
 pub struct PointArgs {
     /// Model file (TOML).
     pub model: PathBuf,
+    #[command(flatten)]
+    pub set: super::SetArgs,
     /// Gear state name.
     #[arg(long)]
     pub gear: String,
@@ -69,7 +72,7 @@ pub struct MapArgs {
 }
 
 fn prepare(p: &PointArgs) -> Result<(Gearbox, Scene, usize), Failure> {
-    let gb = model::load(&p.model)?;
+    let gb = p.set.load(&p.model)?;
     let state = state_index(&gb, &p.gear)?;
     check_range("--vehicle-speed-kmh", p.vehicle_speed_kmh, 0.0, 400.0, " km/h")?;
     // Scene pruning: only this gear state's active items are compiled.
@@ -110,13 +113,14 @@ struct SteadyReport {
     torque_nm: f64,
     temperatures_c: BTreeMap<String, f64>,
     losses_w: BTreeMap<String, f64>,
-    by_source_w: BTreeMap<&'static str, f64>,
+    by_source_w: SourceValues,
     total_loss_w: f64,
     efficiency: Option<f64>,
     iterations: usize,
     ptc_iterations: usize,
     method: &'static str,
     residual_w: f64,
+    warnings: Vec<geartherm::scene::RangeWarning>,
 }
 
 /// Run `steady`.
@@ -171,18 +175,29 @@ pub fn steady(a: &SteadyArgs) -> Result<(), Failure> {
         torque_nm: a.torque_nm,
         temperatures_c: temps,
         losses_w: losses,
-        by_source_w: BTreeMap::from([
-            ("churning", eq.by_source[0]),
-            ("pocketing", eq.by_source[1]),
-            ("sliding", eq.by_source[2]),
-        ]),
+        by_source_w: SourceValues::new(eq.by_source, "", false),
         total_loss_w: total,
         efficiency: eq.efficiency,
         iterations: eq.solution.iterations,
         ptc_iterations: eq.solution.ptc_iterations,
         method: eq.solution.method,
         residual_w: eq.solution.residual_w,
+        warnings: {
+            let mut log = geartherm::scene::RangeLog::new(&scene.losses);
+            let t_oil = eq.solution.temperatures[scene.thermal.oil];
+            log.check(
+                &scene.losses,
+                &geartherm::scene::OperatingPoint {
+                    state,
+                    input_speed: a.speed_rpm * std::f64::consts::PI / 30.0,
+                    input_torque: a.torque_nm,
+                    oil: scene.thermal.oil_properties(t_oil),
+                },
+            );
+            log.warnings(&scene.losses)
+        },
     };
+    geartherm::scene::ranges::print_warnings(&r.warnings);
     if a.json {
         return print_json(&r);
     }
@@ -199,10 +214,8 @@ pub fn steady(a: &SteadyArgs) -> Result<(), Failure> {
         println!("  {n:<44} {q:>10.3}");
     }
     println!(
-        "  churning {:.2} W, pocketing {:.2} W, sliding {:.2} W, total {:.2} W; efficiency {}",
-        eq.by_source[0],
-        eq.by_source[1],
-        eq.by_source[2],
+        "  {}, total {:.2} W; efficiency {}",
+        r.by_source_w.text(1.0, "W", 2),
         total,
         r.efficiency.map_or("n/a".into(), |e| format!("{e:.5}"))
     );

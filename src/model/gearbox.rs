@@ -14,8 +14,9 @@ use crate::physics::losses::sliding::{friction::Schlenk, SlidingOptions};
 pub struct PocketingOptions {
     /// Discharge coefficient C_d.
     pub discharge_coefficient: f64,
-    /// Density of the oil–air mixture pumped by a mesh above the oil level, kg/m³.
-    pub mixture_density: f64,
+    /// Density pumped by the part of a mesh zone above the oil level, kg/m³; `None` (default):
+    /// unknown, that part is not counted and is reported in `warnings` (docs/validation.md).
+    pub mixture_density: Option<f64>,
 }
 
 /// Sliding-loss model choice.
@@ -87,6 +88,8 @@ pub struct Gear {
     pub centre_height: f64,
     /// Depth of the gear's lowest point below the static oil level, m (≤ 0: not immersed).
     pub immersion: f64,
+    /// Axial position of the face-width centre along its member (planets: along the pin), m.
+    pub position: f64,
 }
 
 impl Gear {
@@ -217,6 +220,16 @@ pub struct Gearbox {
     pub thermal: Option<super::thermal::ThermalNetwork>,
     /// The vehicle (`[vehicle]`), if the model has one.
     pub vehicle: Option<crate::cycle::Vehicle>,
+    /// Friction packs of shift elements (`[[clutch_packs]]`): drag while open.
+    pub clutch_packs: Vec<super::automatic::ClutchPackModel>,
+    /// The oil pump (`[pump]`), if any.
+    pub pump: Option<super::automatic::PumpModel>,
+    /// The launch device (`[launch]`), if any: torque converter with lock-up.
+    pub launch: Option<crate::cycle::LaunchDevice>,
+    /// Rolling bearings (`[[bearings]]`).
+    pub bearings: Vec<super::bearings::Bearing>,
+    /// Shaft seals (`[[seals]]`).
+    pub seals: Vec<super::bearings::Seal>,
 }
 
 impl Gearbox {

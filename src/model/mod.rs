@@ -3,18 +3,23 @@
 //! `load` is the only place that reads a model file; everything below works on the checked
 //! [`Gearbox`].
 
+pub mod automatic;
+pub mod bearings;
 pub mod catalogue;
 pub mod gearbox;
 pub mod losses;
+pub mod overrides;
 pub mod parse;
 pub mod problems;
 pub mod schema;
+pub mod source;
 pub mod thermal;
 pub mod validate;
 
 use std::path::{Path, PathBuf};
 
 pub use gearbox::Gearbox;
+pub use overrides::{KeyPath, Override};
 pub use problems::{Problem, Problems};
 
 /// A model file that could not be read or did not validate.
@@ -66,6 +71,78 @@ pub fn from_str(text: &str, file: &Path) -> Result<Gearbox, ModelError> {
             problems: problems.into_vec(),
         }),
     }
+}
+
+/// Parse model text, apply `overrides` (key path = value) to the document, then deserialize and
+/// validate it as if the values had been written in the file. A problem at (or inside, or above)
+/// an overridden path names the override; a model made invalid by overrides lists them.
+pub fn from_str_with(text: &str, file: &Path, overrides: &[Override]) -> Result<Gearbox, ModelError> {
+    if overrides.is_empty() {
+        return from_str(text, file);
+    }
+    let mut problems = Problems::default();
+    let invalid = |problems: Problems| ModelError::Invalid {
+        file: file.to_path_buf(),
+        problems: problems.into_vec(),
+    };
+    let Some(mut doc) = parse::parse_document(text, &mut problems) else {
+        return Err(invalid(problems));
+    };
+    let mut applied = Vec::with_capacity(overrides.len());
+    for ov in overrides {
+        match overrides::apply(&mut doc, ov) {
+            Ok(canon) => applied.push((canon, ov.to_string())),
+            Err(msg) => problems.push(ov.path.to_string(), &ov.value, msg),
+        }
+    }
+    if !problems.is_empty() {
+        return Err(invalid(problems));
+    }
+    let parsed = parse::parse_table(doc, &mut problems);
+    let gearbox = parsed.and_then(|f| validate::validate(&f, &mut problems));
+    match gearbox {
+        Some(g) if problems.is_empty() => Ok(g),
+        _ => Err(invalid(annotate(problems, &applied))),
+    }
+}
+
+/// Name the override behind each problem it concerns; when none does, list every override.
+fn annotate(problems: Problems, applied: &[(String, String)]) -> Problems {
+    let mut list = problems.into_vec();
+    let mut any = false;
+    for p in &mut list {
+        let by: Vec<&str> = applied
+            .iter()
+            .filter(|(canon, _)| overrides::concerns(&p.path, canon))
+            .map(|(_, text)| text.as_str())
+            .collect();
+        if !by.is_empty() {
+            any = true;
+            p.allowed
+                .push_str(&format!(" (set by override `{}`)", by.join("`, `")));
+        }
+    }
+    if !any {
+        let all: Vec<&str> = applied.iter().map(|(_, t)| t.as_str()).collect();
+        for p in &mut list {
+            p.allowed
+                .push_str(&format!(" (with overrides `{}`)", all.join("`, `")));
+        }
+    }
+    let mut out = Problems::default();
+    for p in list {
+        out.push(p.path, p.value, p.allowed);
+    }
+    out
+}
+
+/// Read a model file and apply overrides (see [`from_str_with`]).
+pub fn load_with(path: &Path, overrides: &[Override]) -> Result<Gearbox, ModelError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ModelError::Io {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    from_str_with(&text, path, overrides)
 }
 
 /// Read, parse and validate a model file.

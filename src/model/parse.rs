@@ -25,6 +25,11 @@ const SECTIONS: &[&str] = &[
     "losses",
     "thermal",
     "vehicle",
+    "clutch_packs",
+    "pump",
+    "launch",
+    "bearings",
+    "seals",
 ];
 
 /// Line and column (1-based) of a byte offset.
@@ -200,8 +205,14 @@ fn check_names(value: &Value, path: &str, problems: &mut Problems) {
 /// Parse model-file text. Returns the file when every section deserialized, else `None`, with all
 /// problems found recorded in `problems`.
 pub fn parse_model(text: &str, problems: &mut Problems) -> Option<ModelFile> {
-    let mut table: Table = match text.parse() {
-        Ok(t) => t,
+    let table = parse_document(text, problems)?;
+    parse_table(table, problems)
+}
+
+/// Parse model-file text as a plain TOML document (syntax errors carry line and column).
+pub fn parse_document(text: &str, problems: &mut Problems) -> Option<Table> {
+    match text.parse() {
+        Ok(t) => Some(t),
         Err(e) => {
             let e: toml::de::Error = e;
             let where_ = e
@@ -212,9 +223,13 @@ pub fn parse_model(text: &str, problems: &mut Problems) -> Option<ModelFile> {
                 })
                 .unwrap_or_else(|| "unknown position".into());
             problems.push("", "", format!("TOML syntax error at {where_}: {}", e.message()));
-            return None;
+            None
         }
-    };
+    }
+}
+
+/// A parsed TOML document → [`ModelFile`], every section's type errors reported at once.
+pub fn parse_table(mut table: Table, problems: &mut Problems) -> Option<ModelFile> {
     let unknown: Vec<String> = table
         .keys()
         .filter(|k| !SECTIONS.contains(&k.as_str()))
@@ -242,6 +257,11 @@ pub fn parse_model(text: &str, problems: &mut Problems) -> Option<ModelFile> {
     let losses = section::<LossesSpec>(&mut table, "losses", false, problems);
     let thermal = section::<super::thermal::ThermalSpec>(&mut table, "thermal", false, problems);
     let vehicle = section::<Table>(&mut table, "vehicle", false, problems);
+    let clutch_packs = array::<super::automatic::ClutchPackSpec>(&mut table, "clutch_packs", false, problems);
+    let pump = section::<super::automatic::PumpSpec>(&mut table, "pump", false, problems);
+    let launch = section::<Table>(&mut table, "launch", false, problems);
+    let bearings = array::<super::bearings::BearingSpec>(&mut table, "bearings", false, problems);
+    let seals = array::<super::bearings::SealSpec>(&mut table, "seals", false, problems);
     if problems.len() > before || !problems.is_empty() {
         return None;
     }
@@ -259,6 +279,11 @@ pub fn parse_model(text: &str, problems: &mut Problems) -> Option<ModelFile> {
         losses,
         thermal,
         vehicle,
+        clutch_packs,
+        pump,
+        launch,
+        bearings,
+        seals,
     })
 }
 

@@ -116,6 +116,10 @@ pub struct GearSpecFile {
     /// `true` for an internal (ring) gear.
     #[serde(default)]
     pub internal: bool,
+    /// Axial position of the face-width centre along the member (planets: along the pin), mm
+    /// (default 0; bearing loads use it).
+    #[serde(default)]
+    pub position_mm: Option<f64>,
 }
 
 /// External or internal mesh.
@@ -280,6 +284,9 @@ pub struct LossesSpec {
     /// Spur load sharing: `uniform` (default), `33:67`, `45:55`, `ramp`.
     #[serde(default)]
     pub load_sharing: Option<String>,
+    /// Line-load distribution of helical meshes: `niemann_richer` (default) or `uniform`.
+    #[serde(default)]
+    pub helical_distribution: Option<String>,
     /// `first_order` (default, μ·F·v_g) or `moment_balance` (seed 003).
     #[serde(default)]
     pub loss_form: Option<String>,
@@ -295,7 +302,7 @@ pub struct LossesSpec {
     /// Pocketing discharge coefficient C_d (default 0.65).
     #[serde(default)]
     pub pocketing_discharge_coefficient: Option<f64>,
-    /// Density of the oil–air mixture pumped by a mesh above the oil level, kg/m³ (default 10).
+    /// Density of the oil–air mixture pumped by a mesh above the oil level, kg/m³ (no default: unknown, not counted, warned).
     #[serde(default)]
     pub pocketing_mixture_density_kg_m3: Option<f64>,
     /// Seetharaman–Kahraman: face transition Reynolds number (default 5e5).
@@ -353,4 +360,19 @@ pub struct ModelFile {
     /// `[vehicle]` (reserved: vehicle and shift strategy; read by the transient issue).
     #[serde(default)]
     pub vehicle: Option<toml::Table>,
+    /// `[[clutch_packs]]`: friction packs of shift elements (open-clutch drag).
+    #[serde(default)]
+    pub clutch_packs: Vec<super::automatic::ClutchPackSpec>,
+    /// `[pump]`: the transmission oil pump.
+    #[serde(default)]
+    pub pump: Option<super::automatic::PumpSpec>,
+    /// `[launch]`: torque converter between engine and gearbox input (checked by the cycle layer).
+    #[serde(default)]
+    pub launch: Option<toml::Table>,
+    /// `[[bearings]]`.
+    #[serde(default)]
+    pub bearings: Vec<super::bearings::BearingSpec>,
+    /// `[[seals]]`.
+    #[serde(default)]
+    pub seals: Vec<super::bearings::SealSpec>,
 }

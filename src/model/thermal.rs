@@ -10,6 +10,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use super::problems::Problems;
+use super::source::{Source, N_SOURCES};
 use crate::physics::oil::KELVIN_OFFSET;
 use crate::physics::thermal::{HTable, STEFAN_BOLTZMANN};
 
@@ -188,6 +189,11 @@ pub struct CoolerSpec {
     /// Optional thermostat on the hot side.
     #[serde(default)]
     pub thermostat: Option<ThermostatSpec>,
+    /// Two-way exchanger (ATF warmer/cooler): while the cold side is warmer than the hot side
+    /// the exchanger is fully open and heats the oil (the thermostat throttles only the cooling
+    /// direction). Default false: a cooler that never heats.
+    #[serde(default)]
+    pub two_way: bool,
     /// Where the numbers come from.
     #[serde(default)]
     pub note: Option<String>,
@@ -338,6 +344,8 @@ pub struct Cooler {
     pub conductance: f64,
     /// Thermostat (open, full) in K.
     pub thermostat: Option<(f64, f64)>,
+    /// Heats the oil, fully open, while the cold side is the warmer one.
+    pub two_way: bool,
 }
 
 /// What a heat rule applies to.
@@ -395,7 +403,32 @@ impl ThermalNetwork {
 /// Default initial temperature, °C (a cold start in a test cell).
 pub const DEFAULT_INITIAL_TEMP_C: f64 = 23.0;
 
-const SOURCES: [&str; 3] = ["churning", "pocketing", "sliding"];
+/// Names of the loss items of each source that heat rules may name (`"<source>:<name>"`):
+/// gears for churning, meshes for pocketing and sliding, the model's bearings, seals, ….
+#[derive(Debug, Clone, Default)]
+pub struct LossItemNames<'a> {
+    /// Item names per source, indexed by [`Source::index`].
+    pub by_source: [Vec<&'a str>; N_SOURCES],
+}
+
+impl<'a> LossItemNames<'a> {
+    /// Item names of source `s`.
+    pub fn of(&self, s: Source) -> &[&'a str] {
+        &self.by_source[s.index()]
+    }
+
+    /// Set the item names of source `s`.
+    pub fn set(&mut self, s: Source, names: impl IntoIterator<Item = &'a str>) {
+        self.by_source[s.index()] = names.into_iter().collect();
+    }
+
+    /// True if `item` is `<source>:<name>` with a known source and name.
+    fn knows(&self, item: &str) -> bool {
+        item.split_once(':')
+            .and_then(|(s, n)| Source::parse(s).map(|s| self.of(s).contains(&n)))
+            .unwrap_or(false)
+    }
+}
 
 fn is_identifier(s: &str) -> bool {
     !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
@@ -415,11 +448,12 @@ pub struct GearInfo<'a> {
     pub face_width: f64,
 }
 
-/// Validate `[thermal]` against the gears (names, radii) and meshes (names) of the model.
+/// Validate `[thermal]` against the gears (names, radii) and the loss items (names per source)
+/// of the model.
 pub fn validate_thermal(
     spec: &ThermalSpec,
     gears: &[GearInfo<'_>],
-    meshes: &[&str],
+    items: &LossItemNames<'_>,
     problems: &mut Problems,
 ) -> Option<ThermalNetwork> {
     let start = problems.len();
@@ -750,6 +784,7 @@ pub fn validate_thermal(
                 cold,
                 conductance: c.effectiveness * c.capacity_rate_w_per_k,
                 thermostat,
+                two_way: c.two_way,
             });
         }
     }
@@ -781,23 +816,23 @@ pub fn validate_thermal(
         let p = format!("thermal.heat[{i}]");
         let target = match (&h.item, &h.source) {
             (Some(item), None) => {
-                let ok = match item.split_once(':') {
-                    Some(("churning", g)) => gears.iter().any(|x| x.name == g),
-                    Some(("pocketing" | "sliding", m)) => meshes.contains(&m),
-                    _ => false,
-                };
-                if !ok {
+                if !items.knows(item) {
                     problems.push(
                         format!("{p}.item"),
                         item,
-                        "must be churning:<gear>, pocketing:<mesh> or sliding:<mesh> with a gear/mesh of the model",
+                        "must be <source>:<name> with a loss item of the model (churning:<gear>, \
+                         pocketing:<mesh>, sliding:<mesh>, bearing:<bearing>, seal:<seal>, …)",
                     );
                 }
                 HeatTarget::Item(item.clone())
             }
             (None, Some(s)) => {
-                if !SOURCES.contains(&s.as_str()) {
-                    problems.push(format!("{p}.source"), s, "must be churning, pocketing or sliding");
+                if Source::parse(s).is_none() {
+                    problems.push(
+                        format!("{p}.source"),
+                        s,
+                        format!("must be one of {}", Source::names()),
+                    );
                 }
                 HeatTarget::Source(s.clone())
             }

@@ -442,9 +442,35 @@ fn exchange(_a: &Path, _b: &Path) -> bool {
     false
 }
 
+/// Write `files` (name, contents) into `dir` file by file: each is written to a temporary file
+/// (usual mode) in `dir` and all are renamed into place only when every one was written; other
+/// files in `dir` stay. For a directory that is not replaced as a whole (`study` writes its
+/// cases and journal beside `study.csv`); a result set uses [`replace_all_atomic`].
+pub fn write_all_atomic(dir: &Path, files: &[(&str, &[u8])]) -> std::io::Result<Vec<PathBuf>> {
+    fs::create_dir_all(dir)?;
+    let mut temps = Vec::with_capacity(files.len());
+    for (name, bytes) in files {
+        let prefix = format!(".{name}.");
+        let mut b = tempfile::Builder::new();
+        b.prefix(&prefix).suffix(".tmp");
+        #[cfg(unix)]
+        b.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+        let mut tmp = b.tempfile_in(dir)?;
+        tmp.write_all(bytes)?;
+        tmp.as_file().sync_all()?;
+        temps.push((tmp, dir.join(name)));
+    }
+    let mut out = Vec::with_capacity(temps.len());
+    for (tmp, dest) in temps {
+        tmp.persist(&dest).map_err(|e| e.error)?;
+        out.push(dest);
+    }
+    Ok(out)
+}
+
 /// Write `files` (name, contents) into `dir` as one transaction ([`OutputDir`]): `dir` then
 /// holds exactly these files (and the marker); on any error it keeps what it held.
-pub fn write_all_atomic(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<PathBuf>, OutputError> {
+pub fn replace_all_atomic(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<PathBuf>, OutputError> {
     let out = OutputDir::begin(dir)?;
     let mut paths = Vec::with_capacity(files.len());
     for (name, bytes) in files {
@@ -471,7 +497,7 @@ mod tests {
     fn writes_files_and_leaves_no_temporaries() {
         let d = tempfile::tempdir().unwrap();
         let sub = d.path().join("run");
-        let paths = write_all_atomic(&sub, &[("a.txt", b"one"), ("b.txt", b"two")]).unwrap();
+        let paths = replace_all_atomic(&sub, &[("a.txt", b"one"), ("b.txt", b"two")]).unwrap();
         assert_eq!(paths.len(), 2);
         assert_eq!(fs::read(sub.join("a.txt")).unwrap(), b"one");
         assert_eq!(names(&sub), [MARKER, "a.txt", "b.txt"]);
@@ -482,8 +508,8 @@ mod tests {
     fn a_new_result_replaces_the_old_set_as_a_whole() {
         let d = tempfile::tempdir().unwrap();
         let sub = d.path().join("run");
-        write_all_atomic(&sub, &[("a.txt", b"one"), ("b.txt", b"two")]).unwrap();
-        write_all_atomic(&sub, &[("a.txt", b"three")]).unwrap();
+        replace_all_atomic(&sub, &[("a.txt", b"one"), ("b.txt", b"two")]).unwrap();
+        replace_all_atomic(&sub, &[("a.txt", b"three")]).unwrap();
         assert_eq!(names(&sub), [MARKER, "a.txt"], "b.txt of the old set is gone");
         assert_eq!(fs::read(sub.join("a.txt")).unwrap(), b"three");
     }
@@ -492,7 +518,7 @@ mod tests {
     fn an_uncommitted_transaction_leaves_the_old_set() {
         let d = tempfile::tempdir().unwrap();
         let sub = d.path().join("run");
-        write_all_atomic(&sub, &[("a.txt", b"one")]).unwrap();
+        replace_all_atomic(&sub, &[("a.txt", b"one")]).unwrap();
         {
             let out = OutputDir::begin(&sub).unwrap();
             out.write("a.txt", b"half").unwrap();
@@ -517,11 +543,11 @@ mod tests {
     fn stale_temporaries_of_a_dead_writer_are_removed() {
         let d = tempfile::tempdir().unwrap();
         let sub = d.path().join("run");
-        write_all_atomic(&sub, &[("a.txt", b"one")]).unwrap();
+        replace_all_atomic(&sub, &[("a.txt", b"one")]).unwrap();
         let stale = d.path().join(".run.geartherm-tmp-1-2");
         fs::create_dir(&stale).unwrap();
         fs::write(stale.join("timeseries.csv"), b"x").unwrap();
-        write_all_atomic(&sub, &[("a.txt", b"two")]).unwrap();
+        replace_all_atomic(&sub, &[("a.txt", b"two")]).unwrap();
         assert_eq!(names(d.path()), ["run"]);
     }
 
@@ -553,7 +579,7 @@ mod tests {
         fs::create_dir(&sub).unwrap();
         fs::write(sub.join("summary.json"), b"{}").unwrap();
         fs::write(sub.join(".timeseries.csv.abc.tmp"), b"partial").unwrap();
-        write_all_atomic(&sub, &[("summary.json", b"{\"a\":1}")]).unwrap();
+        replace_all_atomic(&sub, &[("summary.json", b"{\"a\":1}")]).unwrap();
         assert_eq!(names(&sub), [MARKER, "summary.json"]);
     }
 
@@ -563,7 +589,7 @@ mod tests {
         use std::os::unix::fs::PermissionsExt;
         let d = tempfile::tempdir().unwrap();
         let sub = d.path().join("run");
-        write_all_atomic(&sub, &[("a.txt", b"one")]).unwrap();
+        replace_all_atomic(&sub, &[("a.txt", b"one")]).unwrap();
         let mode = fs::metadata(sub.join("a.txt")).unwrap().permissions().mode() & 0o777;
         let dmode = fs::metadata(&sub).unwrap().permissions().mode() & 0o777;
         // The test process's umask is at most 0o077 in any sane environment; a 0600 file or a

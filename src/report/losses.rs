@@ -5,18 +5,9 @@ use std::fmt::Write as _;
 use serde::Serialize;
 
 use crate::model::Gearbox;
-use crate::scene::{LossScene, OperatingPoint, Skipped, Source};
+use crate::scene::{sum_by_source, LossScene, OperatingPoint, RangeLog, RangeWarning, Skipped, Source};
 
-/// Per-source totals, W.
-#[derive(Debug, Serialize, Default)]
-pub struct BySource {
-    /// Churning, W.
-    pub churning_w: f64,
-    /// Pocketing, W.
-    pub pocketing_w: f64,
-    /// Sliding, W.
-    pub sliding_w: f64,
-}
+use super::sources::SourceValues;
 
 /// One loss item.
 #[derive(Debug, Serialize)]
@@ -55,26 +46,21 @@ pub struct LossReport {
     /// P_out/(P_out + P_loss) with P_out the loss-free power T·ω (`physics::efficiency`);
     /// null when no power is transmitted.
     pub efficiency: Option<f64>,
-    /// Totals per source.
-    pub by_source: BySource,
+    /// Totals per source (`<source>_w`).
+    pub by_source: SourceValues,
     /// Every item.
     pub items: Vec<ItemReport>,
     /// What the scene left out.
     pub skipped: Vec<Skipped>,
+    /// Loss models used outside their fitted range at this point, items not counted.
+    pub warnings: Vec<RangeWarning>,
 }
 
 /// Evaluate the scene at `op` and build the report.
 pub fn losses(gb: &Gearbox, scene: &LossScene, op: &OperatingPoint, oil_temp_c: f64) -> LossReport {
     let mut out = vec![0.0; scene.len()];
     scene.evaluate(op, &mut out);
-    let mut by = BySource::default();
-    for (it, w) in scene.items.iter().zip(&out) {
-        match it.source {
-            Source::Churning => by.churning_w += w,
-            Source::Pocketing => by.pocketing_w += w,
-            Source::Sliding => by.sliding_w += w,
-        }
-    }
+    let by = SourceValues::new(sum_by_source(&scene.items, &out), "_w", false);
     let total: f64 = out.iter().sum();
     let p_in = op.input_torque * op.input_speed;
     // The loss items are evaluated at the loss-free torque: T·ω is the power delivered to the
@@ -106,6 +92,11 @@ pub fn losses(gb: &Gearbox, scene: &LossScene, op: &OperatingPoint, oil_temp_c: 
             })
             .collect(),
         skipped: scene.skipped.clone(),
+        warnings: {
+            let mut log = RangeLog::new(scene);
+            log.check(scene, op);
+            log.warnings(scene)
+        },
     }
 }
 
@@ -128,10 +119,17 @@ pub fn to_text(r: &LossReport) -> String {
     for it in &r.items {
         let _ = writeln!(s, "  {:<10} {:<32} {:>12.3}", it.source.as_str(), it.name, it.w);
     }
-    let _ = writeln!(s, "\n  churning  {:>12.3} W", r.by_source.churning_w);
-    let _ = writeln!(s, "  pocketing {:>12.3} W", r.by_source.pocketing_w);
-    let _ = writeln!(s, "  sliding   {:>12.3} W", r.by_source.sliding_w);
-    let _ = writeln!(s, "  total     {:>12.3} W", r.total_w);
+    let _ = writeln!(s);
+    for src in Source::ALL {
+        let w = r.by_source.get(src);
+        let share = if r.total_w > 0.0 {
+            100.0 * w / r.total_w
+        } else {
+            0.0
+        };
+        let _ = writeln!(s, "  {:<10}{:>12.3} W  {:>5.1} %", src.as_str(), w, share);
+    }
+    let _ = writeln!(s, "  {:<10}{:>12.3} W", "total", r.total_w);
     let _ = writeln!(
         s,
         "  efficiency {}",

@@ -1,32 +1,44 @@
 //! `map.csv`: one row per grid point of an operating map (the contract `report::plots` reads).
 
 use crate::physics::oil::KELVIN_OFFSET;
+use crate::scene::N_SOURCES;
 use crate::solve::sweep::MapPoint;
+
+use super::sources::csv_columns;
 
 /// `map.csv` text; `oil` is the oil node index. Points without equilibrium have empty fields and
 /// `converged = false`.
 pub fn map_csv(points: &[MapPoint], oil: usize) -> String {
-    let mut csv = String::from(
-        "speed_rpm,torque_nm,efficiency,total_loss_w,churning_w,pocketing_w,sliding_w,oil_temp_c,iterations,converged\n",
+    let mut csv = format!(
+        "speed_rpm,torque_nm,efficiency,total_loss_w,{},oil_temp_c,iterations,converged\n",
+        csv_columns()
     );
     for p in points {
         match &p.equilibrium {
             Some(e) => {
                 let total: f64 = e.by_source.iter().sum();
                 csv.push_str(&format!(
-                    "{},{},{},{},{},{},{},{},{},true\n",
+                    "{},{},{},{},",
                     p.speed_rpm,
                     p.torque_nm,
                     e.efficiency.map_or(String::new(), |x| x.to_string()),
                     total,
-                    e.by_source[0],
-                    e.by_source[1],
-                    e.by_source[2],
+                ));
+                for v in e.by_source {
+                    csv.push_str(&format!("{v},"));
+                }
+                csv.push_str(&format!(
+                    "{},{},true\n",
                     e.solution.temperatures[oil] - KELVIN_OFFSET,
                     e.solution.iterations + e.solution.ptc_iterations
                 ));
             }
-            None => csv.push_str(&format!("{},{},,,,,,,,false\n", p.speed_rpm, p.torque_nm)),
+            None => csv.push_str(&format!(
+                "{},{},,,{},,,false\n",
+                p.speed_rpm,
+                p.torque_nm,
+                ",".repeat(N_SOURCES)
+            )),
         }
     }
     csv

@@ -5,3 +5,6 @@ pub mod losses;
 pub mod map;
 pub mod plots;
 pub mod run;
+pub mod sources;
+pub mod study;
+pub mod validation;

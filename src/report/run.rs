@@ -9,24 +9,14 @@ use std::fmt::Write as _;
 use serde::Serialize;
 
 use crate::physics::oil::KELVIN_OFFSET;
-use crate::scene::{Scene, Skipped, Source};
+use crate::scene::{
+    sum_by_source, OperatingPoint, RangeLog, RangeWarning, Scene, Skipped, Source, N_SOURCES,
+};
+
+use super::sources::{csv_columns, SourceValues};
 use crate::solve::transient::{energy_balance, Stats, Trajectory};
 
-/// Per-row context the solver does not know: vehicle speed, gear name, input speed and torque,
-/// output power.
-#[derive(Debug, Clone)]
-pub struct RowInputs {
-    /// Vehicle speed, km/h.
-    pub vehicle_speed_kmh: f64,
-    /// Gear-state name.
-    pub gear: String,
-    /// Input speed, rpm.
-    pub input_speed_rpm: f64,
-    /// Loss-free input torque T_out/i, N·m (`timeseries.csv` adds the losses: P_loss/ω_in).
-    pub input_torque_nm: f64,
-    /// Output power, W.
-    pub output_power_w: f64,
-}
+pub use crate::solve::drive::RowInputs;
 
 /// Energy of one loss item.
 #[derive(Debug, Clone, Serialize)]
@@ -59,19 +49,6 @@ pub struct NodeInfo {
     pub boundary: bool,
 }
 
-/// Energy per source, J.
-#[derive(Debug, Clone, Copy, Serialize, Default)]
-pub struct SourceEnergy {
-    /// Churning.
-    pub churning: f64,
-    /// Pocketing.
-    pub pocketing: f64,
-    /// Sliding.
-    pub sliding: f64,
-    /// Sum.
-    pub total: f64,
-}
-
 /// `summary.json`.
 #[derive(Debug, Clone, Serialize)]
 pub struct Summary {
@@ -93,8 +70,8 @@ pub struct Summary {
     pub stats: Stats,
     /// Cycle duration, s.
     pub duration_s: f64,
-    /// Energy lost per source, J.
-    pub energy_lost_j: SourceEnergy,
+    /// Energy lost per source, J (`<source>` keys and `total`).
+    pub energy_lost_j: SourceValues,
     /// Energy per item, J.
     pub energy_by_item_j: Vec<ItemEnergy>,
     /// Heat stored in the nodes, J.
@@ -118,6 +95,27 @@ pub struct Summary {
     pub skipped: Vec<Skipped>,
     /// True when the oil properties were frozen (viscosity feedback off).
     pub frozen_viscosity: bool,
+    /// Loss models used outside their fitted range over the output rows, and items not counted
+    /// (docs/validation.md).
+    pub warnings: Vec<RangeWarning>,
+}
+
+/// Range warnings over the output rows of a run (gear state by name, oil temperature of the row).
+pub fn run_warnings(scene: &Scene, traj: &Trajectory, rows: &[RowInputs]) -> Vec<RangeWarning> {
+    let mut log = RangeLog::new(&scene.losses);
+    for (r, y) in rows.iter().zip(&traj.states) {
+        let Some(state) = scene.losses.state_names.iter().position(|n| *n == r.gear) else {
+            continue;
+        };
+        let op = OperatingPoint {
+            state,
+            input_speed: r.input_speed_rpm * std::f64::consts::PI / 30.0,
+            input_torque: r.input_torque_nm,
+            oil: scene.thermal.oil_properties(scene.oil_temp(y)),
+        };
+        log.check(&scene.losses, &op);
+    }
+    log.warnings(&scene.losses)
 }
 
 /// Build the summary of a run.
@@ -135,16 +133,11 @@ pub fn summary(
     let n = scene.nodes();
     let last = traj.states.last().cloned().unwrap_or_default();
     let by = if last.is_empty() {
-        [0.0; 3]
+        [0.0; N_SOURCES]
     } else {
         scene.loss_energy_by_source(&last)
     };
-    let mut per_source = SourceEnergy {
-        churning: by[0],
-        pocketing: by[1],
-        sliding: by[2],
-        ..SourceEnergy::default()
-    };
+    let per_source = SourceValues::new(by, "", true);
     // Per-item energies only when the scene integrates them (an output that can be switched off).
     let items = scene
         .losses
@@ -162,7 +155,6 @@ pub fn summary(
             })
         })
         .collect();
-    per_source.total = per_source.churning + per_source.pocketing + per_source.sliding;
     let bal = energy_balance(scene, traj);
 
     // Output energy and the loss energy while driving (positive output power), by the trapezoidal
@@ -232,6 +224,7 @@ pub fn summary(
         oil_node: scene.thermal.names[scene.thermal.oil].clone(),
         skipped: scene.skipped.clone(),
         frozen_viscosity: scene.frozen_oil_temp.is_some(),
+        warnings: run_warnings(scene, traj, rows),
     }
 }
 
@@ -258,15 +251,12 @@ pub fn timeseries_csv(
     for it in &scene.losses.items {
         let _ = write!(s, ",loss_{}_{}_w", it.source.as_str(), it.name);
     }
-    s.push_str(",churning_w,pocketing_w,sliding_w,total_loss_w,efficiency\n");
+    let _ = writeln!(s, ",{},total_loss_w,efficiency", csv_columns());
     for (k, t) in traj.times.iter().enumerate() {
         let r = &rows[k];
         let y = &traj.states[k];
-        let mut by = [0.0; 3];
-        for (q, it) in traj.losses[k].iter().zip(&scene.losses.items) {
-            by[it.source.index()] += q;
-        }
-        let total = by[0] + by[1] + by[2];
+        let by = sum_by_source(&scene.losses.items, &traj.losses[k]);
+        let total: f64 = by.iter().sum();
         // The input supplies the transmitted torque and the losses: T_in = T_out/i + P_loss/ω_in
         // (physics spec §9). The loss items themselves are evaluated at the loss-free torque
         // (docs/physics.md §10, "Mesh loads").
@@ -293,7 +283,10 @@ pub fn timeseries_csv(
             s.push(',');
             num(&mut s, *q);
         }
-        let _ = write!(s, ",{},{},{},{}", by[0], by[1], by[2], total);
+        for v in by {
+            let _ = write!(s, ",{v}");
+        }
+        let _ = write!(s, ",{total}");
         s.push(',');
         if let Some(eta) = crate::physics::efficiency::efficiency(r.output_power_w, total) {
             num(&mut s, eta);
@@ -355,16 +348,16 @@ impl Summary {
         let e = &self.energy_lost_j;
         let mut named: Vec<(String, f64)> = vec![
             ("duration_s".into(), self.duration_s),
-            ("energy_lost_j.churning".into(), e.churning),
-            ("energy_lost_j.pocketing".into(), e.pocketing),
-            ("energy_lost_j.sliding".into(), e.sliding),
-            ("energy_lost_j.total".into(), e.total),
+            ("energy_lost_j.total".into(), e.sum()),
             ("energy_stored_j".into(), self.energy_stored_j),
             ("energy_to_boundaries_j".into(), self.energy_to_boundaries_j),
             ("energy_balance_relative".into(), self.energy_balance_relative),
             ("output_energy_j".into(), self.output_energy_j),
             ("cycle_efficiency".into(), self.cycle_efficiency.unwrap_or(0.0)),
         ];
+        for src in Source::ALL {
+            named.push((format!("energy_lost_j.{}", src.as_str()), e.get(src)));
+        }
         for it in &self.energy_by_item_j {
             named.push((
                 format!("energy_by_item_j {}:{}", it.source.as_str(), it.name),

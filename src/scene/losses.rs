@@ -14,40 +14,36 @@ use crate::physics::losses::sliding::friction::Schlenk;
 use crate::physics::losses::sliding::{OilState as SlideOil, PowerLaw, SlidingMesh, SlidingMeshInput};
 use crate::physics::oil::OilProperties;
 
-/// Transverse slices of a helical pocket (physics default 64, itself within 0.3 % of 256; 48 raises
-/// the AT6 pocketing loss by 0.5 % and compiles the scene in 0.39 s instead of 0.65 s).
-pub const HELIX_POCKET_SLICES: usize = 48;
+/// Helical pockets: the exact infinitely-many-slices limit of the connected-slice model (one spur
+/// pocket history summed over phases; was 48 discrete slices, 0.5 % off and 0.35 s per AT6 compile).
+pub const HELIX_POCKET_SLICES: Option<usize> = None;
 
-/// Heat source kind.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Source {
-    /// Oil drag on an immersed gear (load-independent).
-    Churning,
-    /// Oil squeezed out of closing tooth spaces (load-independent).
-    Pocketing,
-    /// Mesh friction (load-dependent).
-    Sliding,
+pub use crate::model::source::{PerSource, Source, N_SOURCES};
+
+/// Sum the values of `items` (W or J, one per item) per source.
+pub fn sum_by_source(items: &[LossItem], values: &[f64]) -> PerSource {
+    let mut by = [0.0; N_SOURCES];
+    for (it, v) in items.iter().zip(values) {
+        by[it.source.index()] += v;
+    }
+    by
 }
 
-impl Source {
-    /// Position in per-source arrays `[churning, pocketing, sliding]`.
-    pub fn index(self) -> usize {
-        match self {
-            Source::Churning => 0,
-            Source::Pocketing => 1,
-            Source::Sliding => 2,
-        }
-    }
-
-    /// Lower-case name.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Source::Churning => "churning",
-            Source::Pocketing => "pocketing",
-            Source::Sliding => "sliding",
-        }
-    }
+/// Where a loss item's heat goes unless a `[[thermal.heat]]` rule says otherwise.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DefaultHeat {
+    /// The oil node (churning, pocketing).
+    Oil,
+    /// The body nodes of the item's gears with their fractions (sliding); a gear in no node
+    /// heats the oil.
+    Gears,
+    /// The body node of a gear on a member (a bearing or seal on that member: its shaft node),
+    /// else the oil node. Gear indices with fractions.
+    Member(Vec<(usize, f64)>),
+    /// Named thermal nodes with fractions, as the model says (e.g. a bearing's shaft and
+    /// housing nodes).
+    Nodes(Vec<(String, f64)>),
 }
 
 /// One loss item: what it is, where its heat goes.
@@ -58,8 +54,11 @@ pub struct LossItem {
     /// Gear name (churning) or mesh name (pocketing, sliding).
     pub name: String,
     /// Gears heated and the fraction each receives (sliding: split between the two gears;
-    /// churning and pocketing: the gear(s) concerned, whose heat goes to the oil by default).
+    /// churning and pocketing: the gear(s) concerned, whose heat goes to the oil by default;
+    /// empty for items that are not gears or meshes).
     pub gears: Vec<(usize, f64)>,
+    /// Default heat destination.
+    pub heat: DefaultHeat,
 }
 
 /// A part of the model the scene left out, and why.
@@ -88,7 +87,9 @@ struct StateFactors {
 #[derive(Debug, Clone)]
 struct ChurnEntry {
     item: usize,
-    model: GearChurning,
+    /// One model per immersion the gear takes, with its weight (a fixed-axis gear: one, weight 1;
+    /// a planet set: the orbit-average quadrature with the planets counted, `planet_churning`).
+    models: Vec<(GearChurning, f64)>,
 }
 
 #[derive(Debug, Clone)]
@@ -141,8 +142,12 @@ pub struct SampleTerms {
     /// Per sliding entry: loss at η = 1 Pa·s for this sample's torque and speed (W,
     /// multiplicity included); unused for entries without a power law.
     slide_unit: Vec<f64>,
+    /// Per bearing: the load- and speed-dependent terms of this sample.
+    bearing: Vec<crate::physics::losses::bearings::LoadTerms>,
     /// Samples prepared.
     pub prepared: usize,
+    /// Pump and converter values of the sample (they need the vehicle speed too).
+    pub auto: super::automatic::AutoSample,
 }
 
 /// Operating point of the whole gearbox.
@@ -169,7 +174,15 @@ pub struct LossScene {
     pocket: Vec<PocketEntry>,
     slide: Vec<SlideEntry>,
     states: Vec<StateFactors>,
-    mixture_density: f64,
+    /// Density pumped by the part of a mesh zone above the oil (`None`: unknown, not counted).
+    mixture_density: Option<f64>,
+    /// Warnings known at compile time (e.g. pocketing of meshes above the oil not counted).
+    pub warnings: Vec<super::ranges::RangeWarning>,
+    /// Gear-state names (for reports that know a state by name).
+    pub state_names: Vec<String>,
+    auto: super::automatic::AutoLosses,
+    /// Bearings and seals.
+    elements: super::element_losses::ElementLosses,
 }
 
 /// A loss model could not be built for a part of the model.
@@ -182,7 +195,8 @@ pub struct SceneError {
     pub why: String,
 }
 
-fn churning_gear(gb: &Gearbox, gi: usize) -> ChurningGear {
+/// Churning data of gear `gi` (immersion at its lowest position; planets: the lowest orbit point).
+pub fn churning_gear(gb: &Gearbox, gi: usize) -> ChurningGear {
     let g = &gb.gears[gi];
     let geo = &g.geometry;
     let (tip, root) = if geo.is_internal() {
@@ -240,6 +254,7 @@ impl LossScene {
         let mut churn = Vec::new();
         let mut pocket = Vec::new();
         let mut slide = Vec::new();
+        let mut warnings = Vec::new();
         let models = &gb.losses;
 
         // Churning: one item per gear that reaches the oil.
@@ -265,19 +280,33 @@ impl LossScene {
                         skipped.push(usage.idle(format!("churning of gear {}", g.name), "stands still"));
                         continue;
                     }
-                    let model = GearChurning::new(cfg, &churning_gear(gb, gi)).map_err(|e| SceneError {
-                        what: format!("churning of gear {}", g.name),
-                        why: e.to_string(),
-                    })?;
+                    let models = super::planet_churning::models(cfg, gb, gi, &churning_gear(gb, gi))
+                        .map_err(|e| SceneError {
+                            what: format!("churning of gear {}", g.name),
+                            why: e.to_string(),
+                        })?;
                     churn.push(ChurnEntry {
                         item: items.len(),
-                        model,
+                        models,
                     });
+                    if cfg.model == crate::physics::losses::churning::ChurningModel::Stavytskyi {
+                        let out = crate::physics::losses::churning::ranges::stavytskyi_geometry(
+                            &churning_gear(gb, gi),
+                        );
+                        if !out.is_empty() {
+                            warnings.push(super::ranges::RangeWarning {
+                                item: format!("churning of gear {}", g.name),
+                                range: crate::physics::losses::churning::ranges::STAVYTSKYI_TESTED.into(),
+                                seen: out.join(", "),
+                            });
+                        }
+                    }
                     churn_gears.push(gi);
                     items.push(LossItem {
                         source: Source::Churning,
                         name: g.name.clone(),
                         gears: vec![(gi, 1.0)],
+                        heat: DefaultHeat::Oil,
                     });
                 }
             }
@@ -285,6 +314,8 @@ impl LossScene {
 
         // Pocketing: external meshes.
         let mut pocket_meshes = Vec::new();
+        // meshes of identical geometry (and C_d) share one K computation
+        let mut pocket_built: Vec<(PocketMeshInput, PocketingMesh)> = Vec::new();
         match &models.pocketing {
             None => skipped.push(Skipped {
                 what: "pocketing".into(),
@@ -300,6 +331,20 @@ impl LossScene {
                                 .into(),
                         });
                         continue;
+                    }
+                    // (Before the idle check: a mesh above the oil is unknown in every state.) Height of the pitch point; planets orbit, so the mesh point sweeps a circle.
+                    let (wet, _) = mesh_zone(gb, mi);
+                    if wet < 1.0 && opt.mixture_density.is_none() {
+                        let w = super::ranges::above_oil_warning(&m.name, wet);
+                        let dry = wet <= 0.0;
+                        warnings.push(w);
+                        if dry {
+                            skipped.push(Skipped {
+                                what: format!("pocketing of mesh {}", m.name),
+                                why: "mesh zone entirely above the oil: pumped density unknown (set [losses] pocketing_mixture_density_kg_m3)".into(),
+                            });
+                            continue;
+                        }
                     }
                     if !usage.any(|u, st| u.speeds[st][m.gear1].relative != 0.0) {
                         skipped.push(usage.idle(
@@ -328,12 +373,19 @@ impl LossScene {
                         discharge_coefficient: opt.discharge_coefficient,
                         helix_slices: HELIX_POCKET_SLICES,
                     };
-                    let model = PocketingMesh::with_options(&input, &popts).map_err(|e| SceneError {
-                        what: format!("pocketing of mesh {}", m.name),
-                        why: e.to_string(),
-                    })?;
-                    // Height of the pitch point; planets orbit, so the mesh point sweeps a circle.
-                    let (wet, _) = mesh_zone(gb, mi);
+                    let model = match pocket_built.iter().find(|(i, pm)| {
+                        *i == input && pm.discharge_coefficient() == popts.discharge_coefficient
+                    }) {
+                        Some((_, pm)) => *pm,
+                        None => {
+                            let pm = PocketingMesh::with_options(&input, &popts).map_err(|e| SceneError {
+                                what: format!("pocketing of mesh {}", m.name),
+                                why: e.to_string(),
+                            })?;
+                            pocket_built.push((input, pm));
+                            pm
+                        }
+                    };
                     pocket.push(PocketEntry {
                         item: items.len(),
                         model,
@@ -345,6 +397,7 @@ impl LossScene {
                         source: Source::Pocketing,
                         name: m.name.clone(),
                         gears: vec![(m.gear1, 0.5), (m.gear2, 0.5)],
+                        heat: DefaultHeat::Oil,
                     });
                 }
             }
@@ -425,6 +478,7 @@ impl LossScene {
                     source: Source::Sliding,
                     name: m.name.clone(),
                     gears: vec![(m.gear1, f1), (m.gear2, 1.0 - f1)],
+                    heat: DefaultHeat::Gears,
                 });
             }
         }
@@ -464,7 +518,24 @@ impl LossScene {
             })
             .collect();
 
-        let mixture_density = models.pocketing.map_or(0.0, |p| p.mixture_density);
+        // The automatic's own parts: open clutch packs, pump, converter.
+        let auto = super::automatic::AutoLosses::compile(
+            gb,
+            &|st| usage.needed(st),
+            needs.evaluate_all,
+            &mut items,
+            &mut skipped,
+        );
+
+        let mixture_density = models.pocketing.and_then(|p| p.mixture_density);
+        let elements = super::element_losses::ElementLosses::compile(
+            gb,
+            &|si| usage.needed(si),
+            &|what, why| usage.idle(what, why),
+            needs.evaluate_all,
+            &mut items,
+            &mut skipped,
+        );
         Ok(LossScene {
             items,
             skipped,
@@ -473,6 +544,10 @@ impl LossScene {
             slide,
             states,
             mixture_density,
+            warnings,
+            state_names: gb.gear_states.iter().map(|s| s.name.clone()).collect(),
+            auto,
+            elements,
         })
     }
 
@@ -490,10 +565,15 @@ impl LossScene {
     /// full. No allocation.
     pub fn evaluate(&self, op: &OperatingPoint, out: &mut [f64]) {
         self.evaluate_load_independent(op, out);
+        let none = super::automatic::AutoSample::default();
+        self.auto
+            .evaluate(op.state, op.input_speed, op.input_torque, &op.oil, &none, out);
         let st = &self.states[op.state];
         for (e, f) in self.slide.iter().zip(&st.slide) {
             out[e.item] = sliding(e, f, op.input_torque, op.input_speed, op.oil.mu, op.oil.rho);
         }
+        self.elements
+            .evaluate(op.state, op.input_speed, op.input_torque, &op.oil, None, out);
     }
 
     /// Empty per-sample terms for this scene (allocates once).
@@ -501,7 +581,9 @@ impl LossScene {
         SampleTerms {
             key: None,
             slide_unit: vec![0.0; self.slide.len()],
+            bearing: vec![Default::default(); self.elements.bearings()],
             prepared: 0,
+            auto: Default::default(),
         }
     }
 
@@ -509,6 +591,20 @@ impl LossScene {
     /// (N·m): each separable sliding loss at η = 1 Pa·s, from its per-state unit value scaled by
     /// two powers. No allocation.
     pub fn prepare(&self, state: usize, input_speed: f64, input_torque: f64, terms: &mut SampleTerms) {
+        self.prepare_at(state, input_speed, input_torque, 0.0, terms);
+    }
+
+    /// [`Self::prepare`] with the vehicle speed (m/s), which the converter's lock-up needs.
+    pub fn prepare_at(
+        &self,
+        state: usize,
+        input_speed: f64,
+        input_torque: f64,
+        vehicle_speed: f64,
+        terms: &mut SampleTerms,
+    ) {
+        self.auto
+            .prepare(state, input_speed, input_torque, vehicle_speed, &mut terms.auto);
         let key = (state, input_speed.to_bits(), input_torque.to_bits());
         if terms.key == Some(key) {
             return;
@@ -527,6 +623,7 @@ impl LossScene {
                 };
             }
         }
+        self.elements.prepare(state, w, t, &mut terms.bearing);
         terms.key = Some(key);
         terms.prepared += 1;
     }
@@ -539,6 +636,14 @@ impl LossScene {
             return self.evaluate(op, out);
         }
         self.evaluate_load_independent(op, out);
+        self.auto.evaluate(
+            op.state,
+            op.input_speed,
+            op.input_torque,
+            &op.oil,
+            &terms.auto,
+            out,
+        );
         let st = &self.states[op.state];
         let mut memo = (f64::NAN, 0.0);
         for ((e, f), u) in self.slide.iter().zip(&st.slide).zip(&terms.slide_unit) {
@@ -553,6 +658,28 @@ impl LossScene {
                 None => sliding(e, f, op.input_torque, op.input_speed, op.oil.mu, op.oil.rho),
             };
         }
+        self.elements.evaluate(
+            op.state,
+            op.input_speed,
+            op.input_torque,
+            &op.oil,
+            Some(&terms.bearing),
+            out,
+        );
+    }
+
+    /// Every churning model with its loss item and its gear's speed (rad/s) in gear state
+    /// `state` at input speed `input_speed` (for range checks; planets: one per orbit node).
+    pub fn churning_models(
+        &self,
+        state: usize,
+        input_speed: f64,
+    ) -> impl Iterator<Item = (usize, &GearChurning, f64)> + '_ {
+        let st = &self.states[state];
+        self.churn
+            .iter()
+            .zip(&st.churn_speed)
+            .flat_map(move |(e, k)| e.models.iter().map(move |(m, _)| (e.item, m, k * input_speed)))
     }
 
     /// Churning and pocketing at `op` into `out`.
@@ -564,10 +691,17 @@ impl LossScene {
             kinematic_viscosity: op.oil.nu,
         };
         for (e, k) in self.churn.iter().zip(&st.churn_speed) {
-            out[e.item] = e.model.power(k * w_in, &churn_oil).total;
+            out[e.item] = e
+                .models
+                .iter()
+                .map(|(m, wt)| wt * m.power(k * w_in, &churn_oil).total)
+                .sum();
         }
         for (e, k) in self.pocket.iter().zip(&st.pocket_speed) {
-            let rho = e.wet_fraction * op.oil.rho + (1.0 - e.wet_fraction) * self.mixture_density;
+            // The share above the oil pumps an unknown density unless the model file gives one;
+            // it is then not counted (and reported in `warnings`).
+            let rho =
+                e.wet_fraction * op.oil.rho + (1.0 - e.wet_fraction) * self.mixture_density.unwrap_or(0.0);
             out[e.item] = e.multiplicity * e.model.power(k * w_in, rho);
         }
     }

@@ -13,7 +13,9 @@
 use crate::model::gearbox::Gearbox;
 use crate::physics::oil::OilProperties;
 
-use super::losses::{LossScene, Needs, OperatingPoint, SampleTerms, SceneError, Skipped};
+use super::losses::{
+    LossScene, Needs, OperatingPoint, PerSource, SampleTerms, SceneError, Skipped, N_SOURCES,
+};
 use super::thermal::{NetworkWork, Operating, ThermalScene};
 
 /// Inputs that hold during one cycle interval.
@@ -115,7 +117,10 @@ impl Scene {
                 what: "energy of each loss item".into(),
                 why: "not requested: loss energy is integrated per source".into(),
             });
-            (losses.items.iter().map(|it| it.source.index()).collect(), 3)
+            (
+                losses.items.iter().map(|it| it.source.index()).collect(),
+                N_SOURCES,
+            )
         } else {
             ((0..losses.len()).collect(), losses.len())
         };
@@ -167,16 +172,16 @@ impl Scene {
         y[n..n + self.energies].iter().sum()
     }
 
-    /// Loss energy per source `[churning, pocketing, sliding]` in state `y`, J.
-    pub fn loss_energy_by_source(&self, y: &[f64]) -> [f64; 3] {
+    /// Loss energy per source (indexed by [`Source::index`](super::Source::index)) in state `y`, J.
+    pub fn loss_energy_by_source(&self, y: &[f64]) -> PerSource {
         let n = self.nodes();
-        let mut by = [0.0; 3];
+        let mut by = [0.0; N_SOURCES];
         if self.has_item_energies() {
             for (it, e) in self.losses.items.iter().zip(&y[n..n + self.energies]) {
                 by[it.source.index()] += e;
             }
         } else {
-            by.copy_from_slice(&y[n..n + 3]);
+            by.copy_from_slice(&y[n..n + N_SOURCES]);
         }
         by
     }
@@ -234,10 +239,11 @@ impl Scene {
         work.sample_id = work.sample_id.wrapping_add(1);
         self.thermal
             .sample_conductances(&Self::operating(&inputs), &mut work.net);
-        self.losses.prepare(
+        self.losses.prepare_at(
             inputs.state,
             inputs.input_speed,
             inputs.input_torque,
+            inputs.vehicle_speed,
             &mut work.terms,
         );
     }

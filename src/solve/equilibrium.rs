@@ -109,8 +109,8 @@ pub struct Equilibrium {
     pub solution: SteadySolution,
     /// Loss of each item at equilibrium, W.
     pub losses: Vec<f64>,
-    /// Per source: churning, pocketing, sliding, W.
-    pub by_source: [f64; 3],
+    /// Per source (indexed by `Source::index`), W.
+    pub by_source: crate::scene::PerSource,
     /// Loss-free transmitted power T·ω, W.
     pub power: f64,
     /// Efficiency P / (P + losses) (None without power).
@@ -153,12 +153,9 @@ pub fn equilibrium(
     y[..scene.nodes()].copy_from_slice(&solution.temperatures);
     let mut w = scene.work(inputs);
     scene.evaluate_losses(&y, &mut w);
-    let mut by = [0.0; 3];
-    for (q, it) in w.q.iter().zip(&scene.losses.items) {
-        by[it.source.index()] += q;
-    }
+    let by = crate::scene::sum_by_source(&scene.losses.items, &w.q);
     let power = inputs.input_torque * inputs.input_speed;
-    let total = by[0] + by[1] + by[2];
+    let total: f64 = by.iter().sum();
     Ok(Equilibrium {
         solution,
         losses: w.q,

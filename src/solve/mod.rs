@@ -4,4 +4,5 @@ pub mod equilibrium;
 pub mod steady;
 pub mod sweep;
 pub mod transient;
+pub mod validation;
 pub mod work_precision;

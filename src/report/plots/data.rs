@@ -12,6 +12,7 @@ use serde::Deserialize;
 
 use super::style::Source;
 use super::PlotError;
+use crate::scene::N_SOURCES;
 
 /// One loss item's power over time.
 #[derive(Clone, Debug)]
@@ -32,8 +33,9 @@ pub struct TimeSeries {
     /// (node name, °C per row), in column order.
     pub temps_c: Vec<(String, Vec<f64>)>,
     pub items: Vec<LossItemSeries>,
-    /// Per-source total power, W, indexed by `Source::index()`.
-    pub source_w: [Vec<f64>; 3],
+    /// Per-source total power, W, indexed by `Source::index()` (zeros for a source the file
+    /// has no column of: files written before that source existed).
+    pub source_w: [Vec<f64>; N_SOURCES],
     pub total_loss_w: Vec<f64>,
     /// Efficiency as a fraction, NaN where undefined.
     pub efficiency: Vec<f64>,
@@ -115,11 +117,16 @@ pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
     let c_time = require("time_s")?;
     let c_speed = require("vehicle_speed_kmh")?;
     let c_gear = require("gear")?;
-    let c_src = [
-        require("churning_w")?,
-        require("pocketing_w")?,
-        require("sliding_w")?,
-    ];
+    // The three gear sources are required; later sources are optional (older files).
+    let mut c_src = [None; N_SOURCES];
+    for s in Source::ALL {
+        let col = format!("{}_w", s.as_str());
+        c_src[s.index()] = if s.index() < 3 {
+            Some(require(&col)?)
+        } else {
+            find(&col)
+        };
+    }
     let c_total = require("total_loss_w")?;
     let c_eff = require("efficiency")?;
 
@@ -134,7 +141,7 @@ pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
             }
         } else if let Some(rest) = h.strip_prefix("loss_").and_then(|r| r.strip_suffix("_w")) {
             let parsed = Source::ALL.into_iter().find_map(|s| {
-                rest.strip_prefix(s.name())
+                rest.strip_prefix(s.as_str())
                     .and_then(|r| r.strip_prefix('_'))
                     .filter(|n| !n.is_empty())
                     .map(|n| (s, n))
@@ -181,8 +188,11 @@ pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
             let v = num(c)?;
             ts.items[k].power_w.push(v);
         }
-        for (k, &c) in c_src.iter().enumerate() {
-            let v = num(c)?;
+        for (k, c) in c_src.iter().enumerate() {
+            let v = match c {
+                Some(c) => num(*c)?,
+                None => 0.0,
+            };
             ts.source_w[k].push(v);
         }
         ts.total_loss_w.push(num(c_total)?);
@@ -197,22 +207,18 @@ pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
     Ok(ts)
 }
 
+/// `energy_lost_j`: one key per source and `total` (missing or null values are `None`).
 #[derive(Clone, Debug, Default, Deserialize)]
-#[serde(default)]
-pub struct EnergyBySource {
-    pub churning: Option<f64>,
-    pub pocketing: Option<f64>,
-    pub sliding: Option<f64>,
-    pub total: Option<f64>,
-}
+#[serde(transparent)]
+pub struct EnergyBySource(BTreeMap<String, Option<f64>>);
 
 impl EnergyBySource {
     pub fn get(&self, s: Source) -> Option<f64> {
-        match s {
-            Source::Churning => self.churning,
-            Source::Pocketing => self.pocketing,
-            Source::Sliding => self.sliding,
-        }
+        self.0.get(s.as_str()).copied().flatten()
+    }
+
+    pub fn total(&self) -> Option<f64> {
+        self.0.get("total").copied().flatten()
     }
 }
 

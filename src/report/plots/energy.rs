@@ -8,8 +8,9 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
 
 use super::data::RunData;
-use super::style::{self, LegendEntry, Source, Swatch};
+use super::style::{self, LegendEntry, Source, SourceColour, Swatch};
 use super::{Canvas, DrawResult};
+use crate::scene::{PerSource, N_SOURCES};
 
 /// Most bars shown; the rest are summed into one "other" bar.
 const MAX_BARS: usize = 40;
@@ -56,9 +57,9 @@ pub fn item_energies(run: &RunData) -> Vec<(Option<Source>, String, f64)> {
 }
 
 /// Energy per source, J (summary first, else integrated source columns).
-pub fn source_energies(run: &RunData) -> [f64; 3] {
+pub fn source_energies(run: &RunData) -> PerSource {
     let order = run.ts.time_order();
-    let mut out = [0.0; 3];
+    let mut out = [0.0; N_SOURCES];
     for s in Source::ALL {
         let from_summary = run
             .summary
@@ -187,13 +188,13 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     let total_kj: f64 = sm
         .energy_lost_j
         .as_ref()
-        .and_then(|e| e.total)
+        .and_then(|e| e.total())
         .filter(|v| v.is_finite())
         .map(|j| j / 1e3)
         .unwrap_or_else(|| src_kj.iter().sum());
     let rows: Vec<(String, RGBColor, f64)> = Source::ALL
         .iter()
-        .map(|s| (s.name().to_string(), s.colour(), src_kj[s.index()]))
+        .map(|s| (s.as_str().to_string(), s.colour(), src_kj[s.index()]))
         .chain([("total".to_string(), RGBColor(70, 70, 70), total_kj)])
         .collect();
     let t_max = rows.iter().map(|r| r.2).fold(0.0f64, f64::max);
@@ -257,7 +258,7 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     }
     let mut entries: Vec<LegendEntry> = Source::ALL
         .iter()
-        .map(|s| LegendEntry::new(s.name(), Swatch::Fill(s.colour())))
+        .map(|s| LegendEntry::new(s.as_str(), Swatch::Fill(s.colour())))
         .collect();
     if items.iter().any(|r| r.0.is_none()) {
         entries.push(LegendEntry::new(

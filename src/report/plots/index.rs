@@ -66,7 +66,7 @@ pub fn markdown(run: &RunData) -> String {
     let total = sm
         .energy_lost_j
         .as_ref()
-        .and_then(|e| e.total)
+        .and_then(|e| e.total())
         .filter(|v| v.is_finite())
         .unwrap_or_else(|| src.iter().sum());
     let _ = writeln!(
@@ -80,7 +80,7 @@ pub fn markdown(run: &RunData) -> String {
         } else {
             "–".into()
         };
-        let _ = writeln!(s, "| {} | {} | {} |", x.name(), fmt_sig(e / 1e3, 4), share);
+        let _ = writeln!(s, "| {} | {} | {} |", x.as_str(), fmt_sig(e / 1e3, 4), share);
     }
     let _ = writeln!(s, "| **total** | **{}** | |", fmt_sig(total / 1e3, 4));
 

@@ -4,7 +4,7 @@
 use plotters::prelude::*;
 
 use super::data::{decimate, finite_segments, RunData};
-use super::style::{self, LegendEntry, Source, Swatch};
+use super::style::{self, LegendEntry, Source, SourceColour, Swatch};
 use super::{Canvas, DrawResult};
 
 const LEGEND_W: u32 = 300;
@@ -37,7 +37,7 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     };
 
     // Cumulative stacks (W): stack[k][r] = sum of sources 0..=k at row order[r].
-    let mut stack = vec![vec![0.0; order.len()]; 3];
+    let mut stack = vec![vec![0.0; order.len()]; Source::ALL.len()];
     for (r, &i) in order.iter().enumerate() {
         let mut acc = 0.0;
         for s in Source::ALL {
@@ -45,7 +45,7 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
             stack[s.index()][r] = acc;
         }
     }
-    let y_hi = stack[2]
+    let y_hi = stack[Source::ALL.len() - 1]
         .iter()
         .copied()
         .chain(ts.total_loss_w.iter().copied().filter(|v| v.is_finite()))
@@ -120,7 +120,7 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     let mut entries: Vec<LegendEntry> = Source::ALL
         .iter()
         .rev()
-        .map(|s| LegendEntry::new(s.name(), Swatch::Fill(s.colour())))
+        .map(|s| LegendEntry::new(s.as_str(), Swatch::Fill(s.colour())))
         .collect();
     entries.push(LegendEntry::new("total", Swatch::Line(BLACK, 1)));
     style::draw_legend_column(&legend, Some("Source"), &entries, 14)?;

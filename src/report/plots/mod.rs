@@ -24,8 +24,10 @@ pub mod heatmap;
 pub mod index;
 pub mod losses;
 pub mod map_index;
+pub mod study;
 pub mod style;
 pub mod temperatures;
+pub mod validation;
 pub mod work_precision;
 
 #[cfg(test)]
@@ -189,6 +191,49 @@ pub fn render_map(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
     jobs.push(Box::new(move || {
         stage_text(dir, "report.md", &map_index::markdown(grid))
     }));
+    commit(stage_parallel(jobs)?)
+}
+
+/// Write the validation outputs into `dir` at once (all or nothing): `validation.csv`,
+/// `validation_summary.csv`, `validation.md`, `parity_sliding.png`, `parity_churning.png`,
+/// `error_vs_speed_sliding.png`, `error_vs_speed_churning.png`.
+pub fn render_validation(
+    dir: &Path,
+    rows: &[crate::solve::validation::Row],
+    texts: &[(&str, String)],
+) -> Result<Vec<PathBuf>, PlotError> {
+    std::fs::create_dir_all(dir).map_err(|e| io_err(dir, e))?;
+    style::ensure_fonts()?;
+    let pick = |q: &str| -> Vec<&crate::solve::validation::Row> {
+        rows.iter().filter(|r| r.quantity == q).collect()
+    };
+    let (sl, ch) = (pick("sliding"), pick("churning"));
+    let (sl, ch) = (&sl, &ch);
+    let mut jobs: Vec<Box<dyn FnOnce() -> Result<Staged, PlotError> + Send + '_>> = vec![
+        Box::new(move || {
+            stage_png(dir, "parity_sliding.png", |r| {
+                validation::draw_parity(r, sl, "Sliding loss: geartherm vs references")
+            })
+        }),
+        Box::new(move || {
+            stage_png(dir, "parity_churning.png", |r| {
+                validation::draw_parity(r, ch, "Churning loss: geartherm vs references")
+            })
+        }),
+        Box::new(move || {
+            stage_png(dir, "error_vs_speed_sliding.png", |r| {
+                validation::draw_error_vs_speed(r, sl, "Sliding loss: relative error vs input speed")
+            })
+        }),
+        Box::new(move || {
+            stage_png(dir, "error_vs_speed_churning.png", |r| {
+                validation::draw_error_vs_speed(r, ch, "Churning loss: relative error vs input speed")
+            })
+        }),
+    ];
+    for (name, text) in texts {
+        jobs.push(Box::new(move || stage_text(dir, name, text)));
+    }
     commit(stage_parallel(jobs)?)
 }
 

@@ -76,39 +76,27 @@ pub const GRID_BOLD: RGBColor = RGBColor(195, 195, 195);
 pub const NEUTRAL: RGBColor = RGBColor(120, 120, 120);
 pub const MISSING: RGBColor = RGBColor(235, 235, 235);
 
-/// The three loss sources; their colour is the same in every figure.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Source {
-    Churning,
-    Pocketing,
-    Sliding,
+/// The loss sources (the scene's list); their colour is the same in every figure.
+pub use crate::scene::Source;
+
+/// Colour of a loss source.
+pub trait SourceColour {
+    /// Okabe–Ito colours (colour-blind safe): blue, orange, bluish green, vermillion, reddish
+    /// purple, then sky blue, yellow, black for further sources.
+    fn colour(self) -> RGBColor;
 }
 
-impl Source {
-    pub const ALL: [Source; 3] = [Source::Churning, Source::Pocketing, Source::Sliding];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Source::Churning => "churning",
-            Source::Pocketing => "pocketing",
-            Source::Sliding => "sliding",
-        }
-    }
-
-    pub fn parse(s: &str) -> Option<Source> {
-        Source::ALL.into_iter().find(|x| x.name() == s)
-    }
-
-    pub fn index(self) -> usize {
-        self as usize
-    }
-
-    /// Okabe–Ito colours (colour-blind safe): blue, orange, bluish green.
-    pub fn colour(self) -> RGBColor {
+impl SourceColour for Source {
+    fn colour(self) -> RGBColor {
         match self {
             Source::Churning => RGBColor(0, 114, 178),
             Source::Pocketing => RGBColor(230, 159, 0),
             Source::Sliding => RGBColor(0, 158, 115),
+            Source::Bearing => RGBColor(213, 94, 0),
+            Source::Seal => RGBColor(204, 121, 167),
+            Source::ClutchDrag => RGBColor(86, 180, 233),
+            Source::Pump => RGBColor(240, 228, 66),
+            Source::Converter => RGBColor(0, 0, 0),
         }
     }
 }
@@ -654,7 +642,7 @@ mod tests {
     #[test]
     fn source_names_round_trip() {
         for s in Source::ALL {
-            assert_eq!(Source::parse(s.name()), Some(s));
+            assert_eq!(Source::parse(s.as_str()), Some(s));
         }
         assert_eq!(Source::parse("windage"), None);
     }

@@ -28,8 +28,8 @@
 //! - `ChurningPower` split: the correlation gives only the total; it is attributed to faces,
 //!   periphery and flanks (`cavity`) in proportion to their areas in S_m (bookkeeping only).
 //!
-//! Speed exponents: P ∝ ω^(3 − 1.2 − 0.21) = ω^1.59 (low Re_c), ω^(3 − 1.76) = ω^1.24 (high),
-//! in the measured range ω^1.4–1.7 (seed 000 table 2). Density enters linearly (ν fixed).
+//! Speed exponents: P ∝ ω^(3 − 1.2 − 0.21) = ω^1.59 (low Re_c), inside the ω^1.4–1.7 of seed 000
+//! table 2, and ω^(3 − 1.76) = ω^1.24 (high Re_c), below it. Density enters linearly (ν fixed).
 
 use super::immersion::immersion_angle;
 use super::{check_positive, ChurningError, ChurningGear, ChurningPower, OilState};
@@ -165,6 +165,11 @@ impl ChangenetGear {
     /// Critical Reynolds number Re_c = ω r_p b/ν.
     pub fn critical_reynolds(&self, omega: f64, oil: &OilState) -> f64 {
         omega.abs() * self.rp * self.b / oil.kinematic_viscosity
+    }
+
+    /// Re_c limits of the low and the high law (the bridge band between them).
+    pub fn bridge(&self) -> (f64, f64) {
+        (self.re_c_low, self.re_c_high)
     }
 
     /// Moment coefficient C_m (low law, log-linear bridge, high law; see the module docs).

@@ -14,14 +14,15 @@
 //! `h ≥ 2 r_a` full immersion (θ = π). The immersion geometry is in [`immersion`].
 //!
 //! **Recommended default: [`ChurningModel::Changenet`]** — it is the only one of the three fitted to
-//! churning measurements, and it is the only one whose speed exponent (P ∝ ω^1.59 at low, ω^1.24 at
-//! high Re_c) falls in the measured range ω^1.4–1.7 (seed 000 table 2); the two physically derived
+//! churning measurements, and the only one whose speed exponent comes near the ω^1.4–1.7 of seed
+//! 000 table 2 (ω^1.59 at low Re_c, inside; ω^1.24 at high Re_c, below); the two physically derived
 //! models rise as ω^2.5–3 (flat-plate faces at tip speed, Coriolis pumping). It needs the sump oil
 //! volume V0 (set it from the model). Use [`ChurningModel::Seetharaman`] when V0 is unknown or the
 //! gear is far outside Changenet's test range; [`ChurningModel::Stavytskyi`] for comparison only.
 
 pub mod changenet;
 pub mod immersion;
+pub mod ranges;
 pub mod seetharaman;
 pub mod stavytskyi;
 
@@ -30,6 +31,7 @@ use std::fmt;
 
 pub use changenet::{ChangenetGear, ChangenetParams};
 pub use immersion::Immersion;
+pub use ranges::RangeCheck;
 pub use seetharaman::{CavityTerm, SeetharamanGear, SeetharamanParams};
 pub use stavytskyi::{InletGap, StavytskyiGear, StavytskyiParams};
 

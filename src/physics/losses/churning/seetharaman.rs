@@ -185,6 +185,16 @@ impl SeetharamanGear {
         omega.abs() * self.re_k / oil.kinematic_viscosity
     }
 
+    /// True when faces at face Reynolds number `re` use a turbulent law (forced turbulent, or
+    /// `Auto` above the transition).
+    pub fn turbulent_faces(&self, re: f64) -> bool {
+        match self.regime {
+            FaceRegime::Laminar => false,
+            FaceRegime::Turbulent => true,
+            FaceRegime::Auto => re > self.re_t,
+        }
+    }
+
     /// Churning power, W (see module docs). ω in rad/s, sign irrelevant.
     pub fn power(&self, omega: f64, oil: &OilState) -> ChurningPower {
         let w = omega.abs();

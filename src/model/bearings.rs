@@ -1,0 +1,293 @@
+//! `[[bearings]]` and `[[seals]]`: the model-file sections, the bearing catalogue
+//! `models/bearings.toml` (compiled into the binary), and the checked bearings and seals.
+
+use serde::{Deserialize, Serialize};
+
+use crate::physics::losses::bearings::BearingFriction;
+use crate::physics::losses::seals::LipSeal;
+
+/// The catalogue text (kept in the repository as `models/bearings.toml` with each value's source).
+pub const BEARINGS_TOML: &str = include_str!("../../models/bearings.toml");
+
+/// Bearing type.
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum BearingType {
+    /// Deep-groove ball bearing.
+    DeepGrooveBall,
+    /// Single-row angular-contact ball bearing.
+    AngularContactBall,
+    /// Four-point-contact ball bearing (QJ).
+    FourPointContactBall,
+    /// Cylindrical roller bearing with cage.
+    CylindricalRoller,
+    /// Tapered roller bearing.
+    TaperedRoller,
+    /// Needle roller bearing.
+    NeedleRoller,
+}
+
+impl BearingType {
+    /// Palmgren factors (f0 oil bath, f1, load factors of P1 = max(F_r, a·F_a + r·F_r)) of this
+    /// type. Source: thermca `bearing.heat_loss` (Palmgren model after [Jun10], load formulas
+    /// after [Sch13]), github.com/thermca (see docs/physics.md §Bearings); f1 "for 10 % dynamic
+    /// load".
+    pub fn palmgren_defaults(self) -> (f64, f64, f64, f64) {
+        match self {
+            BearingType::DeepGrooveBall => (2.0, 0.00022, 3.3, -0.1),
+            BearingType::AngularContactBall => (3.3, 0.00046, 1.0, -0.1),
+            BearingType::FourPointContactBall => (6.0, 0.00046, 1.5, 3.6),
+            BearingType::TaperedRoller => (6.0, 0.00040, 0.0, 1.0),
+            BearingType::CylindricalRoller => (3.0, 0.00030, 0.0, 1.0),
+            BearingType::NeedleRoller => (12.0, 0.00200, 0.0, 1.0),
+        }
+    }
+
+    /// True for the types the SKF model covers here (their table rows were found).
+    pub fn has_skf(self) -> bool {
+        matches!(
+            self,
+            BearingType::DeepGrooveBall | BearingType::AngularContactBall
+        )
+    }
+}
+
+/// SKF constants of a bearing series in the catalogue.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SeriesEntry {
+    /// Series key (e.g. `"62"`).
+    pub series: String,
+    /// Bearing type the row applies to.
+    #[serde(rename = "type")]
+    pub kind: BearingType,
+    /// R1, R2, R3 (R3 angular contact only), S1, S2.
+    pub r1: f64,
+    /// R2.
+    pub r2: f64,
+    /// R3.
+    #[serde(default)]
+    pub r3: f64,
+    /// S1.
+    pub s1: f64,
+    /// S2.
+    pub s2: f64,
+    /// K_z.
+    pub k_z: f64,
+    /// Source.
+    pub source: String,
+}
+
+/// One catalogue bearing.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CatalogueBearing {
+    /// Designation (e.g. `"6206"`, `"NJ 406"`).
+    pub designation: String,
+    /// Type.
+    #[serde(rename = "type")]
+    pub kind: BearingType,
+    /// SKF series key (types with an SKF row).
+    #[serde(default)]
+    pub series: Option<String>,
+    /// Bore d, mm.
+    pub d_mm: f64,
+    /// Outside diameter D, mm.
+    pub outside_mm: f64,
+    /// Width B, mm.
+    pub b_mm: f64,
+    /// Basic static load rating C0, kN.
+    pub c0_kn: f64,
+    /// Rows of rolling elements (default 1).
+    #[serde(default)]
+    pub rows: Option<f64>,
+    /// Source of the dimensions and C0.
+    pub source: String,
+}
+
+#[derive(Deserialize)]
+struct CatalogueFile {
+    series: Vec<SeriesEntry>,
+    bearing: Vec<CatalogueBearing>,
+}
+
+/// All catalogue series and bearings (a parse failure is a build defect caught by a unit test;
+/// reported as an empty catalogue).
+pub fn catalogue() -> (Vec<SeriesEntry>, Vec<CatalogueBearing>) {
+    toml::from_str::<CatalogueFile>(BEARINGS_TOML)
+        .map(|c| (c.series, c.bearing))
+        .unwrap_or_default()
+}
+
+/// Friction model choice of a bearing.
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum BearingModelChoice {
+    /// SKF (2004) (deep-groove and angular-contact ball bearings).
+    Skf,
+    /// Palmgren.
+    Palmgren,
+}
+
+/// `[[bearings]]` entry.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BearingSpec {
+    /// Unique name.
+    pub name: String,
+    /// Member whose shaft runs in the bearing (inner ring); exclusive with `planet`.
+    #[serde(default)]
+    pub member: Option<String>,
+    /// Planet gear the bearing supports on its carrier pin (one bearing per planet).
+    #[serde(default)]
+    pub planet: Option<String>,
+    /// Member holding the outer ring (default: the housing).
+    #[serde(default)]
+    pub outer: Option<String>,
+    /// Catalogue designation.
+    pub designation: String,
+    /// Axial position along the member, mm (the member's axis; gears have `position_mm` too).
+    #[serde(default)]
+    pub position_mm: f64,
+    /// This bearing takes the member's axial load (default: the first bearing of the member).
+    #[serde(default)]
+    pub locating: Option<bool>,
+    /// Friction model (default: `skf` where the type has an SKF row, else `palmgren`).
+    #[serde(default)]
+    pub model: Option<BearingModelChoice>,
+    /// Constant radial load added to the gear loads (e.g. weight), N.
+    #[serde(default)]
+    pub radial_preload_n: f64,
+    /// Constant axial load added to the gear loads (e.g. a preload), N.
+    #[serde(default)]
+    pub axial_preload_n: f64,
+    /// Integral contact seals (SKF seal term; deep-groove ball bearings `-2RS`): `true` uses the
+    /// SKF constants by outside diameter.
+    #[serde(default)]
+    pub sealed: bool,
+    /// Lubrication: `oil_bath` (default; K_rs 3e-8) or `grease` (K_rs 6e-8, no drag).
+    #[serde(default)]
+    pub lubrication: Option<String>,
+    /// Thermal nodes that receive the heat with fractions (default: the member's or planet's
+    /// body node, else the oil).
+    #[serde(default)]
+    pub heat_to: Option<Vec<(String, f64)>>,
+    /// Where the entry's choices come from (free text, shown by `geartherm info`).
+    #[serde(default)]
+    pub source: Option<String>,
+}
+
+/// `[[seals]]` entry.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SealSpec {
+    /// Unique name.
+    pub name: String,
+    /// Member whose shaft the lip runs on.
+    pub member: String,
+    /// Member holding the seal (default: the housing).
+    #[serde(default)]
+    pub outer: Option<String>,
+    /// Shaft diameter at the lip, mm.
+    pub shaft_diameter_mm: f64,
+    /// Measured or maker's friction torque, N·m (default: ISO/TR 14179-2 law).
+    #[serde(default)]
+    pub torque_nm: Option<f64>,
+    /// Thermal nodes with fractions (default: the member's body node, else the oil).
+    #[serde(default)]
+    pub heat_to: Option<Vec<(String, f64)>>,
+    /// Where the entry comes from.
+    #[serde(default)]
+    pub source: Option<String>,
+}
+
+/// Where a bearing sits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BearingMount {
+    /// On a member (inner ring), outer ring in the housing or on another member.
+    Member {
+        /// Member index.
+        member: usize,
+        /// Outer-ring member (None: housing).
+        outer: Option<usize>,
+    },
+    /// On a planet's pin: one bearing per planet of the set.
+    Planet {
+        /// Planet gear index.
+        gear: usize,
+    },
+}
+
+/// A checked bearing.
+#[derive(Debug, Clone)]
+pub struct Bearing {
+    /// Name.
+    pub name: String,
+    /// Designation.
+    pub designation: String,
+    /// Mount.
+    pub mount: BearingMount,
+    /// Axial position on its member, m.
+    pub position: f64,
+    /// Takes the axial load of its member.
+    pub locating: bool,
+    /// Friction model with everything constant precomputed.
+    pub friction: BearingFriction,
+    /// Constant radial and axial loads, N.
+    pub preload: (f64, f64),
+    /// Heat destinations named in the file.
+    pub heat_to: Option<Vec<(String, f64)>>,
+}
+
+/// A checked seal.
+#[derive(Debug, Clone)]
+pub struct Seal {
+    /// Name.
+    pub name: String,
+    /// Member the lip runs on.
+    pub member: usize,
+    /// Member holding the seal (None: housing).
+    pub outer: Option<usize>,
+    /// Model.
+    pub seal: LipSeal,
+    /// Heat destinations named in the file.
+    pub heat_to: Option<Vec<(String, f64)>>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn catalogue_parses_and_every_entry_is_sourced() {
+        let c: CatalogueFile = toml::from_str(BEARINGS_TOML).unwrap();
+        assert!(!c.series.is_empty() && !c.bearing.is_empty());
+        for s in &c.series {
+            assert!(
+                s.r1 > 0.0 && s.s1 > 0.0 && s.k_z > 0.0 && !s.source.is_empty(),
+                "{}",
+                s.series
+            );
+        }
+        for b in &c.bearing {
+            assert!(
+                b.d_mm > 0.0 && b.outside_mm > b.d_mm && b.c0_kn > 0.0,
+                "{}",
+                b.designation
+            );
+            assert!(!b.source.is_empty());
+            if let Some(s) = &b.series {
+                assert!(
+                    c.series.iter().any(|x| &x.series == s && x.kind == b.kind),
+                    "{}",
+                    b.designation
+                );
+            }
+        }
+        let mut names: Vec<&str> = c.bearing.iter().map(|b| b.designation.as_str()).collect();
+        names.sort_unstable();
+        let n = names.len();
+        names.dedup();
+        assert_eq!(n, names.len(), "duplicate designation");
+    }
+}

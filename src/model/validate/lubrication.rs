@@ -1,0 +1,120 @@
+//! `[lubrication]`: oil level, sump volume, gear axis heights, immersion; builds the checked
+//! gears.
+
+use super::common::*;
+use super::sets::Mounts;
+use super::Ctx;
+use crate::model::gearbox::*;
+use crate::model::problems::Problems;
+
+/// Validate `[lubrication]` and build the checked gears; returns them with the oil level (m).
+pub(super) fn validate_lubrication(
+    ctx: &Ctx<'_>,
+    sets: &[PlanetarySet],
+    meshes: &[Mesh],
+    mounts: &Mounts,
+    problems: &mut Problems,
+) -> (Vec<Gear>, f64) {
+    let file = ctx.file;
+    let (gear_ix, planet_of, geoms, gear_member) =
+        (&ctx.gears.ix, &ctx.planet_of, &ctx.gears.geoms, &ctx.gears.member);
+    let lub = &file.lubrication;
+    if !lub.oil_level_mm.is_finite() {
+        problems.push(
+            "lubrication.oil_level_mm",
+            lub.oil_level_mm,
+            "must be a finite number",
+        );
+    }
+    if let Some(v) = lub.sump_volume_l {
+        problems.positive("lubrication.sump_volume_l", v);
+    }
+    for name in lub.centre_height_mm.keys() {
+        match gear_ix.get(name.as_str()) {
+            None => problems.push(format!("lubrication.centre_height_mm.{name}"), "", "unknown gear"),
+            Some(&gi) if planet_of.contains_key(file.gears[gi].name.as_str()) => problems.push(
+                format!("lubrication.centre_height_mm.{name}"),
+                "",
+                "planets orbit: give the centre height of the set's sun instead (planets take the lowest orbit position)",
+            ),
+            _ => {}
+        }
+    }
+    let mut heights: Vec<Option<f64>> = vec![None; file.gears.len()];
+    for (gi, g) in file.gears.iter().enumerate() {
+        if planet_of.contains_key(g.name.as_str()) {
+            continue;
+        }
+        match lub.centre_height_mm.get(&g.name) {
+            Some(h) if h.is_finite() => heights[gi] = Some(h * MM),
+            Some(h) => problems.push(
+                format!("lubrication.centre_height_mm.{}", g.name),
+                h,
+                "must be a finite number",
+            ),
+            None => problems.push(
+                format!("lubrication.centre_height_mm.{}", g.name),
+                "",
+                "missing: every non-planet gear needs its axis height",
+            ),
+        }
+    }
+    // Planets: lowest orbit position = axis height of the set (its sun or ring) − orbit radius.
+    for s in sets {
+        let axis = s.gears.iter().find_map(|&gi| heights[gi]);
+        for &gi in &s.gears {
+            if let (GearMount::Planet { .. }, Some(axis)) = (mounts[gi].0, axis) {
+                let orbit = meshes
+                    .iter()
+                    .find(|m| {
+                        m.set.is_some()
+                            && (m.gear1 == gi || m.gear2 == gi)
+                            && (mounts[m.gear1].0 == GearMount::OnMember
+                                || mounts[m.gear2].0 == GearMount::OnMember)
+                    })
+                    .map(|m| m.geometry.a_w);
+                if let Some(orbit) = orbit {
+                    heights[gi] = Some(axis - orbit);
+                }
+            }
+        }
+    }
+    let level = lub.oil_level_mm * MM;
+    let mut gears = Vec::new();
+    for (gi, g) in file.gears.iter().enumerate() {
+        let (Some(geo), Some(h), Some(m)) = (geoms[gi].clone(), heights[gi], gear_member[gi]) else {
+            continue;
+        };
+        // Lowest point of the gear body: the tip circle of an external gear; for a ring the root circle.
+        let reach = if g.internal {
+            geo.d_f.max(geo.d_a) / 2.0
+        } else {
+            geo.d_a / 2.0
+        };
+        let immersion = level - (h - reach);
+        if immersion > 2.0 * reach {
+            problems.push(
+                format!("lubrication.centre_height_mm.{}", g.name),
+                format!("{:.3}", h / MM),
+                format!(
+                    "gear fully submerged: immersion {:.2} mm exceeds its outer diameter {:.2} mm (immersion must be ≤ tip diameter)",
+                    immersion / MM,
+                    2.0 * reach / MM
+                ),
+            );
+        }
+        gears.push(Gear {
+            name: g.name.clone(),
+            member: m,
+            geometry: geo,
+            roughness_ra: g.roughness_ra_um.unwrap_or(0.5) * 1e-6,
+            mount: mounts[gi].0,
+            carrier: mounts[gi].1,
+            centre_height: h,
+            immersion,
+            position: g.position_mm.unwrap_or(0.0) * MM,
+        });
+    }
+
+    (gears, level)
+}

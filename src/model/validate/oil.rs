@@ -1,0 +1,90 @@
+//! `[oil]`: catalogue entry or inline viscosities and density.
+
+use super::common::q;
+use crate::model::catalogue;
+use crate::model::problems::Problems;
+use crate::model::schema::OilSpec;
+use crate::physics::oil::{Oil, WaltherVariant, ALPHA_T_MINERAL, CST};
+
+/// Validate `[oil]`.
+pub(super) fn validate_oil(o: &OilSpec, problems: &mut Problems) -> Option<Oil> {
+    let variant = o.walther.unwrap_or(WaltherVariant::AstmD341);
+    let inline = o.nu40_cst.is_some() || o.nu100_cst.is_some() || o.rho15_kg_m3.is_some();
+    let (name, nu40, nu100, rho15, alpha) = match (&o.catalogue, inline) {
+        (Some(_), true) => {
+            problems.push(
+                "oil",
+                "",
+                "give either oil.catalogue or inline nu40_cst/nu100_cst/rho15_kg_m3, not both",
+            );
+            return None;
+        }
+        (Some(c), false) => match catalogue::find(c) {
+            Some(e) => (
+                e.name,
+                e.nu40_cst,
+                e.nu100_cst,
+                e.rho15_kg_m3,
+                o.thermal_expansion_per_k.unwrap_or(e.thermal_expansion_per_k),
+            ),
+            None => {
+                let keys: Vec<String> = catalogue::oils().into_iter().map(|e| e.key).collect();
+                problems.push(
+                    "oil.catalogue",
+                    q(c),
+                    format!("unknown oil; catalogue keys: {}", keys.join(", ")),
+                );
+                return None;
+            }
+        },
+        (None, _) => {
+            let mut miss = false;
+            for (k, v) in [
+                ("nu40_cst", o.nu40_cst),
+                ("nu100_cst", o.nu100_cst),
+                ("rho15_kg_m3", o.rho15_kg_m3),
+            ] {
+                if v.is_none() {
+                    problems.push(
+                        format!("oil.{k}"),
+                        "",
+                        "required for an inline oil (or give oil.catalogue)",
+                    );
+                    miss = true;
+                }
+            }
+            if miss {
+                return None;
+            }
+            (
+                o.name.clone().unwrap_or_else(|| "inline oil".into()),
+                o.nu40_cst.unwrap_or_default(),
+                o.nu100_cst.unwrap_or_default(),
+                o.rho15_kg_m3.unwrap_or_default(),
+                o.thermal_expansion_per_k.unwrap_or(ALPHA_T_MINERAL),
+            )
+        }
+    };
+    let mut ok = problems.in_range("oil.nu40_cst", nu40, 1.0, 10000.0, " cSt");
+    ok &= problems.in_range("oil.nu100_cst", nu100, 0.5, 1000.0, " cSt");
+    ok &= problems.in_range("oil.rho15_kg_m3", rho15, 600.0, 1200.0, " kg/m3");
+    ok &= problems.in_range("oil.thermal_expansion_per_k", alpha, -2e-3, 0.0, " 1/K");
+    if ok && nu40 <= nu100 {
+        problems.push(
+            "oil.nu100_cst",
+            nu100,
+            format!("must be less than nu40_cst = {nu40} (oils thin as they warm)"),
+        );
+        ok = false;
+    }
+    if !ok {
+        return None;
+    }
+    match Oil::new(name, variant, nu40 * CST, nu100 * CST, rho15, alpha) {
+        Ok(oil) => Some(oil),
+        Err(e) => {
+            problems.push("oil", "", e.to_string());
+            None
+        }
+    }
+}

@@ -1,0 +1,352 @@
+//! `[[planetary_sets]]`: roles, kinematic rows, generated meshes, planet mounts, assembly and
+//! neighbour conditions.
+
+use std::collections::HashMap;
+
+use super::common::*;
+use super::geometry::mesh_geometry;
+use super::Ctx;
+use crate::model::gearbox::*;
+use crate::model::problems::Problems;
+use crate::model::schema::*;
+use crate::physics::geometry::MeshKind;
+use crate::physics::kinematics::Constraint;
+
+/// Sets and the mount (and carrier) of every gear.
+pub(super) type Mounts = Vec<(GearMount, Option<usize>)>;
+
+/// Planet roles: gear name → index of the set naming it as a planet.
+pub(super) fn planet_roles(file: &ModelFile) -> HashMap<&str, usize> {
+    let mut planet_of: HashMap<&str, usize> = HashMap::new();
+    for (si, s) in file.planetary_sets.iter().enumerate() {
+        for p in [
+            &s.planet,
+            &s.inner_planet,
+            &s.outer_planet,
+            &s.long_planet,
+            &s.short_planet,
+        ]
+        .into_iter()
+        .flatten()
+        {
+            planet_of.insert(p.as_str(), si);
+        }
+    }
+
+    planet_of
+}
+
+/// Validate `[[planetary_sets]]`: appends their rows to `fixed_rows` and their meshes to `meshes`.
+pub(super) fn validate_sets(
+    ctx: &Ctx<'_>,
+    meshes: &mut Vec<Mesh>,
+    fixed_rows: &mut Vec<Constraint>,
+    problems: &mut Problems,
+) -> (Vec<PlanetarySet>, Mounts) {
+    let file = ctx.file;
+    let (geoms, gear_member) = (&ctx.gears.geoms, &ctx.gears.member);
+    let member = |name: &str, path: String, problems: &mut Problems| ctx.member(name, path, problems);
+    let gear_lookup = |name: &str, path: String, problems: &mut Problems| ctx.gear(name, path, problems);
+    let mut sets: Vec<PlanetarySet> = Vec::new();
+    let mut mounts: Vec<(GearMount, Option<usize>)> = vec![(GearMount::OnMember, None); file.gears.len()];
+    for (si, s) in file.planetary_sets.iter().enumerate() {
+        let p = format!("planetary_sets[{si}]");
+        let carrier = member(&s.carrier, format!("{p}.carrier"), problems);
+        if !(1..=12).contains(&s.planets) {
+            problems.push(format!("{p}.planets"), s.planets, "must be an integer in [1, 12]");
+        }
+        let n_pl = s.planets.clamp(1, 12) as u32;
+        let roles: &[(&str, &Option<String>)] = match s.kind {
+            PlanetarySetKind::Simple => &[("sun", &s.sun), ("planet", &s.planet)],
+            PlanetarySetKind::DoublePinion => &[
+                ("sun", &s.sun),
+                ("inner_planet", &s.inner_planet),
+                ("outer_planet", &s.outer_planet),
+            ],
+            PlanetarySetKind::Ravigneaux => &[
+                ("large_sun", &s.large_sun),
+                ("small_sun", &s.small_sun),
+                ("long_planet", &s.long_planet),
+                ("short_planet", &s.short_planet),
+            ],
+        };
+        let all_roles = [
+            ("sun", &s.sun),
+            ("planet", &s.planet),
+            ("inner_planet", &s.inner_planet),
+            ("outer_planet", &s.outer_planet),
+            ("large_sun", &s.large_sun),
+            ("small_sun", &s.small_sun),
+            ("long_planet", &s.long_planet),
+            ("short_planet", &s.short_planet),
+        ];
+        for (role, v) in all_roles {
+            if v.is_some() && !roles.iter().any(|(r, _)| *r == role) {
+                problems.push(
+                    format!("{p}.{role}"),
+                    q(v.as_deref().unwrap_or("")),
+                    format!(
+                        "not used by a {:?} set; it takes: ring, {}",
+                        s.kind,
+                        list(roles.iter().map(|(r, _)| r))
+                    ),
+                );
+            }
+        }
+        let mut ix: Vec<Option<usize>> = Vec::new();
+        for (role, v) in roles {
+            match v {
+                None => {
+                    problems.push(
+                        format!("{p}.{role}"),
+                        "",
+                        format!("required for a {} set", kind_name(s.kind)),
+                    );
+                    ix.push(None);
+                }
+                Some(name) => ix.push(gear_lookup(name, format!("{p}.{role}"), problems)),
+            }
+        }
+        let ring = gear_lookup(&s.ring, format!("{p}.ring"), problems);
+        ix.push(ring);
+        if ix.iter().any(Option::is_none) || carrier.is_none() {
+            continue;
+        }
+        let ix: Vec<usize> = ix.into_iter().flatten().collect();
+        let carrier = carrier.unwrap_or_default();
+        // Roles: internal only for the ring; planets mounted on the carrier; suns/ring on other members.
+        let mut ok = true;
+        let nroles = roles.len();
+        for (k, &gi) in ix.iter().enumerate() {
+            let role = if k == nroles { "ring" } else { roles[k].0 };
+            let is_planet = role.contains("planet");
+            let want_internal = role == "ring";
+            if file.gears[gi].internal != want_internal {
+                problems.push(
+                    format!("{p}.{role}"),
+                    q(&file.gears[gi].name),
+                    if want_internal {
+                        "the ring must be an internal gear (internal = true)"
+                    } else {
+                        "must be an external gear"
+                    },
+                );
+                ok = false;
+            }
+            if let Some(gm) = gear_member[gi] {
+                if is_planet && gm != carrier {
+                    problems.push(
+                        format!("gears[{gi}].member"),
+                        q(&file.gears[gi].member),
+                        format!(
+                            "planet of set \"{}\": its member must be the carrier \"{}\"",
+                            s.name, s.carrier
+                        ),
+                    );
+                    ok = false;
+                }
+                if !is_planet && gm == carrier {
+                    problems.push(
+                        format!("gears[{gi}].member"),
+                        q(&file.gears[gi].member),
+                        "a sun or ring cannot sit on the set's carrier",
+                    );
+                    ok = false;
+                }
+            }
+        }
+        if !ok {
+            continue;
+        }
+        let z = |gi: usize| file.gears[gi].teeth as f64;
+        let mem = |gi: usize| gear_member[gi].unwrap_or_default();
+        let first_row = fixed_rows.len();
+        // Rows, generated meshes (gear1, gear2, kind, load path), and planet mounts.
+        type GenMesh = (usize, usize, MeshKind, Vec<(usize, f64)>);
+        let mut gen: Vec<GenMesh> = Vec::new();
+        match s.kind {
+            PlanetarySetKind::Simple => {
+                let (sun, pl, ring) = (ix[0], ix[1], ix[2]);
+                fixed_rows.push(Constraint::SimpleSet {
+                    sun: mem(sun),
+                    ring: mem(ring),
+                    carrier,
+                    zs: z(sun),
+                    zr: z(ring),
+                });
+                gen.push((sun, pl, MeshKind::External, vec![(first_row, 1.0)]));
+                // Signs: torque applied to gear 1 of each mesh (see MeshLoadPath); the planet is in
+                // equilibrium, so its ring mesh carries the opposite of its sun mesh.
+                gen.push((pl, ring, MeshKind::Internal, vec![(first_row, -1.0)]));
+                mounts[pl] = (
+                    GearMount::Planet {
+                        set: si,
+                        reference: mem(sun),
+                        factor: spin_from_sun(z(sun), z(pl)),
+                    },
+                    Some(carrier),
+                );
+                assembly(problems, &p, "(z_sun + z_ring)", z(sun) + z(ring), n_pl);
+            }
+            PlanetarySetKind::DoublePinion => {
+                let (sun, inner, outer, ring) = (ix[0], ix[1], ix[2], ix[3]);
+                fixed_rows.push(Constraint::DoublePinionSet {
+                    sun: mem(sun),
+                    ring: mem(ring),
+                    carrier,
+                    zs: z(sun),
+                    zr: z(ring),
+                });
+                gen.push((sun, inner, MeshKind::External, vec![(first_row, 1.0)]));
+                gen.push((inner, outer, MeshKind::External, vec![(first_row, -1.0)]));
+                gen.push((outer, ring, MeshKind::Internal, vec![(first_row, 1.0)]));
+                mounts[inner] = (
+                    GearMount::Planet {
+                        set: si,
+                        reference: mem(sun),
+                        factor: spin_from_sun(z(sun), z(inner)),
+                    },
+                    Some(carrier),
+                );
+                mounts[outer] = (
+                    GearMount::Planet {
+                        set: si,
+                        reference: mem(ring),
+                        factor: spin_from_ring(z(ring), z(outer)),
+                    },
+                    Some(carrier),
+                );
+                assembly(problems, &p, "(z_ring − z_sun)", z(ring) - z(sun), n_pl);
+            }
+            PlanetarySetKind::Ravigneaux => {
+                let (ls, ss, long, short, ring) = (ix[0], ix[1], ix[2], ix[3], ix[4]);
+                let [r1, r2] =
+                    Constraint::ravigneaux(mem(ls), mem(ss), mem(ring), carrier, z(ls), z(ss), z(ring));
+                fixed_rows.push(r1);
+                fixed_rows.push(r2);
+                let (k1, k2) = (first_row, first_row + 1);
+                gen.push((ls, long, MeshKind::External, vec![(k1, 1.0)]));
+                gen.push((ss, short, MeshKind::External, vec![(k2, 1.0)]));
+                gen.push((short, long, MeshKind::External, vec![(k2, -1.0)]));
+                // The long pinion–ring mesh carries both rows' ring force: ring torque z_R(λ1 − λ2).
+                gen.push((long, ring, MeshKind::Internal, vec![(k1, -1.0), (k2, 1.0)]));
+                mounts[long] = (
+                    GearMount::Planet {
+                        set: si,
+                        reference: mem(ls),
+                        factor: spin_from_sun(z(ls), z(long)),
+                    },
+                    Some(carrier),
+                );
+                mounts[short] = (
+                    GearMount::Planet {
+                        set: si,
+                        reference: mem(ss),
+                        factor: spin_from_sun(z(ss), z(short)),
+                    },
+                    Some(carrier),
+                );
+                assembly(problems, &p, "(z_ring + z_large_sun)", z(ring) + z(ls), n_pl);
+                assembly(problems, &p, "(z_ring − z_small_sun)", z(ring) - z(ss), n_pl);
+            }
+        }
+        for &gi in &ix {
+            if mounts[gi].1.is_none() {
+                mounts[gi].1 = Some(carrier);
+            }
+        }
+        // Geometry of the generated meshes; coaxiality of the central gears.
+        let mut centre: HashMap<usize, f64> = HashMap::new();
+        let mut gen_ok = true;
+        for (g1, g2, mk, rows) in gen {
+            let mp = format!("{p} mesh {}/{}", file.gears[g1].name, file.gears[g2].name);
+            let Some(geo) = mesh_geometry(geoms, g1, g2, mk, None, &mp, file, problems) else {
+                gen_ok = false;
+                continue;
+            };
+            // Distance of the planet axis from the set axis (sun–planet and planet–ring meshes).
+            let planet = if mounts[g1].0 != GearMount::OnMember {
+                None
+            } else {
+                Some(g2)
+            };
+            let planet = planet.or(if mounts[g2].0 == GearMount::OnMember {
+                Some(g1)
+            } else {
+                None
+            });
+            if let Some(pg) = planet {
+                if let Some(prev) = centre.insert(pg, geo.a_w) {
+                    if (prev - geo.a_w).abs() > 1e-3 * file.gears[pg].module_mm * MM {
+                        problems.push(
+                            p.to_string(),
+                            format!("{:.4} mm vs {:.4} mm", prev / MM, geo.a_w / MM),
+                            format!(
+                                "planet \"{}\": its centre distances to the sun and to the ring must be equal (coaxial set); adjust profile shifts or tooth counts",
+                                file.gears[pg].name
+                            ),
+                        );
+                    }
+                }
+            }
+            meshes.push(Mesh {
+                name: format!("{}:{}/{}", s.name, file.gears[g1].name, file.gears[g2].name),
+                gear1: g1,
+                gear2: g2,
+                geometry: geo,
+                set: Some(si),
+                multiplicity: n_pl,
+                load_path: MeshLoadPath { rows },
+            });
+        }
+        // Neighbour condition: planets of one type must not touch (2 a sin(π/N) > d_a).
+        if gen_ok && n_pl > 1 {
+            for (&pg, &a) in &centre {
+                if let Some(g) = &geoms[pg] {
+                    let gap = 2.0 * a * (std::f64::consts::PI / n_pl as f64).sin() - g.d_a;
+                    if gap <= 0.0 {
+                        problems.push(
+                            format!("{p}.planets"),
+                            n_pl,
+                            format!(
+                                "planets \"{}\" overlap: 2·a·sin(π/N) = {:.2} mm < tip diameter {:.2} mm",
+                                file.gears[pg].name,
+                                (gap + g.d_a) / MM,
+                                g.d_a / MM
+                            ),
+                        );
+                    }
+                }
+            }
+        }
+        sets.push(PlanetarySet {
+            name: s.name.clone(),
+            kind: s.kind,
+            carrier,
+            planets: n_pl,
+            gears: ix,
+        });
+    }
+
+    (sets, mounts)
+}
+
+fn kind_name(k: PlanetarySetKind) -> &'static str {
+    match k {
+        PlanetarySetKind::Simple => "simple",
+        PlanetarySetKind::DoublePinion => "double_pinion",
+        PlanetarySetKind::Ravigneaux => "ravigneaux",
+    }
+}
+
+/// Equal spacing of N planets needs `teeth_sum / N` to be an integer (standard assembly condition).
+fn assembly(problems: &mut Problems, path: &str, what: &str, teeth_sum: f64, n: u32) {
+    let q = teeth_sum / n as f64;
+    if (q - q.round()).abs() > 1e-9 {
+        problems.push(
+            format!("{path}.planets"),
+            n,
+            format!("planets cannot be assembled equally spaced: {what} = {teeth_sum} is not divisible by the number of planets"),
+        );
+    }
+}

@@ -1,0 +1,240 @@
+//! The SKF (2004) frictional-moment model of rolling bearings:
+//!
+//! ```text
+//! M = φ_ish·φ_rs·M_rr + M_sl + M_seal + M_drag                       [N·mm]
+//! M_rr = G_rr·(ν·n)^0.6                                               rolling
+//! φ_ish = 1 / (1 + 1.84e-9·(n·d_m)^1.28·ν^0.64)                       inlet shear heating
+//! φ_rs  = exp(−K_rs·ν·n·(d + D)·√(K_z / (2(D − d))))                  replenishment/starvation
+//! M_sl = G_sl·μ_sl,  μ_sl = φ_bl·μ_bl + (1 − φ_bl)·μ_EHL               sliding
+//! φ_bl = exp(−2.6e-8·(n·ν)^1.4·d_m)                                   film weighting
+//! M_seal = K_S1·d_s^β + K_S2                                          integral contact seals
+//! M_drag = 0.4·V_M·K_ball·d_m^5·n² + 1.093e-7·n²·d_m³·(n·d_m²·f_t/ν)^−1.379·R_s   oil bath (balls)
+//! ```
+//!
+//! with n in r/min, ν in mm²/s, lengths in mm, loads in N.
+//!
+//! Source: SKF, "The SKF model for calculating the frictional moment" (SKF publication,
+//! cdn.skfmediahub.skf.com), as implemented by two open peers that agree term by term and were
+//! used here to read the formulas and constants (no code copied; docs/physics.md §Bearings lists
+//! them): a MATLAB gearbox-loss script citing the document ("Formeln nach SKF") and a Python
+//! deep-groove-ball-bearing model (`BEARING_CONSTANTS`). The `G_rr`/`G_sl` forms implemented:
+//!
+//! - deep-groove ball bearings, F_a = 0: `G_rr = R1·d_m^1.96·F_r^0.54`,
+//!   `G_sl = S1·d_m^−0.26·F_r^(5/3)`; F_a > 0: `α_F = 24.6·(F_a/C_0)^0.24` (deg),
+//!   `G_rr = R1·d_m^1.96·(F_r + R2/sin α_F·F_a)^0.54`,
+//!   `G_sl = S1·d_m^−0.145·(F_r^5 + S2·d_m^1.5/sin α_F·F_a^4)^(1/3)`;
+//! - angular-contact ball bearings: `F_g = R3·d_m^4·n²`,
+//!   `G_rr = R1·d_m^1.97·(F_r + F_g + R2·F_a)^0.54`,
+//!   `G_sl = S1·d_m^0.26·((F_r + F_g)^(4/3) + S2·F_a^(4/3))`.
+//!
+//! The rows of the SKF tables for four-point-contact ball, cylindrical, tapered and needle
+//! roller bearings were not found in any accessible source; those bearings use
+//! [`super::Palmgren`] (docs/physics.md says so).
+
+use super::{BearingError, BearingLoad, BearingMoment, BearingOil, BearingSize, LoadTerms};
+
+/// Which `G_rr`/`G_sl` forms of the SKF table apply.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SkfKind {
+    /// Deep-groove ball bearing (radial form; axial form with α_F when F_a > 0).
+    DeepGrooveBall,
+    /// Single-row angular-contact ball bearing (axial form with the ball centrifugal load F_g).
+    AngularContactBall,
+}
+
+/// Geometry constants of one bearing series (SKF table, catalogue units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SkfConstants {
+    /// R1.
+    pub r1: f64,
+    /// R2.
+    pub r2: f64,
+    /// R3 (angular contact: centrifugal term; 0 otherwise).
+    pub r3: f64,
+    /// S1.
+    pub s1: f64,
+    /// S2.
+    pub s2: f64,
+    /// Bearing-type constant K_z of φ_rs and the drag term (3.1 deep groove, 4.4 angular
+    /// contact).
+    pub k_z: f64,
+}
+
+/// An SKF bearing model with everything that does not change precomputed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Skf {
+    kind: SkfKind,
+    c: SkfConstants,
+    /// d_m in mm.
+    dm: f64,
+    /// Static load rating C_0, N (for α_F of a deep-groove bearing under axial load).
+    c0: f64,
+    /// Sliding friction coefficients in boundary and full-film lubrication.
+    mu_bl: f64,
+    mu_ehl: f64,
+    /// Integral seals K_S1·d_s^β + K_S2, N·mm (0 without contact seals).
+    m_seal: f64,
+    /// Drag: 0.4·V_M·K_ball·d_m^5 (× n²) and 1.093e-7·d_m³·R_s (× n²·(n d_m² f_t/ν)^−1.379) and
+    /// d_m²·f_t; all zero for a bearing above the oil.
+    drag1: f64,
+    drag2: f64,
+    dm2_ft: f64,
+    /// K_rs·(d + D)·√(K_z/(2(D − d))): φ_rs = exp(−this·ν·n).
+    rs: f64,
+}
+
+/// Lubrication method (sets K_rs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Lubrication {
+    /// Low-level oil bath, splash or oil jet: K_rs = 3e-8.
+    OilBath,
+    /// Grease or oil-air: K_rs = 6e-8.
+    Grease,
+}
+
+/// Everything [`Skf::new`] needs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SkfInput {
+    /// Form of the table.
+    pub kind: SkfKind,
+    /// Series constants.
+    pub constants: SkfConstants,
+    /// Boundary dimensions.
+    pub size: BearingSize,
+    /// Static load rating C_0, N (> 0).
+    pub c0: f64,
+    /// Lubrication.
+    pub lubrication: Lubrication,
+    /// μ_bl (SKF: 0.12 for n ≠ 0 as both peers use it).
+    pub mu_bl: f64,
+    /// μ_EHL (0.05 for mineral oil per the SKF online calculator, as the MATLAB peer notes).
+    pub mu_ehl: f64,
+    /// Integral contact seals (K_S1, K_S2, β, d_s in m), if any.
+    pub seal: Option<(f64, f64, f64, f64)>,
+    /// Oil level above the lowest point of the outer-ring raceway... as SKF's H: height of the
+    /// oil level above the bearing's lowest point, m (≤ 0: no drag).
+    pub oil_level: f64,
+    /// V_M of the drag term (SKF diagram; dimensionless).
+    pub drag_vm: f64,
+    /// Rows of rolling elements i_rw.
+    pub rows: f64,
+}
+
+impl Skf {
+    /// Build the model; errors name the input that is out of range.
+    pub fn new(i: &SkfInput) -> Result<Skf, BearingError> {
+        let (d, big_d) = (i.size.bore * 1e3, i.size.outside * 1e3);
+        if !(d > 0.0 && big_d > d) {
+            return Err(BearingError(format!(
+                "bore {d} mm and outside diameter {big_d} mm: need 0 < d < D"
+            )));
+        }
+        let c = i.constants;
+        for (name, v) in [("R1", c.r1), ("S1", c.s1), ("K_z", c.k_z)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(BearingError(format!("{name} = {v}: must be > 0")));
+            }
+        }
+        let dm = 0.5 * (d + big_d);
+        let m_seal = i
+            .seal
+            .map_or(0.0, |(k1, k2, beta, ds)| k1 * (ds * 1e3).powf(beta) + k2);
+        // Drag (ball bearings): SKF with t from the oil level H over d_m (H clamped to 1.2 d_m, where
+        // the bearing is fully immersed).
+        let h = (i.oil_level * 1e3).clamp(0.0, 1.2 * dm);
+        let (drag1, drag2, dm2_ft) = if h > 0.0 {
+            let t = 2.0 * ((0.6 * dm - h) / (0.6 * dm)).clamp(-1.0, 1.0).acos();
+            let f_t = if t <= std::f64::consts::PI {
+                (0.5 * t).sin()
+            } else {
+                1.0
+            };
+            let f_a = 0.05 * c.k_z * (big_d + d) / (big_d - d);
+            let r_s = 0.36 * dm * dm * (t - t.sin()) * f_a;
+            let k_ball = i.rows * c.k_z * (d + big_d) / (big_d - d) * 1e-12;
+            (
+                0.4 * i.drag_vm * k_ball * dm.powi(5),
+                1.093e-7 * dm.powi(3) * r_s,
+                dm * dm * f_t,
+            )
+        } else {
+            (0.0, 0.0, 0.0)
+        };
+        Ok(Skf {
+            kind: i.kind,
+            c,
+            dm,
+            c0: i.c0,
+            mu_bl: i.mu_bl,
+            mu_ehl: i.mu_ehl,
+            m_seal,
+            drag1,
+            drag2,
+            dm2_ft,
+            rs: match i.lubrication {
+                Lubrication::OilBath => 3e-8,
+                Lubrication::Grease => 6e-8,
+            } * (d + big_d)
+                * (c.k_z / (2.0 * (big_d - d))).sqrt(),
+        })
+    }
+
+    /// G_rr and G_sl at speed `n` (r/min) and `load`.
+    pub fn load_terms(&self, n: f64, load: BearingLoad) -> LoadTerms {
+        let (fr, fa) = (load.radial.abs(), load.axial.abs());
+        let (c, dm) = (&self.c, self.dm);
+        let (g_rr, g_sl) = match self.kind {
+            SkfKind::DeepGrooveBall if fa > 0.0 && self.c0 > 0.0 => {
+                let sin_af = (24.6 * (fa / self.c0).powf(0.24)).min(90.0).to_radians().sin();
+                (
+                    c.r1 * dm.powf(1.96) * (fr + c.r2 / sin_af * fa).powf(0.54),
+                    c.s1 * dm.powf(-0.145) * (fr.powi(5) + c.s2 * dm.powf(1.5) / sin_af * fa.powi(4)).cbrt(),
+                )
+            }
+            SkfKind::DeepGrooveBall => (
+                c.r1 * dm.powf(1.96) * fr.powf(0.54),
+                c.s1 * dm.powf(-0.26) * fr.powf(5.0 / 3.0),
+            ),
+            SkfKind::AngularContactBall => {
+                let fg = c.r3 * dm.powi(4) * n * n;
+                (
+                    c.r1 * dm.powf(1.97) * (fr + fg + c.r2 * fa).powf(0.54),
+                    c.s1 * dm.powf(0.26) * ((fr + fg).powf(4.0 / 3.0) + c.s2 * fa.powf(4.0 / 3.0)),
+                )
+            }
+        };
+        let drag = if self.drag2 > 0.0 && n > 0.0 {
+            n * n * (n * self.dm2_ft).powf(-1.379)
+        } else {
+            0.0
+        };
+        LoadTerms {
+            n_rpm: n,
+            g_rr,
+            g_sl,
+            speed: [(n * dm).powf(1.28), n.powf(0.6), n.powf(1.4), drag],
+        }
+    }
+
+    /// Frictional moment at the oil state `oil` with the load terms `t`: two exponentials and
+    /// arithmetic (the powers of ν and n are precomputed). No allocation.
+    pub fn moment(&self, t: &LoadTerms, oil: BearingOil) -> BearingMoment {
+        let n = t.n_rpm;
+        if n == 0.0 {
+            return BearingMoment::default();
+        }
+        let [ndm128, n06, n14, drag_n] = t.speed;
+        let phi_ish = 1.0 / (1.0 + 1.84e-9 * ndm128 * oil.p064);
+        let phi_rs = (-self.rs * oil.nu * n).exp();
+        let m_rr = phi_ish * phi_rs * t.g_rr * n06 * oil.p060;
+        let phi_bl = (-2.6e-8 * n14 * oil.p140 * self.dm).exp();
+        let mu_sl = phi_bl * self.mu_bl + (1.0 - phi_bl) * self.mu_ehl;
+        let m_drag = n * n * self.drag1 + self.drag2 * drag_n * oil.p1379;
+        BearingMoment {
+            rolling: 1e-3 * m_rr,
+            sliding: 1e-3 * t.g_sl * mu_sl,
+            seal: 1e-3 * self.m_seal,
+            drag: 1e-3 * m_drag,
+        }
+    }
+}

@@ -1,0 +1,186 @@
+//! Where a churning model is used outside the range it was fitted or derived on (issue 14).
+//!
+//! Only ranges the models themselves define are checked; the fitted ranges of geometry and
+//! immersion of Changenet & Velex 2007 could not be found in a source (docs/validation.md says
+//! what was searched), so they are not invented here.
+//!
+//! - Changenet–Velex: `Re_c = ω r_p b/ν` between the two laws (6000–9000 by default): the paper
+//!   gives no law there; the power comes from the log-linear bridge (docs/physics.md §5).
+//! - Stavytskyi: above the filling limit (V₃ = 0) the Coriolis term has collapsed; that regime
+//!   follows from reconstruction R3 (absolute bath pressure), and the paper reports only a
+//!   "slight" fall at 5000–7000 rpm, so the computed fall is not backed by the paper.
+//! - Seetharaman–Kahraman: face Reynolds number above the laminar–turbulent transition: the mixed
+//!   plate law there is derived (White), not part of seed 000's fitted or tested range.
+
+use super::{ChurningGear, GearChurning, OilState};
+
+/// One kind of out-of-range use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum RangeCheck {
+    /// Changenet–Velex between its low and high Re_c laws.
+    ChangenetBridge,
+    /// Stavytskyi above the filling limit speed.
+    StavytskyiAboveFillingLimit,
+    /// Seetharaman–Kahraman with turbulent faces.
+    SeetharamanTurbulentFaces,
+}
+
+impl RangeCheck {
+    /// Every check, in output order.
+    pub const ALL: [RangeCheck; 3] = [
+        RangeCheck::ChangenetBridge,
+        RangeCheck::StavytskyiAboveFillingLimit,
+        RangeCheck::SeetharamanTurbulentFaces,
+    ];
+
+    /// Position in [`Self::ALL`].
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The range, in words.
+    pub fn range(self) -> &'static str {
+        match self {
+            RangeCheck::ChangenetBridge => {
+                "Changenet–Velex Re_c between the low and high laws (6000–9000): no law in the paper, log-linear bridge"
+            }
+            RangeCheck::StavytskyiAboveFillingLimit => {
+                "Stavytskyi above the filling limit: Coriolis term collapsed (reconstruction R3, not backed by the paper)"
+            }
+            RangeCheck::SeetharamanTurbulentFaces => {
+                "Seetharaman–Kahraman faces above the laminar transition Re_L: derived mixed plate law"
+            }
+        }
+    }
+
+    /// Name of the quantity whose seen range is reported.
+    pub fn quantity(self) -> &'static str {
+        match self {
+            RangeCheck::ChangenetBridge => "Re_c",
+            RangeCheck::StavytskyiAboveFillingLimit => "speed rpm",
+            RangeCheck::SeetharamanTurbulentFaces => "Re_L",
+        }
+    }
+}
+
+/// The range of the gears Stavytskyi's model was compared with (Blok 1962, seed 001 §3 and
+/// table 1): module 1.5–5 mm, face width 14–24 mm, 20–102 teeth (helix 25°, h/r_a 0.55).
+pub const STAVYTSKYI_TESTED: &str =
+    "Stavytskyi compared with Blok's gears only: module 1.5–5 mm, face width 14–24 mm, 20–102 teeth (seed 001 §3, table 1)";
+
+/// What lies outside [`STAVYTSKYI_TESTED`] for gear `g` (empty when inside).
+pub fn stavytskyi_geometry(g: &ChurningGear) -> Vec<String> {
+    let mut v = Vec::new();
+    let m = g.normal_module * 1e3;
+    if !(1.5..=5.0).contains(&m) {
+        v.push(format!("module {m:.2} mm"));
+    }
+    let b = g.face_width * 1e3;
+    if !(14.0..=24.0).contains(&b) {
+        v.push(format!("face width {b:.1} mm"));
+    }
+    if !(20..=102).contains(&g.teeth) {
+        v.push(format!("{} teeth", g.teeth));
+    }
+    v
+}
+
+impl GearChurning {
+    /// The out-of-range use at ω (rad/s) and `oil`, with the value of [`RangeCheck::quantity`];
+    /// `None` inside the range (or not immersed, or at rest).
+    pub fn out_of_range(&self, omega: f64, oil: &OilState) -> Option<(RangeCheck, f64)> {
+        let w = omega.abs();
+        if w == 0.0 || !self.is_immersed() {
+            return None;
+        }
+        match self {
+            GearChurning::Changenet(g) => {
+                let re_c = g.critical_reynolds(w, oil);
+                let (lo, hi) = g.bridge();
+                (re_c > lo && re_c < hi).then_some((RangeCheck::ChangenetBridge, re_c))
+            }
+            GearChurning::Stavytskyi(g) => (g.filling_velocity(w, oil) == 0.0).then_some((
+                RangeCheck::StavytskyiAboveFillingLimit,
+                w * 30.0 / std::f64::consts::PI,
+            )),
+            GearChurning::Seetharaman(g) => {
+                let re = g.face_reynolds(w, oil);
+                g.turbulent_faces(re)
+                    .then_some((RangeCheck::SeetharamanTurbulentFaces, re))
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_support::*;
+    use super::super::{ChurningConfig, ChurningModel, GearChurning};
+    use super::*;
+
+    fn model(m: ChurningModel) -> GearChurning {
+        let cfg = ChurningConfig {
+            model: m,
+            ..Default::default()
+        };
+        GearChurning::new(&cfg, &fzg_wheel(0.05918)).unwrap()
+    }
+
+    #[test]
+    fn stavytskyi_geometry_outside_blok_is_listed() {
+        // FZG wheel: m 4.5 mm inside, b 14 mm inside, 24 teeth inside.
+        assert!(stavytskyi_geometry(&fzg_wheel(0.05)).is_empty());
+        let g = ChurningGear {
+            face_width: 40e-3,
+            normal_module: 1e-3,
+            ..fzg_wheel(0.05)
+        };
+        assert_eq!(stavytskyi_geometry(&g).len(), 2);
+    }
+
+    #[test]
+    fn changenet_bridge_is_reported_only_inside_the_band() {
+        let g = model(ChurningModel::Changenet);
+        let oil = oil();
+        let GearChurning::Changenet(c) = g else {
+            unreachable!()
+        };
+        // speed at Re_c = 7500 and at 3000 / 12000
+        let w = |re: f64| re / c.critical_reynolds(1.0, &oil);
+        let (k, v) = g.out_of_range(w(7500.0), &oil).unwrap();
+        assert_eq!(k, RangeCheck::ChangenetBridge);
+        assert!((v - 7500.0).abs() < 1e-6);
+        assert!(g.out_of_range(w(3000.0), &oil).is_none());
+        assert!(g.out_of_range(w(12000.0), &oil).is_none());
+        assert!(g.out_of_range(0.0, &oil).is_none());
+    }
+
+    #[test]
+    fn stavytskyi_above_the_filling_limit_is_reported() {
+        let g = model(ChurningModel::Stavytskyi);
+        let oil = oil();
+        let GearChurning::Stavytskyi(s) = g else {
+            unreachable!()
+        };
+        let w0 = s.filling_limit_speed(&oil).unwrap();
+        assert!(g.out_of_range(0.9 * w0, &oil).is_none());
+        let (k, rpm) = g.out_of_range(1.1 * w0, &oil).unwrap();
+        assert_eq!(k, RangeCheck::StavytskyiAboveFillingLimit);
+        assert!((rpm - 1.1 * w0 * 30.0 / std::f64::consts::PI).abs() < 1e-9);
+    }
+
+    #[test]
+    fn seetharaman_turbulent_faces_are_reported() {
+        let g = model(ChurningModel::Seetharaman);
+        let oil = oil();
+        let GearChurning::Seetharaman(s) = g else {
+            unreachable!()
+        };
+        let w_t = 5e5 / s.face_reynolds(1.0, &oil);
+        assert!(g.out_of_range(0.5 * w_t, &oil).is_none());
+        assert_eq!(
+            g.out_of_range(2.0 * w_t, &oil).map(|x| x.0),
+            Some(RangeCheck::SeetharamanTurbulentFaces)
+        );
+    }
+}

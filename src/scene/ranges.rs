@@ -1,0 +1,127 @@
+//! Warnings: loss models used outside the range they were fitted or derived on, and loss items
+//! whose value is not known (issue 14). Reported in `warnings` of the JSON outputs and
+//! summary.json, and one stderr line per item and range.
+//!
+//! Range checks depend on the operating point (speeds, oil viscosity), so they are gathered over
+//! the points a command evaluates ([`RangeLog::check`]) and summarised per item and range with
+//! the span of the quantity seen ([`RangeLog::warnings`]).
+
+use std::fmt;
+
+use crate::physics::losses::churning::{OilState, RangeCheck};
+
+use super::losses::{LossScene, OperatingPoint};
+
+/// One warning: an item, the range or condition, and what was seen.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct RangeWarning {
+    /// Loss item (e.g. "churning of gear wheel").
+    pub item: String,
+    /// The range left or the condition met.
+    pub range: String,
+    /// What was seen (quantity span, share of points).
+    pub seen: String,
+}
+
+impl fmt::Display for RangeWarning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "warning: {}: {} ({})", self.item, self.range, self.seen)
+    }
+}
+
+/// The warning for a mesh whose zone lies partly (wet share `wet` < 1) or wholly above the oil
+/// while the model file gives no density for that part.
+pub fn above_oil_warning(mesh: &str, wet: f64) -> RangeWarning {
+    RangeWarning {
+        item: format!("pocketing of mesh {mesh}"),
+        range: "mesh zone above the oil: the density it pumps is unknown (no jet or splash flow, no carried-oil model); that share is not counted — set [losses] pocketing_mixture_density_kg_m3 to count it".into(),
+        seen: format!("{:.0} % of the mesh zone above the oil", 100.0 * (1.0 - wet).clamp(0.0, 1.0)),
+    }
+}
+
+/// Per item and range: points seen out of range and the span of the quantity.
+#[derive(Debug, Clone)]
+pub struct RangeLog {
+    /// [item][check] → (count, min, max).
+    seen: Vec<[(usize, f64, f64); RangeCheck::ALL.len()]>,
+    /// Points checked.
+    points: usize,
+}
+
+impl RangeLog {
+    /// An empty log for `scene`.
+    pub fn new(scene: &LossScene) -> RangeLog {
+        RangeLog {
+            seen: vec![[(0, f64::INFINITY, f64::NEG_INFINITY); RangeCheck::ALL.len()]; scene.len()],
+            points: 0,
+        }
+    }
+
+    /// Check every churning model of `scene` at `op`.
+    pub fn check(&mut self, scene: &LossScene, op: &OperatingPoint) {
+        self.points += 1;
+        let oil = OilState {
+            density: op.oil.rho,
+            kinematic_viscosity: op.oil.nu,
+        };
+        let mut last = (usize::MAX, usize::MAX);
+        for (item, m, w) in scene.churning_models(op.state, op.input_speed) {
+            if let Some((c, v)) = m.out_of_range(w, &oil) {
+                let e = &mut self.seen[item][c.index()];
+                // a planet has several orbit nodes: count the point once per item and range
+                if last != (item, c.index()) {
+                    e.0 += 1;
+                }
+                last = (item, c.index());
+                e.1 = e.1.min(v);
+                e.2 = e.2.max(v);
+            }
+        }
+    }
+
+    /// The static warnings of `scene` followed by one warning per item and range met.
+    pub fn warnings(&self, scene: &LossScene) -> Vec<RangeWarning> {
+        let mut out = scene.warnings.clone();
+        for (k, per) in self.seen.iter().enumerate() {
+            for c in RangeCheck::ALL {
+                let (n, lo, hi) = per[c.index()];
+                if n == 0 {
+                    continue;
+                }
+                let span = if (hi - lo).abs() <= 1e-9 * hi.abs() {
+                    format!("{} {}", c.quantity(), sig(lo))
+                } else {
+                    format!("{} {}–{}", c.quantity(), sig(lo), sig(hi))
+                };
+                out.push(RangeWarning {
+                    item: format!(
+                        "{} of gear {}",
+                        scene.items[k].source.as_str(),
+                        scene.items[k].name
+                    ),
+                    range: c.range().into(),
+                    seen: format!("{span} at {n} of {} points", self.points),
+                });
+            }
+        }
+        out
+    }
+}
+
+/// A number to 4 significant digits, no exponent for the usual magnitudes.
+fn sig(v: f64) -> String {
+    if v.abs() >= 1e5 {
+        format!("{v:.3e}")
+    } else if v.abs() >= 100.0 {
+        format!("{v:.0}")
+    } else {
+        format!("{v:.3}")
+    }
+}
+
+/// Print each warning as one stderr line.
+pub fn print_warnings(w: &[RangeWarning]) {
+    for x in w {
+        eprintln!("{x}");
+    }
+}

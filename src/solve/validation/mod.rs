@@ -1,0 +1,193 @@
+//! Reference cases (`validation/<case>/case.toml`) evaluated with every applicable model choice
+//! (issue 14; docs/validation.md).
+//!
+//! A case names a model file, a loss quantity (sliding, churning or pocketing, optionally one
+//! item), the kind of reference (peer, standard, measurement, trend) and its source, and either a
+//! reference CSV (`point,gear,speed_rpm,torque_nm,oil_temp_c,reference_w`; speed and torque at
+//! the model's input) or trend checks (a speed exponent or a power ratio that must lie in a
+//! range). Each model choice is a set of `[losses]` keys written over the model file's own.
+
+pub mod case;
+pub mod stats;
+
+use std::path::{Path, PathBuf};
+
+pub use case::{Case, Kind, Quantity, TrendCheck};
+pub use stats::{summarise, SummaryRow};
+
+use crate::model::{self, Gearbox};
+use crate::physics::oil::KELVIN_OFFSET;
+use crate::scene::{LossScene, OperatingPoint, Source};
+
+/// One row of `validation.csv`.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Row {
+    /// Case name (its directory).
+    pub case: String,
+    /// Point label.
+    pub point: String,
+    /// Model choice label.
+    pub model: String,
+    /// Quantity compared (`sliding`, `churning`).
+    pub quantity: &'static str,
+    /// Input speed, rpm (for the error-vs-speed plot).
+    pub speed_rpm: f64,
+    /// geartherm's value (W, or the trend metric).
+    pub predicted: f64,
+    /// Reference value (W; trends: the nearest bound when outside the range, else the value).
+    pub reference: f64,
+    /// Kind of reference.
+    pub kind: Kind,
+    /// Source of the reference.
+    pub source: String,
+    /// (predicted − reference)/reference.
+    pub relative_error: f64,
+}
+
+/// A case that could not be evaluated.
+#[derive(Debug, thiserror::Error)]
+pub enum ValidationError {
+    /// Unreadable or malformed case or reference file.
+    #[error("{}: {msg}", path.display())]
+    Case { path: PathBuf, msg: String },
+    /// The model file (with a choice applied) does not load or compile.
+    #[error("{}: model choice {choice}: {msg}", path.display())]
+    Model {
+        path: PathBuf,
+        choice: String,
+        msg: String,
+    },
+}
+
+/// Every case directory under `dir` (those holding a `case.toml`), sorted.
+pub fn case_dirs(dir: &Path) -> Result<Vec<PathBuf>, ValidationError> {
+    let rd = std::fs::read_dir(dir).map_err(|e| ValidationError::Case {
+        path: dir.to_path_buf(),
+        msg: e.to_string(),
+    })?;
+    let mut v: Vec<PathBuf> = rd
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.join("case.toml").is_file())
+        .collect();
+    v.sort();
+    Ok(v)
+}
+
+/// Evaluate every case under `dir` with every model choice of its family.
+pub fn run_all(dir: &Path) -> Result<Vec<Row>, ValidationError> {
+    let mut rows = Vec::new();
+    for d in case_dirs(dir)? {
+        rows.extend(run_case(&Case::load(&d)?)?);
+    }
+    Ok(rows)
+}
+
+/// Evaluate one case.
+pub fn run_case(c: &Case) -> Result<Vec<Row>, ValidationError> {
+    let mut rows = Vec::new();
+    for (label, keys) in c.quantity.choices() {
+        let gb = c.gearbox(&keys).map_err(|msg| ValidationError::Model {
+            path: c.model_path.clone(),
+            choice: label.to_string(),
+            msg,
+        })?;
+        let scene = LossScene::compile(&gb).map_err(|e| ValidationError::Model {
+            path: c.model_path.clone(),
+            choice: label.to_string(),
+            msg: e.to_string(),
+        })?;
+        let eval = |gear: &str, rpm: f64, torque: f64, temp: f64| -> Result<f64, ValidationError> {
+            value(&gb, &scene, c, gear, rpm, torque, temp).map_err(|msg| ValidationError::Case {
+                path: c.dir.join("case.toml"),
+                msg,
+            })
+        };
+        for p in &c.points {
+            let predicted = eval(&p.gear, p.speed_rpm, p.torque_nm, p.oil_temp_c)?;
+            rows.push(Row {
+                case: c.name.clone(),
+                point: p.point.clone(),
+                model: label.to_string(),
+                quantity: c.quantity.as_str(),
+                speed_rpm: p.speed_rpm,
+                predicted,
+                reference: p.reference_w,
+                kind: c.kind,
+                source: c.source.clone(),
+                relative_error: (predicted - p.reference_w) / p.reference_w,
+            });
+        }
+        for t in &c.trends {
+            let pa = eval(&t.gear, t.speed_a_rpm, t.torque_nm, t.oil_temp_c)?;
+            let pb = eval(&t.gear, t.speed_b_rpm, t.torque_nm, t.oil_temp_c)?;
+            let predicted = t.metric.value(pa, pb, t.speed_a_rpm, t.speed_b_rpm);
+            let reference = predicted.clamp(t.low, t.high);
+            rows.push(Row {
+                case: c.name.clone(),
+                point: t.point.clone(),
+                model: label.to_string(),
+                quantity: c.quantity.as_str(),
+                speed_rpm: t.speed_b_rpm,
+                predicted,
+                reference,
+                kind: Kind::Trend,
+                source: c.source.clone(),
+                relative_error: (predicted - reference) / reference,
+            });
+        }
+    }
+    Ok(rows)
+}
+
+/// The case's quantity (W) at one point.
+fn value(
+    gb: &Gearbox,
+    scene: &LossScene,
+    c: &Case,
+    gear: &str,
+    rpm: f64,
+    torque: f64,
+    temp_c: f64,
+) -> Result<f64, String> {
+    let state = gb
+        .state_index(gear)
+        .ok_or_else(|| format!("gear state \"{gear}\" not in the model"))?;
+    let op = OperatingPoint {
+        state,
+        input_speed: rpm * std::f64::consts::PI / 30.0,
+        input_torque: torque,
+        oil: gb.oil.properties(temp_c + KELVIN_OFFSET),
+    };
+    let mut out = vec![0.0; scene.len()];
+    scene.evaluate(&op, &mut out);
+    let want: Source = c.quantity.source();
+    let v: f64 = scene
+        .items
+        .iter()
+        .zip(&out)
+        .filter(|(it, _)| it.source == want && c.item.as_ref().map_or(true, |n| *n == it.name))
+        .map(|(_, w)| *w)
+        .sum();
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("non-finite {} at {rpm} rpm", c.quantity.as_str()))
+    }
+}
+
+/// Load a model file with `[losses]` keys written over its own.
+pub fn load_with(path: &Path, keys: &[(&str, toml::Value)]) -> Result<Gearbox, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
+    let mut doc: toml::Table = text.parse().map_err(|e: toml::de::Error| e.to_string())?;
+    let losses = doc
+        .entry("losses")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    let Some(t) = losses.as_table_mut() else {
+        return Err("[losses] is not a table".into());
+    };
+    for (k, v) in keys {
+        t.insert((*k).to_string(), v.clone());
+    }
+    let text = toml::to_string(&doc).map_err(|e| e.to_string())?;
+    model::from_str(&text, path).map_err(|e| e.report())
+}

@@ -1,0 +1,514 @@
+//! Design studies: a base model, parameters overridden by key path, a sampling plan, and a job
+//! (drive cycles, steady points or a map) solved for every sample. A case is one sample on one
+//! cycle or operating point; each yields one [`CaseRow`] (parameters, energy per source,
+//! efficiency, final and max temperature per node, or the failure with its message).
+//!
+//! This module sits beside the CLI and the Python binding, above `report`: it orchestrates the
+//! library (model → scene → solve → report summaries) and does no writing itself; the caller
+//! receives each finished case through a callback (the CLI journals it, Python collects it).
+
+pub mod job;
+pub mod plan;
+pub mod spec;
+
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+use toml::Value;
+
+use crate::model::{self, overrides, KeyPath, Override};
+pub use crate::report::study::{CaseRow, ParamValue};
+use job::{JobError, Point, RunOptions};
+use spec::{JobSpec, StudySpec};
+
+/// A study that cannot start: unreadable or invalid study file, invalid base model, bad
+/// parameter.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    /// A file could not be read.
+    #[error("{}: cannot read: {source}", file.display())]
+    Io {
+        /// File.
+        file: PathBuf,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// Invalid study (the message names the file and key path).
+    #[error("{0}")]
+    Invalid(String),
+}
+
+/// What one case solves.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Job {
+    /// A drive cycle with these options.
+    Run(RunOptions),
+    /// A steady operating point.
+    Point(Point),
+}
+
+impl Job {
+    /// Label in the table's `job` column.
+    pub fn label(&self) -> String {
+        match self {
+            Job::Run(o) => o.cycle.clone(),
+            Job::Point(p) => format!("gear {} @ {} rpm, {} N·m", p.gear, p.speed_rpm, p.torque_nm),
+        }
+    }
+}
+
+/// One case: a sample on a job.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Case {
+    /// Position in the study's case list.
+    pub index: usize,
+    /// Sample index.
+    pub sample: usize,
+    /// Job index.
+    pub job: usize,
+}
+
+/// The overrides of a sample and the parameter values shown in its row.
+pub type SampleOverrides = (Vec<Override>, Vec<(String, ParamValue)>);
+
+/// Files of one case (name, contents), written under `cases/<id>/` when asked.
+pub type CaseFiles = Vec<(String, Vec<u8>)>;
+
+/// A loaded, checked study.
+pub struct Study {
+    /// The study file's contents.
+    pub spec: StudySpec,
+    /// The base model's text (shipped whole to remote workers).
+    pub model_text: String,
+    /// The base model's file name (for messages).
+    pub model_file: PathBuf,
+    base: toml::Table,
+    paths: Vec<KeyPath>,
+    /// One value per parameter per sample.
+    pub samples: Vec<Vec<ParamValue>>,
+    /// The jobs every sample is solved on.
+    pub jobs: Vec<Job>,
+    /// Fingerprint of study and model (a journal of another study is refused).
+    pub fingerprint: String,
+}
+
+/// FNV-1a, 64 bit: a stable fingerprint (the same on every platform and version).
+fn fnv1a(parts: &[&[u8]]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for p in parts {
+        for &b in *p {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        h ^= 0xff;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+fn key_of(label: &str) -> String {
+    let s: String = label
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    s.chars().take(40).collect()
+}
+
+fn jobs_of(spec: &JobSpec) -> Result<Vec<Job>, String> {
+    let jobs: Vec<Job> = match spec {
+        JobSpec::Run { cycles, options } => cycles
+            .iter()
+            .map(|c| {
+                Job::Run(RunOptions {
+                    cycle: c.clone(),
+                    ..options.clone().unwrap_or_default()
+                })
+            })
+            .collect(),
+        JobSpec::Steady { points } => points.iter().cloned().map(Job::Point).collect(),
+        JobSpec::Map {
+            gear,
+            speed_rpm,
+            torque_nm,
+            vehicle_speed_kmh,
+        } => speed_rpm
+            .iter()
+            .flat_map(|&s| {
+                torque_nm.iter().map(move |&t| {
+                    Job::Point(Point {
+                        gear: gear.clone(),
+                        speed_rpm: s,
+                        torque_nm: t,
+                        vehicle_speed_kmh: *vehicle_speed_kmh,
+                        ambient_c: None,
+                    })
+                })
+            })
+            .collect(),
+    };
+    if jobs.is_empty() {
+        return Err("job: no cycles or points".into());
+    }
+    Ok(jobs)
+}
+
+/// Scale a number or (nested) array of numbers.
+fn scaled(v: &Value, f: f64) -> Result<Value, String> {
+    match v {
+        Value::Integer(i) => Ok(Value::Float(*i as f64 * f)),
+        Value::Float(x) => Ok(Value::Float(x * f)),
+        Value::Array(a) => a
+            .iter()
+            .map(|x| scaled(x, f))
+            .collect::<Result<Vec<_>, _>>()
+            .map(Value::Array),
+        other => Err(format!(
+            "a scale parameter needs a number or an array of numbers, found {other}"
+        )),
+    }
+}
+
+impl Study {
+    /// Read a study file; its `study.model` is resolved relative to the study file.
+    pub fn from_file(path: &Path) -> Result<Study, StudyError> {
+        let io = |file: &Path| {
+            let file = file.to_path_buf();
+            move |source| StudyError::Io { file, source }
+        };
+        let text = std::fs::read_to_string(path).map_err(io(path))?;
+        let de = toml::de::Deserializer::parse(&text)
+            .map_err(|e| StudyError::Invalid(format!("{}: {}", path.display(), e.message())))?;
+        let spec: StudySpec = serde_path_to_error::deserialize(de).map_err(|e| {
+            let at = e.path().to_string();
+            let msg = e.inner().message().to_string();
+            StudyError::Invalid(format!("{}: {at}: {msg}", path.display()))
+        })?;
+        let model_path = path.parent().unwrap_or(Path::new(".")).join(&spec.study.model);
+        let model_text = std::fs::read_to_string(&model_path).map_err(io(&model_path))?;
+        Study::new(spec, model_text, model_path).map_err(|e| match e {
+            StudyError::Invalid(m) => StudyError::Invalid(format!("{}: {m}", path.display())),
+            other => other,
+        })
+    }
+
+    /// Check a study given as values: the base model must validate, every parameter path must
+    /// exist in the model (or be accepted by its schema), the plan must be well formed.
+    pub fn new(spec: StudySpec, model_text: String, model_file: PathBuf) -> Result<Study, StudyError> {
+        let invalid = StudyError::Invalid;
+        model::from_str(&model_text, &model_file).map_err(|e| invalid(e.report()))?;
+        let mut problems = model::Problems::default();
+        let base = model::parse::parse_document(&model_text, &mut problems)
+            .ok_or_else(|| invalid(format!("{}: not a TOML document", model_file.display())))?;
+        if spec.parameters.is_empty() {
+            return Err(invalid("no [[parameters]]".into()));
+        }
+        let mut paths = Vec::new();
+        for (k, p) in spec.parameters.iter().enumerate() {
+            let path: KeyPath = p
+                .path
+                .parse()
+                .map_err(|e| invalid(format!("parameters[{k}].path `{}`: {e}", p.path)))?;
+            paths.push(path);
+        }
+        let samples = plan::samples(&spec.parameters, &spec.sampling).map_err(invalid)?;
+        for (k, (p, path)) in spec.parameters.iter().zip(&paths).enumerate() {
+            let Err(e) = overrides::get(&base, path) else {
+                continue;
+            };
+            if p.scale.is_some() {
+                return Err(invalid(format!("parameters[{k}].path: {e}")));
+            }
+            // Not written in the model: accepted when the schema takes it (probed with the
+            // first sample's value).
+            let value = match samples.first().map(|s| &s[k]) {
+                Some(ParamValue::Text(t)) => Value::String(t.clone()),
+                Some(ParamValue::Number(x)) => Value::Float(*x),
+                None => continue,
+            };
+            let probe = Override {
+                path: path.clone(),
+                value,
+            };
+            if let Err(e) = model::from_str_with(&model_text, &model_file, &[probe]) {
+                let r = e.report();
+                if r.contains("unknown") || r.contains("has no") || r.contains("not a table") {
+                    return Err(invalid(format!("parameters[{k}].path `{}`: {r}", p.path)));
+                }
+            }
+        }
+        let jobs = jobs_of(&spec.job).map_err(invalid)?;
+        let spec_json = serde_json::to_string(&spec).map_err(|e| invalid(e.to_string()))?;
+        let fingerprint = format!("{:016x}", fnv1a(&[spec_json.as_bytes(), model_text.as_bytes()]));
+        Ok(Study {
+            spec,
+            model_text,
+            model_file,
+            base,
+            paths,
+            samples,
+            jobs,
+            fingerprint,
+        })
+    }
+
+    /// Every case, sample-major.
+    pub fn cases(&self) -> Vec<Case> {
+        let nj = self.jobs.len();
+        (0..self.samples.len() * nj)
+            .map(|index| Case {
+                index,
+                sample: index / nj,
+                job: index % nj,
+            })
+            .collect()
+    }
+
+    /// The cases of shard `i` of `n` (every n-th case from i; i from 0).
+    pub fn shard(&self, i: usize, n: usize) -> Vec<Case> {
+        self.cases()
+            .into_iter()
+            .filter(|c| c.index % n.max(1) == i)
+            .collect()
+    }
+
+    /// Case id: `<sample>-<job>` (usable as a directory name).
+    pub fn case_id(&self, c: &Case) -> String {
+        let job = match &self.jobs[c.job] {
+            Job::Run(o) => key_of(
+                Path::new(&o.cycle)
+                    .file_stem()
+                    .map_or(&*o.cycle, |s| s.to_str().unwrap_or("cycle")),
+            ),
+            Job::Point(_) => format!("p{:04}", c.job),
+        };
+        format!("{:06}-{job}", c.sample)
+    }
+
+    /// Column name of parameter `j` (a scale parameter's value is the factor).
+    pub fn column(&self, j: usize) -> String {
+        let p = &self.spec.parameters[j];
+        if p.scale.is_some() {
+            format!("{} (scale)", p.path)
+        } else {
+            p.path.clone()
+        }
+    }
+
+    /// The overrides of a sample, and the parameter values actually used (integers rounded).
+    pub fn overrides(&self, sample: usize) -> Result<SampleOverrides, String> {
+        let mut ovs = Vec::new();
+        let mut used = Vec::new();
+        for (j, v) in self.samples[sample].iter().enumerate() {
+            let p = &self.spec.parameters[j];
+            let base = overrides::get(&self.base, &self.paths[j]).ok();
+            let (value, shown) = match v {
+                ParamValue::Text(s) => (Value::String(s.clone()), v.clone()),
+                ParamValue::Number(f) if p.scale.is_some() => {
+                    let b = base.ok_or_else(|| format!("{}: not in the model", p.path))?;
+                    (scaled(&b, *f).map_err(|e| format!("{}: {e}", p.path))?, v.clone())
+                }
+                ParamValue::Number(f) => match base {
+                    Some(Value::Integer(_)) => {
+                        (Value::Integer(f.round() as i64), ParamValue::Number(f.round()))
+                    }
+                    _ => (Value::Float(*f), v.clone()),
+                },
+            };
+            ovs.push(Override {
+                path: self.paths[j].clone(),
+                value,
+            });
+            used.push((self.column(j), shown));
+        }
+        Ok((ovs, used))
+    }
+
+    /// The equivalent stand-alone command of a case (for job arrays without Python).
+    pub fn command_line(&self, c: &Case) -> String {
+        let q = |s: &str| format!("'{}'", s.replace('\'', "'\\''"));
+        let model = q(&self.model_file.display().to_string());
+        let mut cmd = match &self.jobs[c.job] {
+            Job::Run(o) => {
+                let mut s = format!(
+                    "geartherm run {model} --cycle {} --solver {} --rtol {} --atol {} --summary-only",
+                    q(&o.cycle),
+                    o.solver,
+                    o.rtol,
+                    o.atol
+                );
+                if let Some(t) = o.initial_temp_c {
+                    s.push_str(&format!(" --initial-temp-c {t}"));
+                }
+                if let Some(t) = o.ambient_c {
+                    s.push_str(&format!(" --ambient-c {t}"));
+                }
+                s
+            }
+            Job::Point(p) => {
+                let mut s = format!(
+                    "geartherm steady {model} --gear {} --speed-rpm {} --torque-nm {} --vehicle-speed-kmh {}",
+                    q(&p.gear),
+                    p.speed_rpm,
+                    p.torque_nm,
+                    p.vehicle_speed_kmh
+                );
+                if let Some(t) = p.ambient_c {
+                    s.push_str(&format!(" --ambient-c {t}"));
+                }
+                s
+            }
+        };
+        match self.overrides(c.sample) {
+            Ok((ovs, _)) => {
+                for o in ovs {
+                    cmd.push_str(&format!(" --set {}", q(&o.to_string())));
+                }
+            }
+            Err(e) => cmd.push_str(&format!("  # {e}")),
+        }
+        cmd
+    }
+
+    /// Solve one case. Never fails: a failure is a row with status `invalid` or `failed` and
+    /// its message. With `per_case`, the run's files are returned too.
+    pub fn run_case(&self, c: &Case, per_case: bool) -> (CaseRow, CaseFiles) {
+        let mut row = CaseRow {
+            case: self.case_id(c),
+            sample: c.sample,
+            job: self.jobs[c.job].label(),
+            params: Vec::new(),
+            status: "ok".into(),
+            message: String::new(),
+            outputs: Vec::new(),
+        };
+        let result =
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| self.solve(c, per_case, &mut row)));
+        let outcome = result.unwrap_or_else(|p| {
+            let what = p
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_default();
+            Err(JobError::Numerical(format!("internal error (panic): {what}")))
+        });
+        match outcome {
+            Ok(files) => (row, files),
+            Err(e) => {
+                row.status = match e {
+                    JobError::Invalid(_) => "invalid",
+                    JobError::Numerical(_) => "failed",
+                }
+                .into();
+                row.message = e.to_string();
+                row.outputs.clear();
+                (row, Vec::new())
+            }
+        }
+    }
+
+    fn solve(&self, c: &Case, per_case: bool, row: &mut CaseRow) -> Result<CaseFiles, JobError> {
+        let (ovs, used) = self.overrides(c.sample).map_err(JobError::Invalid)?;
+        row.params = used;
+        let gb = model::from_str_with(&self.model_text, &self.model_file, &ovs).map_err(|e| {
+            let ModelMessage(m) = ModelMessage::from(&e);
+            JobError::Invalid(m)
+        })?;
+        match &self.jobs[c.job] {
+            Job::Run(o) => {
+                let o = RunOptions {
+                    summary_only: !per_case,
+                    ..o.clone()
+                };
+                let r = job::run_cycle(&gb, &o)?;
+                row.outputs = run_outputs(&r.summary);
+                let mut files = Vec::new();
+                if per_case {
+                    let json = serde_json::to_vec_pretty(&r.summary)
+                        .map_err(|e| JobError::Numerical(e.to_string()))?;
+                    files.push(("summary.json".to_string(), json));
+                    if let Some(csv) = r.timeseries_csv {
+                        files.push(("timeseries.csv".to_string(), csv.into_bytes()));
+                    }
+                }
+                Ok(files)
+            }
+            Job::Point(p) => {
+                let r = job::steady_point(&gb, p)?;
+                row.outputs = steady_outputs(&r);
+                let mut files = Vec::new();
+                if per_case {
+                    let json =
+                        serde_json::to_vec_pretty(&r).map_err(|e| JobError::Numerical(e.to_string()))?;
+                    files.push(("steady.json".to_string(), json));
+                }
+                Ok(files)
+            }
+        }
+    }
+
+    /// Solve `cases` in parallel (rayon); `on_done` receives each case as it finishes (from
+    /// worker threads, in completion order).
+    pub fn run(&self, cases: &[Case], per_case: bool, on_done: &(dyn Fn(CaseRow, CaseFiles) + Sync)) {
+        cases.par_iter().with_max_len(1).for_each(|c| {
+            let (row, files) = self.run_case(c, per_case);
+            on_done(row, files);
+        });
+    }
+}
+
+/// A model error as one line: its problems joined.
+struct ModelMessage(String);
+
+impl From<&model::ModelError> for ModelMessage {
+    fn from(e: &model::ModelError) -> Self {
+        match e {
+            model::ModelError::Invalid { problems, .. } => ModelMessage(
+                problems
+                    .iter()
+                    .map(|p| p.to_string())
+                    .collect::<Vec<_>>()
+                    .join("; "),
+            ),
+            other => ModelMessage(other.to_string()),
+        }
+    }
+}
+
+/// Table outputs of a run: energy per source, output energy, mean efficiency, final and max
+/// temperature per node.
+pub fn run_outputs(s: &crate::report::run::Summary) -> Vec<(String, Option<f64>)> {
+    let mut out = Vec::new();
+    if let Ok(serde_json::Value::Object(m)) = serde_json::to_value(s.energy_lost_j) {
+        for (k, v) in m {
+            out.push((format!("energy_{k}_j"), v.as_f64()));
+        }
+    }
+    out.push(("output_energy_j".into(), Some(s.output_energy_j)));
+    out.push(("cycle_efficiency".into(), s.cycle_efficiency));
+    for (node, t) in &s.temperatures_c {
+        out.push((format!("final_temp_{node}_c"), Some(t.r#final)));
+        out.push((format!("max_temp_{node}_c"), Some(t.max)));
+    }
+    out
+}
+
+/// Table outputs of a steady point: loss per source, total, efficiency, temperature per node.
+pub fn steady_outputs(r: &job::SteadyResult) -> Vec<(String, Option<f64>)> {
+    let mut out: Vec<(String, Option<f64>)> = r
+        .by_source_w
+        .iter()
+        .map(|(k, v)| (format!("loss_{k}_w"), Some(*v)))
+        .collect();
+    out.push(("total_loss_w".into(), Some(r.total_loss_w)));
+    out.push(("efficiency".into(), r.efficiency));
+    for (node, t) in &r.temperatures_c {
+        out.push((format!("temp_{node}_c"), Some(*t)));
+    }
+    out
+}
