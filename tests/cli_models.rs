@@ -179,8 +179,9 @@ fn info_text_lists_states_meshes_and_gears() {
 }
 
 #[test]
-fn missing_model_file_is_invalid_input() {
+fn missing_model_file_is_an_io_error() {
+    // README: exit 3 for I/O (issue 16: a missing model file exited 1).
     let out = run(&["check", "models/does_not_exist.toml"], &root());
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(3));
     assert!(String::from_utf8_lossy(&out.stderr).contains("does_not_exist.toml"));
 }

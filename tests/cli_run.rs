@@ -99,7 +99,7 @@ fn run_outputs_follow_the_contract() {
         "rtol",
         "energy_lost_j",
         "energy_balance_relative",
-        "mean_efficiency",
+        "cycle_efficiency",
         "temperatures_c",
         "skipped",
     ] {
@@ -117,7 +117,7 @@ fn run_outputs_follow_the_contract() {
         .sum();
     assert!((sum - e["total"].as_f64().unwrap()).abs() < 1e-6 * sum);
     assert!(e["bearing"].as_f64().unwrap() > 0.0 && e["seal"].as_f64().unwrap() > 0.0);
-    let eta = s["mean_efficiency"].as_f64().unwrap();
+    let eta = s["cycle_efficiency"].as_f64().unwrap();
     assert!(eta > 0.9 && eta < 1.0, "{eta}");
     assert!(
         !s["skipped"].as_array().unwrap().is_empty(),
@@ -174,7 +174,7 @@ fn run_outputs_follow_the_contract() {
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
     names.sort();
-    assert_eq!(names, ["summary.json", "timeseries.csv"]);
+    assert_eq!(names, [".geartherm-output", "summary.json", "timeseries.csv"]);
 }
 
 fn assert_invalid_and_nothing_written(args: &[&str], dir: &Path, expect: &[&str]) {

@@ -160,22 +160,15 @@ pub fn bench(args: &BenchArgs) -> Result<(), Failure> {
         code: EXIT_IO,
         message: e.to_string(),
     })?;
-    geartherm::report::files::write_all_atomic(
-        &dir,
-        &[
-            ("bench.csv", to_csv(&rows).as_bytes()),
-            ("bench.json", text.as_bytes()),
-        ],
-    )
-    .map_err(|e| Failure {
-        code: EXIT_IO,
-        message: format!("{}: {e}", dir.display()),
-    })?;
-    let png = geartherm::report::plots::render_bench(&dir).map_err(|e| Failure {
+    let out = geartherm::report::files::OutputDir::begin(&dir)?;
+    out.write("bench.csv", to_csv(&rows).as_bytes())?;
+    out.write("bench.json", text.as_bytes())?;
+    geartherm::report::plots::render_bench(out.path()).map_err(|e| Failure {
         code: EXIT_IO,
         message: format!("plot: {e}"),
     })?;
+    let dir = out.commit()?;
     println!("{}", dir.join("bench.csv").display());
-    println!("{}", png.display());
+    println!("{}", dir.join("work_precision.png").display());
     Ok(())
 }

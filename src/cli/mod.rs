@@ -128,10 +128,39 @@ pub struct Failure {
 
 impl From<ModelError> for Failure {
     fn from(e: ModelError) -> Self {
+        // A file that cannot be read (missing, no permission, a directory) is I/O; one that is
+        // read but is not UTF-8 text is invalid input.
+        let code = match &e {
+            ModelError::Io { source, .. } if source.kind() != std::io::ErrorKind::InvalidData => EXIT_IO,
+            _ => EXIT_INVALID,
+        };
         Failure {
-            code: EXIT_INVALID,
+            code,
             message: e.report(),
         }
+    }
+}
+
+impl From<geartherm::report::files::OutputError> for Failure {
+    fn from(e: geartherm::report::files::OutputError) -> Self {
+        Failure {
+            code: EXIT_IO,
+            message: format!("cannot write outputs: {e}"),
+        }
+    }
+}
+
+/// A cycle that cannot be used: I/O (exit 3) when the file exists but cannot be read, else
+/// invalid input.
+pub(crate) fn cycle_failure(e: geartherm::cycle::CycleError) -> Failure {
+    let code = if e.kind == geartherm::cycle::CycleErrorKind::Io {
+        EXIT_IO
+    } else {
+        EXIT_INVALID
+    };
+    Failure {
+        code,
+        message: format!("--cycle: {e}"),
     }
 }
 
@@ -167,6 +196,58 @@ fn check_range(flag: &str, v: f64, lo: f64, hi: f64, unit: &str) -> Result<(), F
     } else {
         Err(invalid(format!("{flag} {v}: must lie in [{lo}, {hi}]{unit}")))
     }
+}
+
+/// `report DIR`: re-render a run, map or bench directory as one transaction (its inputs are
+/// carried into the new result set, the figures and report.md replace the old ones whole).
+fn report(dir: &std::path::Path) -> Result<(), Failure> {
+    use geartherm::report::plots::{self, PlotError};
+    let fail = |e: PlotError| Failure {
+        // Unreadable or malformed inputs are invalid input; failing to write is I/O.
+        code: match &e {
+            PlotError::Csv { .. } | PlotError::Json { .. } | PlotError::Data { .. } => EXIT_INVALID,
+            PlotError::Io { source, .. } if source.kind() == std::io::ErrorKind::InvalidData => EXIT_INVALID,
+            _ => EXIT_IO,
+        },
+        message: format!("report: {e}"),
+    };
+    let kinds = [
+        ("timeseries.csv", "summary.json"),
+        ("map.csv", "map.json"),
+        ("bench.csv", "bench.json"),
+    ];
+    if !dir.is_dir() || !kinds.iter().any(|(a, _)| dir.join(a).is_file()) {
+        return Err(invalid(format!(
+            "report: {} holds no timeseries.csv, map.csv or bench.csv",
+            dir.display()
+        )));
+    }
+    let out = geartherm::report::files::OutputDir::begin(dir)?;
+    out.carry_over(&[
+        "timeseries.csv",
+        "summary.json",
+        "map.csv",
+        "map.json",
+        "bench.csv",
+        "bench.json",
+    ])?;
+    let mut written = Vec::new();
+    if out.path().join("timeseries.csv").is_file() {
+        written.extend(plots::render_run(out.path()).map_err(fail)?);
+    }
+    if out.path().join("map.csv").is_file() {
+        written.extend(plots::render_map(out.path()).map_err(fail)?);
+    }
+    if out.path().join("bench.csv").is_file() {
+        written.push(plots::render_bench(out.path()).map_err(fail)?);
+    }
+    let target = out.commit()?;
+    for p in written {
+        if let Some(name) = p.file_name() {
+            println!("{}", target.join(name).display());
+        }
+    }
+    Ok(())
 }
 
 /// Run a parsed command line.
@@ -214,7 +295,29 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
                 input_torque: torque_nm,
                 oil: gb.oil.properties(oil_temp_c + KELVIN_OFFSET),
             };
+            if !(op.oil.nu.is_finite() && op.oil.nu > 0.0 && op.oil.rho.is_finite() && op.oil.rho > 0.0) {
+                return Err(invalid(format!(
+                    "--oil-temp-c {oil_temp_c}: the oil of {} has no finite viscosity there (ν = {} m²/s)",
+                    model.display(),
+                    op.oil.nu
+                )));
+            }
             let report = losses::losses(&gb, &scene, &op, oil_temp_c);
+            let bad = report
+                .items
+                .iter()
+                .find(|it| !it.w.is_finite())
+                .map(|it| format!("loss item {}:{}", it.source.as_str(), it.name))
+                .or_else(|| (!report.total_w.is_finite()).then(|| "total loss".to_string()));
+            if let Some(what) = bad {
+                return Err(Failure {
+                    code: EXIT_NUMERICAL,
+                    message: format!(
+                        "{}: {what} is not finite at gear {gear}, {speed_rpm} rpm, {torque_nm} N m, {oil_temp_c} °C",
+                        model.display()
+                    ),
+                });
+            }
             geartherm::scene::ranges::print_warnings(&report.warnings);
             if json {
                 print_json(&report)?;
@@ -223,33 +326,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             }
             Ok(())
         }
-        Command::Report { dir } => {
-            use geartherm::report::plots;
-            let io = |e: plots::PlotError| Failure {
-                code: if dir.is_dir() { EXIT_IO } else { EXIT_INVALID },
-                message: format!("report: {e}"),
-            };
-            let mut written = Vec::new();
-            if dir.join("timeseries.csv").is_file() {
-                written.extend(plots::render_run(&dir).map_err(io)?);
-            }
-            if dir.join("map.csv").is_file() {
-                written.extend(plots::render_map(&dir).map_err(io)?);
-            }
-            if dir.join("bench.csv").is_file() {
-                written.push(plots::render_bench(&dir).map_err(io)?);
-            }
-            if written.is_empty() {
-                return Err(invalid(format!(
-                    "report: {} holds no timeseries.csv, map.csv or bench.csv",
-                    dir.display()
-                )));
-            }
-            for p in written {
-                println!("{}", p.display());
-            }
-            Ok(())
-        }
+        Command::Report { dir } => report(&dir),
         Command::Bench(args) => bench::bench(&args),
         Command::Study(args) => study::study(&args),
         Command::Validate(args) => validate::validate(&args),

@@ -7,8 +7,8 @@ use geartherm::cycle::DriveCycle;
 use geartherm::cycle::Schedule;
 use geartherm::model::Gearbox;
 use geartherm::physics::oil::KELVIN_OFFSET;
-use geartherm::report::files::write_all_atomic;
-use geartherm::report::run::{summary, timeseries_csv, Summary};
+use geartherm::report::files::OutputDir;
+use geartherm::report::run::{check_finite, summary, timeseries_csv, Summary};
 use geartherm::scene::{Needs, Scene};
 use geartherm::solve::drive::{row_inputs, segments};
 use geartherm::solve::transient::{integrate, Method, Restart, Segment, Trajectory, TransientOptions};
@@ -69,6 +69,10 @@ pub struct RunArgs {
     pub evaluate_all: bool,
 }
 
+/// Largest relative energy-balance residual a run may write (a converged integration closes
+/// it to about 1e-7; a residual near 1 means the numbers are meaningless).
+pub const MAX_ENERGY_RESIDUAL: f64 = 1e-2;
+
 /// A checked, compiled run, ready to integrate.
 pub struct Prepared {
     /// The model.
@@ -120,7 +124,7 @@ pub fn prepare(args: &RunArgs) -> Result<Prepared, Failure> {
             check_range(flag, v, -60.0, 250.0, " °C")?;
         }
     }
-    let cycle = DriveCycle::resolve(&args.cycle).map_err(|e| invalid(format!("--cycle: {e}")))?;
+    let cycle = DriveCycle::resolve(&args.cycle).map_err(super::cycle_failure)?;
     let (sched, segs) =
         segments(&gb, &cycle).map_err(|e| invalid(format!("{}: {e}", args.model.display())))?;
     // Scene pruning: only the gear states this cycle visits, only the outputs asked for.
@@ -175,6 +179,9 @@ pub fn run(args: &RunArgs) -> Result<RunOutcome, Failure> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("runs").join(format!("{}_{}", stem(&args.model), cycle.name)));
+    // The output directory is locked (a second writer is refused now, not after the run) and
+    // written as one transaction: the previous result stays whole until the commit.
+    let out = OutputDir::begin(&dir)?;
 
     let bar = (!args.quiet && std::io::stderr().is_terminal()).then(|| {
         let b = indicatif::ProgressBar::new(segs.len() as u64);
@@ -218,25 +225,34 @@ pub fn run(args: &RunArgs) -> Result<RunOutcome, Failure> {
         scene.thermal.boundary_temperatures(t, &mut w);
         w.boundary_t.clone()
     };
+    let numerical = |what: String| Failure {
+        code: EXIT_NUMERICAL,
+        message: format!("{}: {what}", args.model.display()),
+    };
+    check_finite(&scene, &traj, &rows, &sum).map_err(numerical)?;
+    if sum.energy_balance_relative > MAX_ENERGY_RESIDUAL {
+        return Err(numerical(format!(
+            "energy balance residual {:.2e} exceeds {MAX_ENERGY_RESIDUAL:e}: the integration is not trustworthy \
+             (tighten --rtol or check the cycle's time steps)",
+            sum.energy_balance_relative
+        )));
+    }
     let csv = (!args.summary_only).then(|| timeseries_csv(&scene, &traj, &rows, &bt));
     let json = serde_json::to_string_pretty(&sum).map_err(|e| Failure {
         code: EXIT_IO,
         message: format!("cannot serialise the summary: {e}"),
     })?;
-    let mut files: Vec<(&str, &[u8])> = vec![("summary.json", json.as_bytes())];
     if let Some(csv) = &csv {
-        files.insert(0, ("timeseries.csv", csv.as_bytes()));
+        out.write("timeseries.csv", csv.as_bytes())?;
     }
-    write_all_atomic(&dir, &files).map_err(|e| Failure {
-        code: EXIT_IO,
-        message: format!("{}: cannot write outputs: {e}", dir.display()),
-    })?;
+    out.write("summary.json", json.as_bytes())?;
     if args.report {
-        geartherm::report::plots::render_run(&dir).map_err(|e| Failure {
+        geartherm::report::plots::render_run(out.path()).map_err(|e| Failure {
             code: EXIT_IO,
             message: format!("report: {e}"),
         })?;
     }
+    let dir = out.commit()?;
     Ok(RunOutcome { summary: sum, dir })
 }
 
@@ -255,9 +271,9 @@ pub fn to_text(o: &RunOutcome) -> String {
         e.sum() / 1e3
     ));
     t.push_str(&format!(
-        "energy balance residual {:.2e} (relative); mean efficiency {}\n",
+        "energy balance residual {:.2e} (relative); cycle efficiency (energy-weighted) {}\n",
         s.energy_balance_relative,
-        s.mean_efficiency.map_or("n/a".into(), |x| format!("{x:.4}"))
+        s.cycle_efficiency.map_or("n/a".into(), |x| format!("{x:.4}"))
     ));
     t.push_str("temperatures, °C        min      max    final\n");
     for (name, ts) in &s.temperatures_c {

@@ -137,11 +137,28 @@ pub fn steady(a: &SteadyArgs) -> Result<(), Failure> {
     .map_err(|e| Failure {
         code: EXIT_NUMERICAL,
         message: format!(
-            "{}: no equilibrium: {}",
+            "{}: no equilibrium in gear {} at --speed-rpm {} --torque-nm {}{}: {}",
             a.point.model.display(),
+            a.point.gear,
+            a.speed_rpm,
+            a.torque_nm,
+            a.point
+                .ambient_c
+                .map_or(String::new(), |c| format!(" --ambient-c {c}")),
             describe(&scene, &e)
         ),
     })?;
+    let numerical = |what: String| Failure {
+        code: EXIT_NUMERICAL,
+        message: format!(
+            "{}: gear {} at {} rpm, {} N m: {what}",
+            a.point.model.display(),
+            a.point.gear,
+            a.speed_rpm,
+            a.torque_nm
+        ),
+    };
+    check_equilibrium(&scene, &eq).map_err(numerical)?;
     let mut temps = BTreeMap::new();
     for (n, t) in scene.thermal.names.iter().zip(&eq.solution.temperatures) {
         temps.insert(n.clone(), t - KELVIN_OFFSET);
@@ -205,6 +222,36 @@ pub fn steady(a: &SteadyArgs) -> Result<(), Failure> {
     Ok(())
 }
 
+/// Largest residual of an equilibrium relative to its total loss (the solver converges to about
+/// 1e-12; a larger residual is not an equilibrium, whatever the step criterion said).
+const MAX_RELATIVE_RESIDUAL: f64 = 1e-6;
+
+/// Every number of an equilibrium finite and its residual small, else the first failure named.
+fn check_equilibrium(scene: &Scene, eq: &geartherm::solve::equilibrium::Equilibrium) -> Result<(), String> {
+    for (n, t) in scene.thermal.names.iter().zip(&eq.solution.temperatures) {
+        if !t.is_finite() {
+            return Err(format!("temperature of node {n} is not finite"));
+        }
+    }
+    for (it, q) in scene.losses.items.iter().zip(&eq.losses) {
+        if !q.is_finite() {
+            return Err(format!(
+                "loss item {}:{} is not finite",
+                it.source.as_str(),
+                it.name
+            ));
+        }
+    }
+    let total: f64 = eq.by_source.iter().sum();
+    let r = eq.solution.residual_w;
+    if !r.is_finite() || r > MAX_RELATIVE_RESIDUAL * total.abs().max(1.0) {
+        return Err(format!(
+            "no equilibrium: residual {r:.3e} W exceeds {MAX_RELATIVE_RESIDUAL:e} of the total loss {total:.3e} W"
+        ));
+    }
+    Ok(())
+}
+
 fn describe(scene: &Scene, e: &geartherm::solve::steady::SteadyError) -> String {
     use geartherm::solve::steady::SteadyError as E;
     let name = |i: usize| scene.thermal.names.get(i).cloned().unwrap_or_default();
@@ -229,11 +276,18 @@ fn describe(scene: &Scene, e: &geartherm::solve::steady::SteadyError) -> String 
     }
 }
 
+/// Most points per map axis.
+pub const MAX_AXIS_POINTS: usize = 2000;
+/// Most points of a map (N_speed × N_torque): each equilibrium keeps its losses and solver
+/// state (about 5 kB), and a 2-core machine solves about 1000 points per second; beyond this a
+/// map is a study (`geartherm study`), not a map.
+pub const MAX_MAP_POINTS: usize = 40_000;
+
 fn range(flag: &str, s: &str) -> Result<Vec<f64>, Failure> {
     let parts: Vec<&str> = s.split(':').collect();
     let bad = || {
         invalid(format!(
-            "{flag} {s}: expected A:B:N (from A to B in N points, N ≥ 1)"
+            "{flag} {s}: expected A:B:N (from A to B in N points, A ≤ B finite, 1 ≤ N ≤ {MAX_AXIS_POINTS})"
         ))
     };
     if parts.len() != 3 {
@@ -242,7 +296,7 @@ fn range(flag: &str, s: &str) -> Result<Vec<f64>, Failure> {
     let a: f64 = parts[0].trim().parse().map_err(|_| bad())?;
     let b: f64 = parts[1].trim().parse().map_err(|_| bad())?;
     let n: usize = parts[2].trim().parse().map_err(|_| bad())?;
-    if n == 0 || n > 2000 || !a.is_finite() || !b.is_finite() || (n > 1 && b < a) {
+    if n == 0 || n > MAX_AXIS_POINTS || !a.is_finite() || !b.is_finite() || (n > 1 && b < a) {
         return Err(bad());
     }
     Ok((0..n)
@@ -261,12 +315,34 @@ pub fn map(a: &MapArgs) -> Result<(), Failure> {
     let (gb, scene, state) = prepare(&a.point)?;
     let speeds = range("--speed-rpm", &a.speed_rpm)?;
     let torques = range("--torque-nm", &a.torque_nm)?;
+    let n = speeds.len() * torques.len();
+    if n > MAX_MAP_POINTS {
+        return Err(invalid(format!(
+            "--speed-rpm {} --torque-nm {}: {} × {} = {n} points; a map may have at most {MAX_MAP_POINTS} points",
+            a.speed_rpm,
+            a.torque_nm,
+            speeds.len(),
+            torques.len()
+        )));
+    }
     for &s in &speeds {
         check_range("--speed-rpm", s, 0.0, 50_000.0, " rpm")?;
     }
     for &t in &torques {
         check_range("--torque-nm", t, -1e6, 1e6, " N m")?;
     }
+    let dir = a.out.clone().unwrap_or_else(|| {
+        PathBuf::from("maps").join(format!(
+            "{}_gear{}",
+            a.point
+                .model
+                .file_stem()
+                .map_or("model".into(), |s| s.to_string_lossy()),
+            a.point.gear
+        ))
+    });
+    // Lock the output directory now: a second writer is refused before the work, not after.
+    let out = geartherm::report::files::OutputDir::begin(&dir)?;
     let bar = (!a.quiet && std::io::stderr().is_terminal()).then(|| {
         let b = indicatif::ProgressBar::new((speeds.len() * torques.len()) as u64);
         if let Ok(st) = indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} points ({eta})")
@@ -300,7 +376,29 @@ pub fn map(a: &MapArgs) -> Result<(), Failure> {
     let (ok, iters) = converged.fold((0usize, 0usize), |(k, i), e| {
         (k + 1, i + e.solution.iterations + e.solution.ptc_iterations)
     });
-    let n = speeds.len() * torques.len();
+    // A map is written whole or not at all: points without an equilibrium are a failure
+    // (exit 2, nothing written) that names them, not a map with holes.
+    let failed: Vec<String> = points
+        .iter()
+        .filter_map(|p| {
+            let why = match &p.equilibrium {
+                None => "no equilibrium".to_string(),
+                Some(e) => check_equilibrium(&scene, e).err()?,
+            };
+            Some(format!("{} rpm, {} N m: {why}", p.speed_rpm, p.torque_nm))
+        })
+        .collect();
+    if !failed.is_empty() {
+        return Err(Failure {
+            code: EXIT_NUMERICAL,
+            message: format!(
+                "{}: {} of {n} points failed, nothing written (narrow the grid); first: {}",
+                a.point.model.display(),
+                failed.len(),
+                failed.iter().take(5).cloned().collect::<Vec<_>>().join("; ")
+            ),
+        });
+    }
     let json = serde_json::json!({
         "model": gb.name,
         "gear": a.point.gear,
@@ -310,45 +408,24 @@ pub fn map(a: &MapArgs) -> Result<(), Failure> {
         "wall_time_s": wall,
         "threads": rayon::current_num_threads(),
     });
-    let dir = a.out.clone().unwrap_or_else(|| {
-        PathBuf::from("maps").join(format!(
-            "{}_gear{}",
-            a.point
-                .model
-                .file_stem()
-                .map_or("model".into(), |s| s.to_string_lossy()),
-            a.point.gear
-        ))
-    });
     let text = serde_json::to_string_pretty(&json).map_err(|e| Failure {
         code: EXIT_IO,
         message: e.to_string(),
     })?;
-    geartherm::report::files::write_all_atomic(
-        &dir,
-        &[("map.csv", csv.as_bytes()), ("map.json", text.as_bytes())],
-    )
-    .map_err(|e| Failure {
-        code: EXIT_IO,
-        message: format!("{}: {e}", dir.display()),
-    })?;
+    out.write("map.csv", csv.as_bytes())?;
+    out.write("map.json", text.as_bytes())?;
     if !a.no_plots {
-        geartherm::report::plots::render_map(&dir).map_err(|e| Failure {
+        geartherm::report::plots::render_map(out.path()).map_err(|e| Failure {
             code: EXIT_IO,
             message: format!("plot: {e}"),
         })?;
     }
+    let dir = out.commit()?;
     println!(
         "{n} points ({ok} converged, {:.1} iterations on average) in {wall:.3} s on {} threads; outputs in {}",
         iters as f64 / ok.max(1) as f64,
         rayon::current_num_threads(),
         dir.display()
     );
-    if ok < n {
-        return Err(Failure {
-            code: EXIT_NUMERICAL,
-            message: format!("{} of {n} points have no equilibrium (blank in map.csv)", n - ok),
-        });
-    }
     Ok(())
 }

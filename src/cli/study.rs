@@ -224,7 +224,7 @@ fn default_effects(t: &Table) -> Vec<String> {
     let pick = |prefix: &str| t.outputs.iter().find(|o| o.starts_with(prefix)).cloned();
     [
         pick("energy_total").or_else(|| pick("total_loss")),
-        pick("mean_efficiency").or_else(|| pick("efficiency")),
+        pick("cycle_efficiency").or_else(|| pick("efficiency")),
         pick("max_temp_").or_else(|| pick("temp_")),
     ]
     .into_iter()

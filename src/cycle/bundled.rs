@@ -101,8 +101,11 @@ pub fn resolve(arg: &str) -> Result<DriveCycle, CycleError> {
     if lookup(arg).is_some() {
         return DriveCycle::bundled(arg);
     }
+    // A path that does not exist may be a misspelt bundled name (invalid input); a path that
+    // exists but cannot be read (a directory, no permission) stays an I/O error.
+    let missing = !std::path::Path::new(arg).exists();
     DriveCycle::load(arg).map_err(|mut e| {
-        if e.kind == CycleErrorKind::Io {
+        if e.kind == CycleErrorKind::Io && missing {
             e.kind = CycleErrorKind::UnknownName;
             e.allowed = format!("{} (and not a bundled cycle: {})", e.allowed, NAMES.join(", "));
         }

@@ -57,6 +57,21 @@ pub struct DriveCycle {
     pub has_gear: bool,
 }
 
+/// Highest vehicle speed a cycle may ask for, km/h (the fastest road cars reach about 490 km/h;
+/// beyond that the vehicle model and the gearbox speeds are meaningless).
+pub const MAX_VEHICLE_SPEED_KMH: f64 = 500.0;
+/// Highest rig input speed, rpm (the same limit as the command-line `--speed-rpm`).
+pub const MAX_INPUT_SPEED_RPM: f64 = 50_000.0;
+/// Largest rig input torque magnitude, N·m (the same limit as the command line).
+pub const MAX_INPUT_TORQUE_NM: f64 = 1e6;
+/// Shortest time step between two rows, s (1 kHz logging; finer steps carry no thermal
+/// information and make the energy integrals round-off).
+pub const MIN_TIME_STEP_S: f64 = 1e-3;
+/// Latest time in a cycle, s (about 116 days).
+pub const MAX_TIME_S: f64 = 1e7;
+/// Most rows a cycle may have (memory of the schedule and the output rows grows with it).
+pub const MAX_ROWS: usize = 2_000_000;
+
 const TIME: &str = "time_s";
 const SPEED: &str = "speed_kmh";
 const IN_SPEED: &str = "input_speed_rpm";
@@ -156,18 +171,28 @@ impl DriveCycle {
                         .at_value(&names[c], s)),
                 }
             };
+            if rows.len() >= MAX_ROWS {
+                return Err(err(
+                    CycleErrorKind::Value,
+                    format!("a cycle may have at most {MAX_ROWS} rows"),
+                )
+                .at_line(line));
+            }
             let time = num(c_time)?;
-            if time < 0.0 {
-                return Err(err(CycleErrorKind::Time, "time must be >= 0 s".into())
-                    .at_line(line)
-                    .at_value(TIME, rec.get(c_time).copied().unwrap_or("")));
+            if !(0.0..=MAX_TIME_S).contains(&time) {
+                return Err(err(
+                    CycleErrorKind::Time,
+                    format!("time must lie in [0, {MAX_TIME_S:e}] s"),
+                )
+                .at_line(line)
+                .at_value(TIME, rec.get(c_time).copied().unwrap_or("")));
             }
             if let Some(prev) = rows.last() {
-                if time <= prev.time {
+                if time < prev.time + MIN_TIME_STEP_S {
                     return Err(err(
                         CycleErrorKind::Time,
                         format!(
-                            "time must increase strictly (line {} has time_s = {})",
+                            "time must increase by at least {MIN_TIME_STEP_S} s per row (line {} has time_s = {})",
                             prev.line, prev.time
                         ),
                     )
@@ -175,12 +200,14 @@ impl DriveCycle {
                     .at_value(TIME, rec.get(c_time).copied().unwrap_or("")));
                 }
             }
-            let non_negative = |c: usize, unit: &str| -> Result<f64, CycleError> {
+            let bounded = |c: usize, lo: f64, hi: f64, unit: &str| -> Result<f64, CycleError> {
                 let v = num(c)?;
-                if v < 0.0 {
-                    Err(err(CycleErrorKind::Value, format!("must be >= 0 {unit}"))
-                        .at_line(line)
-                        .at_value(&names[c], rec.get(c).copied().unwrap_or("")))
+                if !(lo..=hi).contains(&v) {
+                    Err(
+                        err(CycleErrorKind::Value, format!("must lie in [{lo}, {hi}] {unit}"))
+                            .at_line(line)
+                            .at_value(&names[c], rec.get(c).copied().unwrap_or("")),
+                    )
                 } else {
                     Ok(v)
                 }
@@ -195,11 +222,18 @@ impl DriveCycle {
             };
             match kind {
                 CycleKind::Vehicle => {
-                    row.vehicle_speed = non_negative(c_speed.unwrap_or(0), "km/h")? * KMH;
+                    row.vehicle_speed =
+                        bounded(c_speed.unwrap_or(0), 0.0, MAX_VEHICLE_SPEED_KMH, "km/h")? * KMH;
                 }
                 CycleKind::Rig => {
-                    row.input_speed = non_negative(c_in_speed.unwrap_or(0), "rpm")? * RPM;
-                    row.input_torque = num(c_in_torque.unwrap_or(0))?;
+                    row.input_speed =
+                        bounded(c_in_speed.unwrap_or(0), 0.0, MAX_INPUT_SPEED_RPM, "rpm")? * RPM;
+                    row.input_torque = bounded(
+                        c_in_torque.unwrap_or(0),
+                        -MAX_INPUT_TORQUE_NM,
+                        MAX_INPUT_TORQUE_NM,
+                        "N m",
+                    )?;
                 }
             }
             if let Some(c) = c_gear {

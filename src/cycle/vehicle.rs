@@ -230,15 +230,24 @@ impl Vehicle {
 impl VehicleSpec {
     /// Deserialize the `[vehicle]` table (as the model layer keeps it) into a spec.
     pub fn from_table(table: &toml::Table) -> Result<VehicleSpec, Vec<VehicleProblem>> {
-        toml::Value::Table(table.clone())
-            .try_into()
-            .map_err(|e: toml::de::Error| {
+        // serde_path_to_error keeps the key path (`vehicle.shift.upshift_rpm`), which a plain
+        // `try_into` loses inside nested tables.
+        serde_path_to_error::deserialize(toml::Value::Table(table.clone())).map_err(
+            |e: serde_path_to_error::Error<toml::de::Error>| {
+                let inner = e.path().to_string();
+                let path = if inner == "." || inner.is_empty() {
+                    "vehicle".to_string()
+                } else {
+                    format!("vehicle.{inner}")
+                };
+                let msg = e.into_inner().message().trim().to_string();
                 vec![VehicleProblem {
-                    path: "vehicle".into(),
+                    path,
                     value: String::new(),
-                    allowed: e.message().to_string(),
+                    allowed: msg.lines().next().unwrap_or("").to_string(),
                 }]
-            })
+            },
+        )
     }
 
     /// Check every value and turn the spec into a [`Vehicle`] (SI), or list every problem.
@@ -627,6 +636,22 @@ min_hold_s = 2.0
         bad.insert("mass".into(), toml::Value::Float(1.0));
         let e = VehicleSpec::from_table(&bad).unwrap_err();
         assert!(e[0].allowed.contains("mass"), "{}", e[0]);
+    }
+
+    #[test]
+    fn type_errors_name_the_key_path_in_vehicle_and_shift() {
+        let t: toml::Table = toml::from_str(AT6_TOML).unwrap();
+        let vt = t["vehicle"].as_table().unwrap();
+        let mut bad = vt.clone();
+        bad.insert("mass_kg".into(), toml::Value::String("1100.0".into()));
+        let e = VehicleSpec::from_table(&bad).unwrap_err();
+        assert_eq!(e[0].path, "vehicle.mass_kg", "{}", e[0]);
+        let mut bad = vt.clone();
+        let shift = bad.get_mut("shift").and_then(|v| v.as_table_mut()).unwrap();
+        let key = shift.keys().next().unwrap().clone();
+        shift.insert(key.clone(), toml::Value::String("x".into()));
+        let e = VehicleSpec::from_table(&bad).unwrap_err();
+        assert!(e[0].path.starts_with(&format!("vehicle.shift.{key}")), "{}", e[0]);
     }
 
     #[test]

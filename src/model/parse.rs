@@ -142,6 +142,66 @@ fn array<T: DeserializeOwned>(
     }
 }
 
+/// Longest name of a model part.
+pub const MAX_NAME_LEN: usize = 64;
+
+/// Characters a part name may not contain: they would need quoting or escaping in a CSV column
+/// name, a Markdown table cell or a shell word.
+pub const NAME_FORBIDDEN: &[char] = &[',', '"', '\'', '|', '\\', ';', '`'];
+
+/// True for a part name: 1–64 characters, no control character (newline, tab, …), none of
+/// [`NAME_FORBIDDEN`], no leading or trailing space. Names become CSV column names
+/// (`temp_<node>_c`, `loss_sliding_<mesh>_w`), JSON keys and Markdown cells, and with this
+/// rule no writer ever needs to quote them (`pinion/wheel` and `pinion-oil still` are fine).
+pub fn is_plain_name(name: &str) -> bool {
+    !name.is_empty()
+        && name.chars().count() <= MAX_NAME_LEN
+        && name.trim() == name
+        && !name
+            .chars()
+            .any(|c| c.is_control() || NAME_FORBIDDEN.contains(&c))
+}
+
+/// Every `name` key of the file (except the free-text `model.name` and `oil.name`) must be an
+/// identifier ([`is_plain_name`]); one problem per bad name, with its key path.
+fn check_names(value: &Value, path: &str, problems: &mut Problems) {
+    let join = |k: &str| {
+        if path.is_empty() {
+            k.to_string()
+        } else {
+            format!("{path}.{k}")
+        }
+    };
+    match value {
+        Value::Table(t) => {
+            for (k, v) in t {
+                let p = join(k);
+                if k == "name" && p != "model.name" && p != "oil.name" {
+                    if let Value::String(s) = v {
+                        if !is_plain_name(s) {
+                            problems.push(
+                                p,
+                                describe(v),
+                                format!(
+                                    "must be a plain name: 1–{MAX_NAME_LEN} characters, no control characters, none of , \" ' | \\ ; `, no leading or trailing space"
+                                ),
+                            );
+                        }
+                    }
+                } else {
+                    check_names(v, &p, problems);
+                }
+            }
+        }
+        Value::Array(a) => {
+            for (i, v) in a.iter().enumerate() {
+                check_names(v, &format!("{path}[{i}]"), problems);
+            }
+        }
+        _ => {}
+    }
+}
+
 /// Parse model-file text. Returns the file when every section deserialized, else `None`, with all
 /// problems found recorded in `problems`.
 pub fn parse_model(text: &str, problems: &mut Problems) -> Option<ModelFile> {
@@ -182,6 +242,7 @@ pub fn parse_table(mut table: Table, problems: &mut Problems) -> Option<ModelFil
             format!("unknown top-level key; allowed sections: {}", SECTIONS.join(", ")),
         );
     }
+    check_names(&Value::Table(table.clone()), "", problems);
     let before = problems.len();
     let model = section::<ModelMeta>(&mut table, "model", true, problems);
     let oil = section::<OilSpec>(&mut table, "oil", true, problems);
@@ -274,6 +335,28 @@ centre_height_mm = {}
                 .any(|m| m.starts_with("gears[1]") && m.contains("modul_mm")),
             "{all:?}"
         );
+    }
+
+    #[test]
+    fn names_must_be_plain() {
+        assert!(is_plain_name("sun1"));
+        assert!(is_plain_name("R"));
+        assert!(is_plain_name("pinion_a.2"));
+        assert!(!is_plain_name(""));
+        assert!(!is_plain_name("a\nb,c\"d"));
+        assert!(is_plain_name("pinion/wheel"));
+        assert!(is_plain_name("pinion-oil still"));
+        assert!(!is_plain_name(" a"));
+        assert!(!is_plain_name("a|b"));
+        assert!(!is_plain_name(&"x".repeat(MAX_NAME_LEN + 1)));
+        let mut p = Problems::default();
+        let v: Value =
+            toml::from_str("[model]\nname = \"free text, ok\"\n[[gears]]\nname = \"a\\nb,c\\\"d\"\n")
+                .unwrap();
+        check_names(&v, "", &mut p);
+        let all: Vec<String> = p.as_slice().iter().map(|x| x.to_string()).collect();
+        assert_eq!(all.len(), 1, "{all:?}");
+        assert!(all[0].starts_with("gears[0].name"), "{all:?}");
     }
 
     #[test]

@@ -37,14 +37,15 @@ pub struct LossReport {
     pub oil_viscosity_cst: f64,
     /// Density at that temperature, kg/m³.
     pub oil_density_kg_m3: f64,
-    /// Input power T·ω, W.
+    /// Loss-free input power T·ω (= output power), W.
     pub input_power_w: f64,
     /// Output speed, rpm.
     pub output_speed_rpm: f64,
     /// Sum of all loss items, W.
     pub total_w: f64,
-    /// (P_in − P_loss)/P_in (1 when P_in = 0 and no loss; 0 when P_in = 0 with losses).
-    pub efficiency: f64,
+    /// P_out/(P_out + P_loss) with P_out the loss-free power T·ω (`physics::efficiency`);
+    /// null when no power is transmitted.
+    pub efficiency: Option<f64>,
     /// Totals per source (`<source>_w`).
     pub by_source: SourceValues,
     /// Every item.
@@ -62,13 +63,9 @@ pub fn losses(gb: &Gearbox, scene: &LossScene, op: &OperatingPoint, oil_temp_c: 
     let by = SourceValues::new(sum_by_source(&scene.items, &out), "_w", false);
     let total: f64 = out.iter().sum();
     let p_in = op.input_torque * op.input_speed;
-    let efficiency = if p_in > 0.0 {
-        (p_in - total) / p_in
-    } else if total == 0.0 {
-        1.0
-    } else {
-        0.0
-    };
+    // The loss items are evaluated at the loss-free torque: T·ω is the power delivered to the
+    // output, and the input supplies it plus the losses.
+    let efficiency = crate::physics::efficiency::efficiency(p_in, total);
     let st = &gb.gear_states[op.state];
     let rpm = 60.0 / (2.0 * std::f64::consts::PI);
     LossReport {
@@ -133,7 +130,12 @@ pub fn to_text(r: &LossReport) -> String {
         let _ = writeln!(s, "  {:<10}{:>12.3} W  {:>5.1} %", src.as_str(), w, share);
     }
     let _ = writeln!(s, "  {:<10}{:>12.3} W", "total", r.total_w);
-    let _ = writeln!(s, "  efficiency {:.5}", r.efficiency);
+    let _ = writeln!(
+        s,
+        "  efficiency {}",
+        r.efficiency
+            .map_or("n/a (no power transmitted)".into(), |e| format!("{e:.5}"))
+    );
     if !r.skipped.is_empty() {
         let _ = writeln!(s, "\nskipped:");
         for k in &r.skipped {

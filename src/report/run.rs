@@ -82,8 +82,9 @@ pub struct Summary {
     pub energy_balance_relative: f64,
     /// Output energy, J (positive output power integrated).
     pub output_energy_j: f64,
-    /// Mean efficiency: output energy / (output energy + loss energy while driving).
-    pub mean_efficiency: Option<f64>,
+    /// Cycle efficiency, energy-weighted: ∫P_out / ∫P_in over the driving time, with
+    /// ∫P_in = ∫P_out + loss energy while driving (`physics::efficiency`).
+    pub cycle_efficiency: Option<f64>,
     /// Temperatures per node, °C.
     pub temperatures_c: BTreeMap<String, TempStats>,
     /// Nodes (capacity nodes then boundaries).
@@ -169,7 +170,7 @@ pub fn summary(
             loss_drive += scene.loss_energy(&traj.states[k + 1]) - scene.loss_energy(&traj.states[k]);
         }
     }
-    let mean_eff = (out_e > 0.0).then(|| out_e / (out_e + loss_drive));
+    let mean_eff = crate::physics::efficiency::efficiency(out_e, loss_drive);
 
     let mut temps = BTreeMap::new();
     for i in 0..n {
@@ -217,7 +218,7 @@ pub fn summary(
         energy_to_boundaries_j: bal.to_boundaries,
         energy_balance_relative: bal.relative,
         output_energy_j: out_e,
-        mean_efficiency: mean_eff,
+        cycle_efficiency: mean_eff,
         temperatures_c: temps,
         nodes,
         oil_node: scene.thermal.names[scene.thermal.oil].clone(),
@@ -287,10 +288,90 @@ pub fn timeseries_csv(
         }
         let _ = write!(s, ",{total}");
         s.push(',');
-        if r.output_power_w > 0.0 {
-            num(&mut s, r.output_power_w / (r.output_power_w + total));
+        if let Some(eta) = crate::physics::efficiency::efficiency(r.output_power_w, total) {
+            num(&mut s, eta);
         }
         s.push('\n');
     }
     s
+}
+
+/// The first non-finite number a run would write, named (`time 12.5 s, node oil`), or `Ok`.
+/// Checked before anything is written: a run whose numbers are not all finite fails (exit 2)
+/// instead of writing blanks or `null`s.
+pub fn check_finite(
+    scene: &Scene,
+    traj: &Trajectory,
+    rows: &[RowInputs],
+    sum: &Summary,
+) -> Result<(), String> {
+    for (k, t) in traj.times.iter().enumerate() {
+        if let Some(i) = traj.states[k]
+            .iter()
+            .take(scene.nodes())
+            .position(|v| !v.is_finite())
+        {
+            return Err(format!(
+                "temperature of node {} at t = {t} s is not finite",
+                scene.thermal.names[i]
+            ));
+        }
+        if let Some(q) = traj.losses.get(k) {
+            if let Some(i) = q.iter().position(|v| !v.is_finite()) {
+                let it = &scene.losses.items[i];
+                return Err(format!(
+                    "loss item {}:{} at t = {t} s is not finite",
+                    it.source.as_str(),
+                    it.name
+                ));
+            }
+        }
+        if let Some(r) = rows.get(k) {
+            for (what, v) in [
+                ("vehicle speed", r.vehicle_speed_kmh),
+                ("input speed", r.input_speed_rpm),
+                ("input torque", r.input_torque_nm),
+                ("output power", r.output_power_w),
+            ] {
+                if !v.is_finite() {
+                    return Err(format!("{what} at t = {t} s is not finite"));
+                }
+            }
+        }
+    }
+    sum.check_finite()
+}
+
+impl Summary {
+    /// The first non-finite number of the summary, named, or `Ok`.
+    pub fn check_finite(&self) -> Result<(), String> {
+        let e = &self.energy_lost_j;
+        let mut named: Vec<(String, f64)> = vec![
+            ("duration_s".into(), self.duration_s),
+            ("energy_lost_j.total".into(), e.sum()),
+            ("energy_stored_j".into(), self.energy_stored_j),
+            ("energy_to_boundaries_j".into(), self.energy_to_boundaries_j),
+            ("energy_balance_relative".into(), self.energy_balance_relative),
+            ("output_energy_j".into(), self.output_energy_j),
+            ("cycle_efficiency".into(), self.cycle_efficiency.unwrap_or(0.0)),
+        ];
+        for src in Source::ALL {
+            named.push((format!("energy_lost_j.{}", src.as_str()), e.get(src)));
+        }
+        for it in &self.energy_by_item_j {
+            named.push((
+                format!("energy_by_item_j {}:{}", it.source.as_str(), it.name),
+                it.j,
+            ));
+        }
+        for (n, t) in &self.temperatures_c {
+            named.push((format!("temperatures_c.{n}.min"), t.min));
+            named.push((format!("temperatures_c.{n}.max"), t.max));
+            named.push((format!("temperatures_c.{n}.final"), t.r#final));
+        }
+        match named.into_iter().find(|(_, v)| !v.is_finite()) {
+            Some((n, v)) => Err(format!("summary value {n} = {v} is not finite")),
+            None => Ok(()),
+        }
+    }
 }

@@ -350,7 +350,7 @@ mod tests {
             outputs: if ok {
                 vec![
                     ("energy_total_j".into(), Some(1.0 / 3.0 + i as f64)),
-                    ("mean_efficiency".into(), None),
+                    ("cycle_efficiency".into(), None),
                 ]
             } else {
                 vec![]
@@ -389,7 +389,7 @@ mod tests {
         let lines: Vec<&str> = csv.lines().collect();
         assert_eq!(
             lines[0],
-            "case,sample,job,lubrication.oil_level_mm,oil.catalogue,status,message,energy_total_j,mean_efficiency"
+            "case,sample,job,lubrication.oil_level_mm,oil.catalogue,status,message,energy_total_j,cycle_efficiency"
         );
         assert_eq!(lines.len(), 4);
         assert!(

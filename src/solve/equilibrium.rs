@@ -161,7 +161,7 @@ pub fn equilibrium(
         losses: w.q,
         by_source: by,
         power,
-        efficiency: (power > 0.0).then(|| power / (power + total)),
+        efficiency: crate::physics::efficiency::efficiency(power, total),
     })
 }
 

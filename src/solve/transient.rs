@@ -445,7 +445,12 @@ impl Driver<'_> {
                 )
             })?;
             loop {
-                let steps = solver.get_statistics().number_of_steps;
+                // Attempts, not only accepted steps: a solver that keeps rejecting must also
+                // stop at the budget.
+                let st = solver.get_statistics();
+                let steps = st.number_of_steps
+                    + st.number_of_error_test_failures
+                    + st.number_of_nonlinear_solver_fails;
                 if steps > self.opts.max_steps {
                     let st = solver.state();
                     return Err(self.failure(

@@ -490,7 +490,7 @@ pub fn run_outputs(s: &crate::report::run::Summary) -> Vec<(String, Option<f64>)
         }
     }
     out.push(("output_energy_j".into(), Some(s.output_energy_j)));
-    out.push(("mean_efficiency".into(), s.mean_efficiency));
+    out.push(("cycle_efficiency".into(), s.cycle_efficiency));
     for (node, t) in &s.temperatures_c {
         out.push((format!("final_temp_{node}_c"), Some(t.r#final)));
         out.push((format!("max_temp_{node}_c"), Some(t.max)));

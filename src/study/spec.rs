@@ -29,7 +29,7 @@
 //! [outputs]
 //! per_case = false            # timeseries.csv + summary.json per case under cases/<id>/
 //! pareto = ["energy_total_j", "max_temp_sump_c"]   # both minimised
-//! effects = ["energy_total_j", "mean_efficiency", "max_temp_sump_c"]
+//! effects = ["energy_total_j", "cycle_efficiency", "max_temp_sump_c"]
 //! ```
 
 use serde::{Deserialize, Serialize};

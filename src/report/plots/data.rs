@@ -75,12 +75,14 @@ impl TimeSeries {
     }
 }
 
+/// A CSV number: empty is "no value" (NaN inside, a break in the curve); `NaN`, `inf` and
+/// anything else that is not a finite number is rejected (geartherm never writes them).
 fn parse_num(field: &str) -> Option<f64> {
     let f = field.trim();
     if f.is_empty() {
         return Some(f64::NAN);
     }
-    f.parse::<f64>().ok()
+    f.parse::<f64>().ok().filter(|v| v.is_finite())
 }
 
 fn csv_err(path: &Path, e: csv::Error) -> PlotError {
@@ -169,7 +171,10 @@ pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
             let field = record.get(c).unwrap_or("");
             parse_num(field).ok_or_else(|| PlotError::Csv {
                 path: path.to_path_buf(),
-                msg: format!("line {line}, column `{}`: `{field}` is not a number", &headers[c]),
+                msg: format!(
+                    "line {line}, column `{}`: `{field}` is not a finite number",
+                    &headers[c]
+                ),
             })
         };
         ts.time_s.push(num(c_time)?);
@@ -263,7 +268,9 @@ pub struct Summary {
     pub energy_lost_j: Option<EnergyBySource>,
     pub energy_by_item_j: Vec<ItemEnergy>,
     pub energy_balance_relative: Option<f64>,
-    pub mean_efficiency: Option<f64>,
+    /// `cycle_efficiency` (∫P_out/∫P_in); `mean_efficiency` in directories written before it.
+    #[serde(alias = "mean_efficiency")]
+    pub cycle_efficiency: Option<f64>,
     pub temperatures_c: BTreeMap<String, TempStats>,
     pub nodes: Vec<NodeInfo>,
     pub oil_node: Option<String>,
@@ -379,7 +386,30 @@ pub fn read_map(dir: &Path) -> Result<MapGrid, PlotError> {
     let mut rdr = open_csv(&path)?;
     let mut rows = Vec::new();
     for r in rdr.deserialize::<MapRow>() {
-        rows.push(r.map_err(|e| csv_err(&path, e))?);
+        let r = r.map_err(|e| csv_err(&path, e))?;
+        let cells = [
+            Some(r.speed_rpm),
+            Some(r.torque_nm),
+            r.efficiency,
+            r.total_loss_w,
+            r.churning_w,
+            r.pocketing_w,
+            r.sliding_w,
+            r.oil_temp_c,
+            r.iterations,
+        ];
+        if cells.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(PlotError::Csv {
+                path,
+                msg: format!(
+                    "row {} ({} rpm, {} N m) holds a value that is not a finite number",
+                    rows.len() + 2,
+                    r.speed_rpm,
+                    r.torque_nm
+                ),
+            });
+        }
+        rows.push(r);
     }
     if rows.is_empty() {
         return Err(PlotError::Data {

@@ -72,15 +72,10 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     } else {
         e_min
     };
-    let mean_summary = sm.mean_efficiency.filter(|m| m.is_finite()).map(|m| 100.0 * m);
-    let mean_time = if defined_time > 0.0 {
-        Some(pairs.iter().map(|(e, w)| e * w).sum::<f64>() / defined_time)
-    } else {
-        None
-    };
-    let (lo, hi) = mean_summary
+    // One efficiency figure for the cycle: the energy-weighted ∫P_out/∫P_in of summary.json.
+    let cycle_eff = sm.cycle_efficiency.filter(|m| m.is_finite()).map(|m| 100.0 * m);
+    let (lo, hi) = cycle_eff
         .iter()
-        .chain(&mean_time)
         .fold((floor, e_max), |(a, b), &m| (a.min(m), b.max(m)));
     let (y0, y1) = style::pad_range(lo, hi, 0.06);
     let clipped_time: f64 = pairs.iter().filter(|p| p.0 < y0).map(|p| p.1).sum();
@@ -119,15 +114,24 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
         .y_label_formatter(&|v| style::fmt_num(*v))
         .draw()?;
     let line_colour = RGBColor(0, 90, 160);
+    // plotters does not clip line series to the plotting area: clamp to the axis range so no
+    // line is drawn over the title or below the axis.
     let clamped: Vec<f64> = eff_pct
         .iter()
-        .map(|e| if e.is_finite() { e.max(y0) } else { *e })
+        .map(|e| if e.is_finite() { e.clamp(y0, y1) } else { *e })
         .collect();
     for seg in finite_segments(&order, &ts.time_s, &clamped, t_scale) {
         if seg.len() == 1 {
             chart.draw_series(std::iter::once(Circle::new(seg[0], 3, line_colour.filled())))?;
         } else {
-            chart.draw_series(LineSeries::new(decimate(&seg, 1200), line_colour.stroke_width(2)))?;
+            // Two-point paths, not one polyline: plotters joins the segments of a wide polyline
+            // with unlimited mitres, and the sharp spikes of this curve turned them into lines
+            // across the whole figure (over the title, below the axis).
+            let pts = decimate(&seg, 1200);
+            chart.draw_series(
+                pts.windows(2)
+                    .map(|w| PathElement::new(vec![w[0], w[1]], line_colour.stroke_width(2))),
+            )?;
         }
     }
     if pairs.is_empty() {
@@ -169,17 +173,17 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
         Rectangle::new([(0.0, lo), (*s, lo + bin_w)], RGBColor(86, 140, 196).filled())
     }))?;
 
-    // Means.
+    // The cycle efficiency.
     let summary_colour = RGBColor(213, 94, 0);
-    let time_colour = RGBColor(80, 80, 80);
     let mut entries = vec![LegendEntry::new(
-        "efficiency (output / input power)",
+        "efficiency P_out / (P_out + P_loss)",
         Swatch::Line(line_colour, 2),
     )];
-    for (m, colour, label) in [
-        (mean_summary, summary_colour, "mean (summary.json)"),
-        (mean_time, time_colour, "time-weighted mean"),
-    ] {
+    for (m, colour, label) in [(
+        cycle_eff,
+        summary_colour,
+        "cycle efficiency (energy-weighted, ∫P_out/∫P_in)",
+    )] {
         if let Some(m) = m.filter(|m| *m >= y0 && *m <= y1) {
             chart.draw_series(DashedLineSeries::new(
                 [(x0, m), (x1, m)],

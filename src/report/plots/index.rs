@@ -55,8 +55,8 @@ pub fn markdown(run: &RunData) -> String {
     );
     let _ = writeln!(
         s,
-        "| Mean efficiency | {} |",
-        opt(sm.mean_efficiency, |m| format!("{:.2} %", 100.0 * m))
+        "| Cycle efficiency (energy-weighted, ∫P_out/∫P_in) | {} |",
+        opt(sm.cycle_efficiency, |m| format!("{:.2} %", 100.0 * m))
     );
     if let Some(oil) = &sm.oil_node {
         let _ = writeln!(s, "| Oil node | {} |", cell(oil));

@@ -2,8 +2,8 @@
 //!
 //! - [`render_run`]: `temperatures.png`, `losses.png`, `energy.png`, `efficiency.png` and
 //!   `report.md` from a run directory (`timeseries.csv`, `summary.json`).
-//! - [`render_map`]: `map_efficiency.png`, `map_total_loss.png`, `map_oil_temp.png` from a map
-//!   directory (`map.csv`, `map.json`).
+//! - [`render_map`]: `map_efficiency.png`, `map_total_loss.png`, `map_oil_temp.png` and
+//!   `report.md` from a map directory (`map.csv`, `map.json`).
 //! - [`render_bench`]: `work_precision.png` from a bench directory (`bench.csv`, `bench.json`).
 //!
 //! Every PNG is 1600×1000 px. Each output is rendered to a temporary file in the target
@@ -23,6 +23,7 @@ pub mod energy;
 pub mod heatmap;
 pub mod index;
 pub mod losses;
+pub mod map_index;
 pub mod study;
 pub mod style;
 pub mod temperatures;
@@ -75,11 +76,13 @@ fn io_err(path: &Path, source: std::io::Error) -> PlotError {
 }
 
 fn temp_in(dir: &Path, name: &str, suffix: &str) -> Result<NamedTempFile, PlotError> {
-    tempfile::Builder::new()
-        .prefix(&format!(".{name}."))
-        .suffix(suffix)
-        .tempfile_in(dir)
-        .map_err(|e| io_err(&dir.join(name), e))
+    let prefix = format!(".{name}.");
+    let mut b = tempfile::Builder::new();
+    b.prefix(&prefix).suffix(suffix);
+    // The usual mode (0666 less the umask), not tempfile's owner-only 0600.
+    #[cfg(unix)]
+    b.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    b.tempfile_in(dir).map_err(|e| io_err(&dir.join(name), e))
 }
 
 /// Render a 1600×1000 PNG into a temporary file in `dir` that becomes `name` on commit.
@@ -178,13 +181,16 @@ pub fn render_map(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
     style::ensure_fonts()?;
     let grid = data::read_map(dir)?;
     let grid = &grid;
-    let jobs: Vec<Box<dyn FnOnce() -> Result<Staged, PlotError> + Send + '_>> = heatmap::Quantity::ALL
+    let mut jobs: Vec<Box<dyn FnOnce() -> Result<Staged, PlotError> + Send + '_>> = heatmap::Quantity::ALL
         .into_iter()
         .map(|q| {
             Box::new(move || stage_png(dir, q.file_name(), |root| heatmap::draw(root, grid, q)))
                 as Box<dyn FnOnce() -> Result<Staged, PlotError> + Send>
         })
         .collect();
+    jobs.push(Box::new(move || {
+        stage_text(dir, "report.md", &map_index::markdown(grid))
+    }));
     commit(stage_parallel(jobs)?)
 }
 

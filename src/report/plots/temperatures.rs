@@ -1,4 +1,5 @@
-//! `temperatures.png`: node temperatures vs time (boundary nodes dashed, the oil node thicker),
+//! `temperatures.png`: node temperatures vs time (the oil node thicker; boundary nodes dashed on
+//! their own right axis, so that a fixed 90 °C coolant does not set the scale of the nodes),
 //! and below it, on the same time axis, vehicle speed (left axis) and gear (step line, right axis).
 
 use plotters::prelude::*;
@@ -62,15 +63,32 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     };
     let buckets = (w - LEGEND_W) as usize;
 
-    // Upper panel: temperatures.
-    let (y0, y1) = style::padded_range(ts.temps_c.iter().flat_map(|(_, v)| v.iter().copied()), 0.06);
+    // Upper panel: temperatures. The gearbox nodes set the left axis; boundaries (ambient,
+    // coolant at a fixed 90 °C, ...) have their own right axis, so a distant boundary does not
+    // squash the node curves into a thin band.
+    let oil = sm.oil_node.as_deref();
+    let any_node = ts.temps_c.iter().any(|(n, _)| !sm.is_boundary(n));
+    let any_boundary = ts.temps_c.iter().any(|(n, _)| sm.is_boundary(n));
+    let range_of = |boundary: bool| {
+        style::padded_range(
+            ts.temps_c
+                .iter()
+                .filter(|(n, _)| sm.is_boundary(n) == boundary || !(any_node && any_boundary))
+                .flat_map(|(_, v)| v.iter().copied()),
+            0.06,
+        )
+    };
+    let (y0, y1) = range_of(!any_node);
+    let (b0, b1) = range_of(true);
     let mut chart = ChartBuilder::on(&upper)
         .margin_left(20)
-        .margin_right(10 + Y2_LABEL_W)
+        .margin_right(10)
         .margin_top(10)
         .x_label_area_size(12)
         .y_label_area_size(Y_LABEL_W)
-        .build_cartesian_2d(x0..x1, y0..y1)?;
+        .right_y_label_area_size(Y2_LABEL_W)
+        .build_cartesian_2d(x0..x1, y0..y1)?
+        .set_secondary_coord(x0..x1, b0..b1);
     chart
         .configure_mesh()
         .y_desc("Temperature (°C)")
@@ -83,8 +101,16 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
         .x_label_formatter(&|_| String::new())
         .y_label_formatter(&|v| style::fmt_num(*v))
         .draw()?;
-
-    let oil = sm.oil_node.as_deref();
+    if any_node && any_boundary {
+        chart
+            .configure_secondary_axes()
+            .y_desc("Boundaries (°C, dashed)")
+            .axis_desc_style(style::font(style::AXIS_DESC_PX))
+            .label_style(style::font(style::TICK_PX))
+            .y_labels(8)
+            .y_label_formatter(&|v| style::fmt_num(*v))
+            .draw()?;
+    }
     let mut entries = Vec::new();
     for (k, (name, values)) in ts.temps_c.iter().enumerate() {
         let colour = style::series_colour(k);
@@ -94,6 +120,8 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
             let seg = decimate(&seg, buckets);
             if seg.len() == 1 {
                 chart.draw_series(std::iter::once(Circle::new(seg[0], 5, colour.filled())))?;
+            } else if boundary && any_node {
+                chart.draw_secondary_series(DashedLineSeries::new(seg, 14, 10, colour.stroke_width(2)))?;
             } else if boundary {
                 chart.draw_series(DashedLineSeries::new(seg, 14, 10, colour.stroke_width(2)))?;
             } else {
@@ -101,7 +129,7 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
             }
         }
         let (label, swatch) = if boundary {
-            (format!("{name} (boundary)"), Swatch::Dashed(colour, 2))
+            (format!("{name} (right axis)"), Swatch::Dashed(colour, 2))
         } else if Some(name.as_str()) == oil {
             (format!("{name} (oil)"), Swatch::Line(colour, 5))
         } else {

@@ -144,7 +144,8 @@ fn write_run(dir: &Path, spec: &RunSpec) {
             };
             by_src[*s] += p;
             if spec.with_gaps && k == 0 && r % 40 == 3 {
-                csv.push_str(",NaN");
+                // A gap is an empty cell (`NaN` and `inf` cells are rejected: never written).
+                csv.push(',');
             } else {
                 let _ = write!(csv, ",{p}");
             }
@@ -182,7 +183,7 @@ fn write_run(dir: &Path, spec: &RunSpec) {
     let summary = format!(
         r#"{{"model":"test box","cycle":"WLTC-like","solver":"bdf","rtol":1e-6,"atol":1e-6,"wall_time_s":0.42,
         "steps":1234,"energy_lost_j":{{"churning":1.0e5,"pocketing":5.0e4,"sliding":2.0e5,"total":3.5e5}},
-        "energy_by_item_j":[{}],"energy_balance_relative":2.5e-7,"mean_efficiency":0.962,
+        "energy_by_item_j":[{}],"energy_balance_relative":2.5e-7,"cycle_efficiency":0.962,
         "temperatures_c":{{{}}},"nodes":[{}],"oil_node":"oil_sump",
         "skipped":[{{"what":"gear g5","why":"never engaged in this cycle"}}],"extra_key":{{"x":1}}}}"#,
         items_json.join(","),
@@ -400,7 +401,12 @@ fn maps_render() {
         let dir = tempfile::tempdir().unwrap();
         write_map(dir.path(), nx, ny, shuffle);
         let paths = render_map(dir.path()).unwrap_or_else(|e| panic!("{nx}x{ny}: {e}"));
-        assert_eq!(paths.len(), 3);
+        assert_eq!(paths.len(), 4, "three heat maps and report.md");
+        let md = fs::read_to_string(dir.path().join("report.md")).unwrap();
+        assert!(
+            md.contains("map_oil_temp.png") && md.contains("Converged points"),
+            "{md}"
+        );
         for name in ["map_efficiency.png", "map_total_loss.png", "map_oil_temp.png"] {
             assert_png_ok(&dir.path().join(name));
         }
