@@ -3,8 +3,9 @@
 //! documented limits. Bounded for CI: a fixed number of cases per property (override with
 //! `PROPTEST_CASES`), seconds in total in release mode.
 //!
-//! The override parser (`model/override.rs`, issue 17) is not fuzzed here yet: it did not exist
-//! on this branch; its property goes here once it is merged.
+//! The override parser (`model/overrides.rs`, issue 17): random `PATH = VALUE` texts and
+//! hostile values at real key paths never panic, and a model accepted with overrides has plain
+//! part names and compiles.
 
 use std::path::Path;
 
@@ -130,5 +131,39 @@ proptest! {
     #[test]
     fn cycle_parser_survives_random_text(text in "\\PC{0,400}") {
         let _ = DriveCycle::parse(&text, "fuzz.csv");
+    }
+
+    /// Random override texts never panic the override parser.
+    #[test]
+    fn override_parser_survives_random_text(text in "\\PC{0,80}") {
+        let _ = text.parse::<geartherm::model::Override>();
+    }
+
+    /// Hostile values at real key paths of the bundled models never panic the parser, the
+    /// validator or the scene compile; an accepted model has plain part names.
+    #[test]
+    fn overrides_at_real_paths_never_panic(
+        m in 0..MODELS.len(),
+        path in prop_oneof![
+            Just("lubrication.oil_level_mm"),
+            Just("gears[0].face_width_mm"),
+            Just("gears[1].teeth"),
+            Just("gears[0].name"),
+            Just("oil.catalogue"),
+            Just("thermal.nodes[0].mass_kg"),
+            Just("losses.friction"),
+            Just("vehicle.mass_kg"),
+            Just("gears[99].teeth"),
+        ],
+        value in prop_oneof![hostile_number(), Just("\"a\\nb,c\\\"d\"".to_string()), Just("\"fva_3a\"".to_string())],
+    ) {
+        if let Ok(ov) = format!("{path} = {value}").parse::<geartherm::model::Override>() {
+            if let Ok(gb) = geartherm::model::from_str_with(MODELS[m], Path::new("fuzz.toml"), &[ov]) {
+                for n in gb.gears.iter().map(|g| g.name.as_str()) {
+                    prop_assert!(geartherm::model::parse::is_plain_name(n), "{n:?}");
+                }
+                let _ = geartherm::scene::Scene::compile(&gb);
+            }
+        }
     }
 }
