@@ -143,9 +143,10 @@ fn pruned_scene_gives_the_full_scenes_temperatures_and_energies() {
         },
     )
     .unwrap();
-    // What gear 3 leaves idle: the three external Ravigneaux pockets, all four RAV sliding meshes
-    // and the two Ravigneaux planet-pin bearings (the locked set's pinions do not spin).
-    assert_eq!(all.items() - pruned.items(), 9, "{:?}", pruned.skipped);
+    // What gear 3 leaves idle: the three external Ravigneaux pockets, all four RAV sliding meshes,
+    // the two Ravigneaux planet-pin bearings (the locked set's pinions do not spin) and the packs
+    // of the two engaged elements A and B (no slip, no drag).
+    assert_eq!(all.items() - pruned.items(), 11, "{:?}", pruned.skipped);
     for mesh in ["RAV:large_sun/long_pinion", "RAV:short_pinion/long_pinion"] {
         for src in ["pocketing", "sliding"] {
             let what = format!("{src} of mesh {mesh}");
@@ -368,15 +369,16 @@ fn per_state_idle_items_of_the_at6() {
         idle_by_state.push((st.name.clone(), idle.len()));
     }
     let count = |n: &str| idle_by_state.iter().find(|(s, _)| s == n).map(|x| x.1);
-    // 3rd: 7 gear items and the 2 Ravigneaux planet bearings.
-    assert_eq!(count("3"), Some(9));
-    // 2nd holds the large sun: its bearing stands still.
-    assert_eq!(count("2"), Some(1));
+    // Every state engages two shift elements: their clutch packs do not slip (2 idle items each).
+    // 3rd: 7 gear items, the 2 Ravigneaux planet bearings and the packs of A and B.
+    assert_eq!(count("3"), Some(11));
+    // 2nd holds the large sun: its bearing stands still; A and C engaged.
+    assert_eq!(count("2"), Some(3));
     // every other state leaves one to four meshes unloaded, and in 1st, 6th and R one held
-    // member's bearing still
+    // member's bearing still, plus its two engaged packs
     for s in ["1", "4", "5", "6", "R"] {
         assert!(
-            count(s).is_some_and(|c| (1..=5).contains(&c)),
+            count(s).is_some_and(|c| (3..=7).contains(&c)),
             "{s}: {idle_by_state:?}"
         );
     }

@@ -86,8 +86,12 @@ fn steady_state_equals_a_long_transient() {
 #[test]
 fn newton_converges_from_ambient_on_a_10_by_10_grid() {
     for (path, gear, wmax, tmax) in CASES {
-        let sc = scene(path);
-        let gb = model::load(std::path::Path::new(path)).unwrap();
+        // Without the AT6's torque converter: at low turbine speed and high torque the open
+        // converter slips kilowatts into the oil (a stalled converter has no equilibrium below
+        // 200 °C), which is physics, not a Newton failure; the grid tests the solver.
+        let mut gb = model::load(std::path::Path::new(path)).unwrap();
+        gb.launch = None;
+        let sc = Scene::compile(&gb).unwrap();
         let state = gb.state_index(gear).unwrap();
         let (mut iters, mut ptc, mut worst_res) = (0, 0, 0.0f64);
         for i in 0..10 {

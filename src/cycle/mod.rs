@@ -6,11 +6,16 @@
 //!   `time_s,input_speed_rpm,input_torque_nm,gear`), with line-numbered [`CycleError`]s;
 //! - [`bundled`]: the cycles in `models/cycles/` compiled in; [`bundled_names`], [`resolve`];
 //! - [`vehicle`]: the `[vehicle]` section ([`VehicleSpec`]) → checked [`Vehicle`];
+//! - [`gears`]: the gear table (state names and ratios) the others share;
 //! - [`shift`]: gear choice with hysteresis and minimum hold time;
+//! - [`launch`]: the `[launch]` section, a torque converter with lock-up: engine-side speed and
+//!   torque from the turbine (= gearbox input) demand;
 //! - [`schedule()`]: cycle + vehicle + gear table → piecewise-constant [`Schedule`].
 
 pub mod bundled;
 pub mod error;
+pub mod gears;
+pub mod launch;
 pub mod parse;
 pub mod schedule;
 pub mod shift;
@@ -18,8 +23,10 @@ pub mod vehicle;
 
 pub use bundled::{bundled_names, resolve};
 pub use error::{CycleError, CycleErrorKind};
+pub use gears::GearTable;
+pub use launch::{EngineSide, LaunchDevice, LaunchSpec};
 pub use parse::{CycleKind, CycleRow, DriveCycle};
-pub use schedule::{schedule, GearTable, Interval, Schedule};
+pub use schedule::{schedule, schedule_with_launch, Interval, Schedule};
 pub use shift::{BoundShift, Shifter};
 pub use vehicle::{
     Demand, Overrun, RoadLoad, RoadLoadSpec, ShiftSpec, ShiftStrategy, Vehicle, VehicleProblem, VehicleSpec,

@@ -16,39 +16,11 @@
 //! loss-free output power = T_in·ω_in. The last row only closes the last interval.
 
 use super::error::{CycleError, CycleErrorKind};
+pub use super::gears::GearTable;
+use super::launch::LaunchDevice;
 use super::parse::{CycleKind, DriveCycle};
 use super::shift::Shifter;
 use super::vehicle::{Overrun, Vehicle};
-
-/// The model's gear states with their ratios ω_in/ω_out (reverse negative).
-#[derive(Debug, Clone, PartialEq)]
-pub struct GearTable {
-    /// (name, ratio) per gear state.
-    pub states: Vec<(String, f64)>,
-}
-
-impl GearTable {
-    /// Wrap a list of (name, ratio).
-    pub fn new(states: Vec<(String, f64)>) -> Self {
-        GearTable { states }
-    }
-
-    /// Index of the state named `name`.
-    pub fn index_of(&self, name: &str) -> Option<usize> {
-        self.states.iter().position(|(n, _)| n == name)
-    }
-
-    /// All state names.
-    pub fn names(&self) -> Vec<&str> {
-        self.states.iter().map(|(n, _)| n.as_str()).collect()
-    }
-}
-
-impl From<Vec<(String, f64)>> for GearTable {
-    fn from(states: Vec<(String, f64)>) -> Self {
-        GearTable { states }
-    }
-}
 
 /// Gearbox inputs, constant over [t0, t1).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -70,6 +42,15 @@ pub struct Interval {
     pub output_power: f64,
     /// The gearbox input is at rest.
     pub standstill: bool,
+    /// Engine-side (converter impeller) speed, rad/s: the input speed without a launch device;
+    /// with one, from the converter characteristic (idle at standstill).
+    pub engine_speed: f64,
+    /// Engine-side torque into the launch device, N·m (the input torque without one).
+    pub engine_torque: f64,
+    /// Converter slip loss, W (0 without a launch device).
+    pub converter_loss: f64,
+    /// The lock-up clutch is closed (false without a launch device).
+    pub lockup: bool,
     /// The gear differs from the previous interval's.
     pub shift: bool,
     /// Gear, input speed or input torque differ from the previous interval's (the solver's
@@ -122,6 +103,20 @@ pub fn schedule(
     cycle: &DriveCycle,
     vehicle: Option<&Vehicle>,
     gears: &GearTable,
+) -> Result<Schedule, CycleError> {
+    schedule_with_launch(cycle, vehicle, gears, None)
+}
+
+/// [`schedule`] with an optional launch device: each interval's engine side (speed, torque,
+/// converter slip loss, lock-up) follows from its gearbox input (= turbine) speed and torque
+/// (rig cycles too: their input is the turbine side; their vehicle speed for the lock-up follows
+/// from the input speed when a vehicle is given, else it is 0 and the lock-up stays open).
+/// Without a launch device the engine side is the gearbox input.
+pub fn schedule_with_launch(
+    cycle: &DriveCycle,
+    vehicle: Option<&Vehicle>,
+    gears: &GearTable,
+    launch: Option<&LaunchDevice>,
 ) -> Result<Schedule, CycleError> {
     let src = cycle.source.as_str();
     if gears.states.is_empty() {
@@ -179,6 +174,10 @@ pub fn schedule(
                     input_torque: t,
                     output_power: t * w,
                     standstill: w <= 0.0,
+                    engine_speed: w,
+                    engine_torque: t,
+                    converter_loss: 0.0,
+                    lockup: false,
                     shift: false,
                     jump: false,
                 });
@@ -238,10 +237,30 @@ pub fn schedule(
                     input_torque: torque,
                     output_power: power,
                     standstill,
+                    engine_speed: w_in,
+                    engine_torque: torque,
+                    converter_loss: 0.0,
+                    lockup: false,
                     shift: false,
                     jump: false,
                 });
             }
+        }
+    }
+    if let Some(l) = launch {
+        for i in &mut out {
+            // Rig cycles have no vehicle speed; with a vehicle it follows from the input speed.
+            let v = match (cycle.kind, vehicle) {
+                (CycleKind::Rig, Some(veh)) => {
+                    veh.wheel_radius * i.input_speed / (veh.final_drive_ratio * gears.states[i.gear].1.abs())
+                }
+                _ => i.vehicle_speed,
+            };
+            let e = l.engine_side(i.gear, v, i.input_speed, i.input_torque);
+            i.engine_speed = e.impeller_speed;
+            i.engine_torque = e.impeller_torque;
+            i.converter_loss = e.loss;
+            i.lockup = e.locked;
         }
     }
     for k in 1..out.len() {
@@ -514,6 +533,42 @@ mod tests {
             .filter(|w| w[0].standstill && w[1].standstill)
             .all(|w| !w[1].jump));
         assert_eq!(s.jumps().len(), s.intervals.iter().filter(|i| i.jump).count());
+    }
+
+    #[test]
+    fn launch_device_sets_the_engine_side() {
+        let v = at6();
+        let l = crate::cycle::launch::tests::launch();
+        let plain = schedule(&wltc(), Some(&v), &at6_gears()).unwrap();
+        let s = schedule_with_launch(&wltc(), Some(&v), &at6_gears(), Some(&l)).unwrap();
+        assert_eq!(plain.intervals.len(), s.intervals.len());
+        let idle = l.idle_speed;
+        for (a, b) in plain.intervals.iter().zip(&s.intervals) {
+            // the gearbox side is unchanged
+            assert_eq!(
+                (a.gear, a.input_speed, a.input_torque),
+                (b.gear, b.input_speed, b.input_torque)
+            );
+            assert_eq!(
+                (a.engine_speed, a.converter_loss, a.lockup),
+                (a.input_speed, 0.0, false)
+            );
+            // the engine never runs below idle, and never below the turbine
+            assert!(b.engine_speed >= idle - 1e-9 && b.engine_speed >= b.input_speed - 1e-9);
+            assert!(b.converter_loss >= 0.0);
+            if b.standstill {
+                assert_eq!(b.engine_speed, idle);
+                assert!(b.converter_loss > 0.0 && !b.lockup);
+            }
+            if b.lockup {
+                assert!(b.gear >= 2 && b.vehicle_speed > 40.0 / 3.6);
+            }
+        }
+        assert!(s.intervals.iter().any(|i| i.lockup));
+        assert!(s
+            .intervals
+            .iter()
+            .any(|i| !i.lockup && !i.standstill && i.converter_loss > 0.0));
     }
 
     #[test]

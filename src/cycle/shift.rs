@@ -17,7 +17,7 @@
 //! threshold and a downshift never lands above the upshift threshold, so the rules cannot hunt.
 
 use super::error::{CycleError, CycleErrorKind};
-use super::schedule::GearTable;
+use super::gears::GearTable;
 use super::vehicle::ShiftStrategy;
 
 /// A shift strategy bound to a gear table: gear-table indices and ratios.

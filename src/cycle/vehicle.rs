@@ -8,8 +8,8 @@
 //! Wheel torque T_w = r_w·F_w, gearbox output torque T_out = T_w / i_final.
 
 use super::error::{CycleError, CycleErrorKind};
+use super::gears::GearTable;
 use super::parse::{KMH, RPM};
-use super::schedule::GearTable;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 

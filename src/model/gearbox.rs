@@ -219,6 +219,12 @@ pub struct Gearbox {
     pub thermal: Option<super::thermal::ThermalNetwork>,
     /// The vehicle (`[vehicle]`), if the model has one.
     pub vehicle: Option<crate::cycle::Vehicle>,
+    /// Friction packs of shift elements (`[[clutch_packs]]`): drag while open.
+    pub clutch_packs: Vec<super::automatic::ClutchPackModel>,
+    /// The oil pump (`[pump]`), if any.
+    pub pump: Option<super::automatic::PumpModel>,
+    /// The launch device (`[launch]`), if any: torque converter with lock-up.
+    pub launch: Option<crate::cycle::LaunchDevice>,
     /// Rolling bearings (`[[bearings]]`).
     pub bearings: Vec<super::bearings::Bearing>,
     /// Shaft seals (`[[seals]]`).

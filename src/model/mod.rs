@@ -3,6 +3,7 @@
 //! `load` is the only place that reads a model file; everything below works on the checked
 //! [`Gearbox`].
 
+pub mod automatic;
 pub mod bearings;
 pub mod catalogue;
 pub mod gearbox;

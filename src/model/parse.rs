@@ -25,6 +25,9 @@ const SECTIONS: &[&str] = &[
     "losses",
     "thermal",
     "vehicle",
+    "clutch_packs",
+    "pump",
+    "launch",
     "bearings",
     "seals",
 ];
@@ -193,6 +196,9 @@ pub fn parse_table(mut table: Table, problems: &mut Problems) -> Option<ModelFil
     let losses = section::<LossesSpec>(&mut table, "losses", false, problems);
     let thermal = section::<super::thermal::ThermalSpec>(&mut table, "thermal", false, problems);
     let vehicle = section::<Table>(&mut table, "vehicle", false, problems);
+    let clutch_packs = array::<super::automatic::ClutchPackSpec>(&mut table, "clutch_packs", false, problems);
+    let pump = section::<super::automatic::PumpSpec>(&mut table, "pump", false, problems);
+    let launch = section::<Table>(&mut table, "launch", false, problems);
     let bearings = array::<super::bearings::BearingSpec>(&mut table, "bearings", false, problems);
     let seals = array::<super::bearings::SealSpec>(&mut table, "seals", false, problems);
     if problems.len() > before || !problems.is_empty() {
@@ -212,6 +218,9 @@ pub fn parse_table(mut table: Table, problems: &mut Problems) -> Option<ModelFil
         losses,
         thermal,
         vehicle,
+        clutch_packs,
+        pump,
+        launch,
         bearings,
         seals,
     })

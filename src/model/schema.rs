@@ -357,6 +357,15 @@ pub struct ModelFile {
     /// `[vehicle]` (reserved: vehicle and shift strategy; read by the transient issue).
     #[serde(default)]
     pub vehicle: Option<toml::Table>,
+    /// `[[clutch_packs]]`: friction packs of shift elements (open-clutch drag).
+    #[serde(default)]
+    pub clutch_packs: Vec<super::automatic::ClutchPackSpec>,
+    /// `[pump]`: the transmission oil pump.
+    #[serde(default)]
+    pub pump: Option<super::automatic::PumpSpec>,
+    /// `[launch]`: torque converter between engine and gearbox input (checked by the cycle layer).
+    #[serde(default)]
+    pub launch: Option<toml::Table>,
     /// `[[bearings]]`.
     #[serde(default)]
     pub bearings: Vec<super::bearings::BearingSpec>,

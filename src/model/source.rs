@@ -20,6 +20,12 @@ pub enum Source {
     Bearing,
     /// Radial lip-seal friction (speed-dependent).
     Seal,
+    /// Drag of open wet clutches and brakes (slip- and viscosity-dependent).
+    ClutchDrag,
+    /// Oil-pump drive power (line pressure and pump speed).
+    Pump,
+    /// Torque-converter slip (engine side minus turbine side power).
+    Converter,
 }
 
 /// Number of loss sources.
@@ -30,12 +36,15 @@ pub type PerSource = [f64; N_SOURCES];
 
 impl Source {
     /// Every source in output order (the order of per-source arrays and columns).
-    pub const ALL: [Source; 5] = [
+    pub const ALL: [Source; 8] = [
         Source::Churning,
         Source::Pocketing,
         Source::Sliding,
         Source::Bearing,
         Source::Seal,
+        Source::ClutchDrag,
+        Source::Pump,
+        Source::Converter,
     ];
 
     /// Position in per-source arrays (the order of [`Source::ALL`]).
@@ -51,6 +60,9 @@ impl Source {
             Source::Sliding => "sliding",
             Source::Bearing => "bearing",
             Source::Seal => "seal",
+            Source::ClutchDrag => "clutch_drag",
+            Source::Pump => "pump",
+            Source::Converter => "converter",
         }
     }
 

@@ -189,6 +189,11 @@ pub struct CoolerSpec {
     /// Optional thermostat on the hot side.
     #[serde(default)]
     pub thermostat: Option<ThermostatSpec>,
+    /// Two-way exchanger (ATF warmer/cooler): while the cold side is warmer than the hot side
+    /// the exchanger is fully open and heats the oil (the thermostat throttles only the cooling
+    /// direction). Default false: a cooler that never heats.
+    #[serde(default)]
+    pub two_way: bool,
     /// Where the numbers come from.
     #[serde(default)]
     pub note: Option<String>,
@@ -339,6 +344,8 @@ pub struct Cooler {
     pub conductance: f64,
     /// Thermostat (open, full) in K.
     pub thermostat: Option<(f64, f64)>,
+    /// Heats the oil, fully open, while the cold side is the warmer one.
+    pub two_way: bool,
 }
 
 /// What a heat rule applies to.
@@ -777,6 +784,7 @@ pub fn validate_thermal(
                 cold,
                 conductance: c.effectiveness * c.capacity_rate_w_per_k,
                 thermostat,
+                two_way: c.two_way,
             });
         }
     }

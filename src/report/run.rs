@@ -14,21 +14,7 @@ use crate::scene::{sum_by_source, Scene, Skipped, Source, N_SOURCES};
 use super::sources::{csv_columns, SourceValues};
 use crate::solve::transient::{energy_balance, Stats, Trajectory};
 
-/// Per-row context the solver does not know: vehicle speed, gear name, input speed and torque,
-/// output power.
-#[derive(Debug, Clone)]
-pub struct RowInputs {
-    /// Vehicle speed, km/h.
-    pub vehicle_speed_kmh: f64,
-    /// Gear-state name.
-    pub gear: String,
-    /// Input speed, rpm.
-    pub input_speed_rpm: f64,
-    /// Loss-free input torque T_out/i, N·m (`timeseries.csv` adds the losses: P_loss/ω_in).
-    pub input_torque_nm: f64,
-    /// Output power, W.
-    pub output_power_w: f64,
-}
+pub use crate::solve::drive::RowInputs;
 
 /// Energy of one loss item.
 #[derive(Debug, Clone, Serialize)]

@@ -180,7 +180,23 @@ impl ElementLosses {
         terms: Option<&[LoadTerms]>,
         out: &mut [f64],
     ) {
-        let bo = BearingOil { nu: oil.nu };
+        if !self.bearings.is_empty() {
+            self.evaluate_bearings(state, w_in, t_in, BearingOil::new(oil.nu), terms, out);
+        }
+        for e in &self.seals {
+            out[e.item] = e.seal.power(e.speed[state] * w_in);
+        }
+    }
+
+    fn evaluate_bearings(
+        &self,
+        state: usize,
+        w_in: f64,
+        t_in: f64,
+        bo: BearingOil,
+        terms: Option<&[LoadTerms]>,
+        out: &mut [f64],
+    ) {
         for (k, e) in self.bearings.iter().enumerate() {
             let w = e.speed[state] * w_in;
             out[e.item] = if w == 0.0 {
@@ -192,9 +208,6 @@ impl ElementLosses {
                 };
                 e.multiplicity * e.model.moment(&t, bo).total() * w.abs()
             };
-        }
-        for e in &self.seals {
-            out[e.item] = e.seal.power(e.speed[state] * w_in);
         }
     }
 }

@@ -14,9 +14,9 @@ use crate::physics::losses::sliding::friction::Schlenk;
 use crate::physics::losses::sliding::{OilState as SlideOil, PowerLaw, SlidingMesh, SlidingMeshInput};
 use crate::physics::oil::OilProperties;
 
-/// Transverse slices of a helical pocket (physics default 64, itself within 0.3 % of 256; 48 raises
-/// the AT6 pocketing loss by 0.5 % and compiles the scene in 0.39 s instead of 0.65 s).
-pub const HELIX_POCKET_SLICES: usize = 48;
+/// Helical pockets: the exact infinitely-many-slices limit of the connected-slice model (one spur
+/// pocket history summed over phases; was 48 discrete slices, 0.5 % off and 0.35 s per AT6 compile).
+pub const HELIX_POCKET_SLICES: Option<usize> = None;
 
 pub use crate::model::source::{PerSource, Source, N_SOURCES};
 
@@ -144,6 +144,8 @@ pub struct SampleTerms {
     bearing: Vec<crate::physics::losses::bearings::LoadTerms>,
     /// Samples prepared.
     pub prepared: usize,
+    /// Pump and converter values of the sample (they need the vehicle speed too).
+    pub auto: super::automatic::AutoSample,
 }
 
 /// Operating point of the whole gearbox.
@@ -171,6 +173,7 @@ pub struct LossScene {
     slide: Vec<SlideEntry>,
     states: Vec<StateFactors>,
     mixture_density: f64,
+    auto: super::automatic::AutoLosses,
     /// Bearings and seals.
     elements: super::element_losses::ElementLosses,
 }
@@ -289,6 +292,8 @@ impl LossScene {
 
         // Pocketing: external meshes.
         let mut pocket_meshes = Vec::new();
+        // meshes of identical geometry (and C_d) share one K computation
+        let mut pocket_built: Vec<(PocketMeshInput, PocketingMesh)> = Vec::new();
         match &models.pocketing {
             None => skipped.push(Skipped {
                 what: "pocketing".into(),
@@ -332,10 +337,19 @@ impl LossScene {
                         discharge_coefficient: opt.discharge_coefficient,
                         helix_slices: HELIX_POCKET_SLICES,
                     };
-                    let model = PocketingMesh::with_options(&input, &popts).map_err(|e| SceneError {
-                        what: format!("pocketing of mesh {}", m.name),
-                        why: e.to_string(),
-                    })?;
+                    let model = match pocket_built.iter().find(|(i, pm)| {
+                        *i == input && pm.discharge_coefficient() == popts.discharge_coefficient
+                    }) {
+                        Some((_, pm)) => *pm,
+                        None => {
+                            let pm = PocketingMesh::with_options(&input, &popts).map_err(|e| SceneError {
+                                what: format!("pocketing of mesh {}", m.name),
+                                why: e.to_string(),
+                            })?;
+                            pocket_built.push((input, pm));
+                            pm
+                        }
+                    };
                     // Height of the pitch point; planets orbit, so the mesh point sweeps a circle.
                     let (wet, _) = mesh_zone(gb, mi);
                     pocket.push(PocketEntry {
@@ -470,6 +484,15 @@ impl LossScene {
             })
             .collect();
 
+        // The automatic's own parts: open clutch packs, pump, converter.
+        let auto = super::automatic::AutoLosses::compile(
+            gb,
+            &|st| usage.needed(st),
+            needs.evaluate_all,
+            &mut items,
+            &mut skipped,
+        );
+
         let mixture_density = models.pocketing.map_or(0.0, |p| p.mixture_density);
         let elements = super::element_losses::ElementLosses::compile(
             gb,
@@ -487,6 +510,7 @@ impl LossScene {
             slide,
             states,
             mixture_density,
+            auto,
             elements,
         })
     }
@@ -505,6 +529,9 @@ impl LossScene {
     /// full. No allocation.
     pub fn evaluate(&self, op: &OperatingPoint, out: &mut [f64]) {
         self.evaluate_load_independent(op, out);
+        let none = super::automatic::AutoSample::default();
+        self.auto
+            .evaluate(op.state, op.input_speed, op.input_torque, &op.oil, &none, out);
         let st = &self.states[op.state];
         for (e, f) in self.slide.iter().zip(&st.slide) {
             out[e.item] = sliding(e, f, op.input_torque, op.input_speed, op.oil.mu, op.oil.rho);
@@ -520,6 +547,7 @@ impl LossScene {
             slide_unit: vec![0.0; self.slide.len()],
             bearing: vec![Default::default(); self.elements.bearings()],
             prepared: 0,
+            auto: Default::default(),
         }
     }
 
@@ -527,6 +555,20 @@ impl LossScene {
     /// (N·m): each separable sliding loss at η = 1 Pa·s, from its per-state unit value scaled by
     /// two powers. No allocation.
     pub fn prepare(&self, state: usize, input_speed: f64, input_torque: f64, terms: &mut SampleTerms) {
+        self.prepare_at(state, input_speed, input_torque, 0.0, terms);
+    }
+
+    /// [`Self::prepare`] with the vehicle speed (m/s), which the converter's lock-up needs.
+    pub fn prepare_at(
+        &self,
+        state: usize,
+        input_speed: f64,
+        input_torque: f64,
+        vehicle_speed: f64,
+        terms: &mut SampleTerms,
+    ) {
+        self.auto
+            .prepare(state, input_speed, input_torque, vehicle_speed, &mut terms.auto);
         let key = (state, input_speed.to_bits(), input_torque.to_bits());
         if terms.key == Some(key) {
             return;
@@ -558,6 +600,14 @@ impl LossScene {
             return self.evaluate(op, out);
         }
         self.evaluate_load_independent(op, out);
+        self.auto.evaluate(
+            op.state,
+            op.input_speed,
+            op.input_torque,
+            &op.oil,
+            &terms.auto,
+            out,
+        );
         let st = &self.states[op.state];
         let mut memo = (f64::NAN, 0.0);
         for ((e, f), u) in self.slide.iter().zip(&st.slide).zip(&terms.slide_unit) {

@@ -1,5 +1,6 @@
 //! Scene compile: from a checked model (and a scenario) to flat, precomputed structures the
 //! solvers evaluate without strings, maps or allocation.
+pub mod automatic;
 pub mod bearing_loads;
 pub mod element_losses;
 pub mod losses;

@@ -239,10 +239,11 @@ impl Scene {
         work.sample_id = work.sample_id.wrapping_add(1);
         self.thermal
             .sample_conductances(&Self::operating(&inputs), &mut work.net);
-        self.losses.prepare(
+        self.losses.prepare_at(
             inputs.state,
             inputs.input_speed,
             inputs.input_torque,
+            inputs.vehicle_speed,
             &mut work.terms,
         );
     }

@@ -92,6 +92,20 @@ struct CoolerTerm {
     cold: End,
     g: f64,
     thermostat: Option<(f64, f64)>,
+    two_way: bool,
+}
+
+impl CoolerTerm {
+    /// Opening x and dx/dT_hot at hot-side temperature `th` and cold-side `tc`: a two-way
+    /// exchanger is fully open while the cold side is warmer (it heats the oil); otherwise the
+    /// thermostat, if any, sets the opening.
+    fn opening(&self, th: f64, tc: f64) -> (f64, f64) {
+        if self.two_way && tc > th {
+            return (1.0, 0.0);
+        }
+        self.thermostat
+            .map_or((1.0, 0.0), |(a, b)| thermostat_opening(th, a, b))
+    }
 }
 
 /// What the network needs of the operating point during one cycle interval.
@@ -227,6 +241,7 @@ impl ThermalScene {
                     cold: c.cold.into(),
                     g: c.conductance,
                     thermostat: c.thermostat,
+                    two_way: c.two_way,
                 }),
                 NodeRef::Boundary(_) => None,
             })
@@ -422,8 +437,9 @@ impl ThermalScene {
         }
         for c in &self.coolers {
             let th = temps[c.hot];
-            let x = c.thermostat.map_or(1.0, |(a, b)| thermostat_opening(th, a, b).0);
-            let q = c.g * x * (th - Self::temp(c.cold, temps, bt));
+            let tc = Self::temp(c.cold, temps, bt);
+            let x = c.opening(th, tc).0;
+            let q = c.g * x * (th - tc);
             Self::flow(End::Node(c.hot), c.cold, q, heat, &mut to_b);
         }
         to_b
@@ -481,9 +497,7 @@ impl ThermalScene {
         for c in &self.coolers {
             let th = temps[c.hot];
             let tc = Self::temp(c.cold, temps, bt);
-            let (x, dx) = c
-                .thermostat
-                .map_or((1.0, 0.0), |(a, b)| thermostat_opening(th, a, b));
+            let (x, dx) = c.opening(th, tc);
             let dq = c.g * ((x + dx * (th - tc)) * v[c.hot] - x * dv(c.cold));
             Self::flow(End::Node(c.hot), c.cold, dq, out, &mut to_b);
         }

@@ -1,9 +1,8 @@
 //! From a gearbox and a drive (or rig) cycle to the solver's input segments and the per-row
 //! inputs of the outputs: the glue between `cycle` and the transient driver.
 
-use crate::cycle::{schedule, CycleError, DriveCycle, GearTable, Schedule};
+use crate::cycle::{schedule_with_launch, CycleError, DriveCycle, GearTable, Schedule};
 use crate::model::Gearbox;
-use crate::report::run::RowInputs;
 use crate::scene::Inputs;
 
 use super::transient::{Segment, Trajectory};
@@ -21,7 +20,7 @@ pub fn gear_table(gb: &Gearbox) -> GearTable {
 
 /// Schedule a cycle on a gearbox and turn it into solver segments.
 pub fn segments(gb: &Gearbox, cycle: &DriveCycle) -> Result<(Schedule, Vec<Segment>), CycleError> {
-    let sched = schedule(cycle, gb.vehicle.as_ref(), &gear_table(gb))?;
+    let sched = schedule_with_launch(cycle, gb.vehicle.as_ref(), &gear_table(gb), gb.launch.as_ref())?;
     let segs = sched
         .intervals
         .iter()
@@ -37,6 +36,22 @@ pub fn segments(gb: &Gearbox, cycle: &DriveCycle) -> Result<(Schedule, Vec<Segme
         })
         .collect();
     Ok((sched, segs))
+}
+
+/// Per-row context the solver does not know: vehicle speed, gear name, input speed and torque,
+/// output power.
+#[derive(Debug, Clone)]
+pub struct RowInputs {
+    /// Vehicle speed, km/h.
+    pub vehicle_speed_kmh: f64,
+    /// Gear-state name.
+    pub gear: String,
+    /// Input speed, rpm.
+    pub input_speed_rpm: f64,
+    /// Loss-free input torque T_out/i, N·m (`timeseries.csv` adds the losses: P_loss/ω_in).
+    pub input_torque_nm: f64,
+    /// Output power, W.
+    pub output_power_w: f64,
 }
 
 /// Row inputs of a trajectory's output rows (each row shows the inputs of its segment).

@@ -131,10 +131,26 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         lub.sump_volume_l,
         problems,
     );
+    let element_names: Vec<&str> = file.shift_elements.iter().map(|e| e.name.as_str()).collect();
+    let member_names: Vec<&str> = file.members.iter().map(|m| m.name.as_str()).collect();
+    let clutch_packs = super::automatic::validate_clutch_packs(&file.clutch_packs, &element_names, problems);
+    let pump = file
+        .pump
+        .as_ref()
+        .and_then(|p| super::automatic::validate_pump(p, &member_names, problems));
+    let launch = file.launch.as_ref().and_then(|t| {
+        let gt = RatioTable::new(gear_states.iter().map(|g| (g.name.clone(), g.ratio())).collect());
+        super::automatic::validate_launch(t, &gt, problems)
+    });
+    let auto_names = AutoNames {
+        packs: clutch_packs.iter().map(|c| c.name.as_str()).collect(),
+        pump: file.pump.is_some(),
+        converter: file.launch.is_some(),
+    };
     let thermal = file
         .thermal
         .as_ref()
-        .and_then(|spec| thermal(spec, &gears, &meshes, (&bearings, &seals), problems));
+        .and_then(|spec| thermal(spec, &gears, &meshes, (&bearings, &seals), &auto_names, problems));
     let vehicle = file
         .vehicle
         .as_ref()
@@ -170,9 +186,19 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         losses: losses?,
         thermal,
         vehicle,
+        clutch_packs,
+        pump,
+        launch,
         bearings,
         seals,
     })
+}
+
+/// Loss-item names of the automatic's own parts (for heat rules).
+struct AutoNames<'a> {
+    packs: Vec<&'a str>,
+    pump: bool,
+    converter: bool,
 }
 
 /// `[thermal]` against the checked gears and the loss items of the model.
@@ -181,6 +207,7 @@ fn thermal(
     gears: &[Gear],
     meshes: &[Mesh],
     (bearings, seals): (&[super::bearings::Bearing], &[super::bearings::Seal]),
+    auto: &AutoNames<'_>,
     problems: &mut Problems,
 ) -> Option<ThermalNetwork> {
     let infos: Vec<GearInfo<'_>> = gears
@@ -195,6 +222,9 @@ fn thermal(
     names.set(Source::Churning, gears.iter().map(|g| g.name.as_str()));
     names.set(Source::Pocketing, meshes.iter().map(|m| m.name.as_str()));
     names.set(Source::Sliding, meshes.iter().map(|m| m.name.as_str()));
+    names.set(Source::ClutchDrag, auto.packs.iter().copied());
+    names.set(Source::Pump, auto.pump.then_some("pump"));
+    names.set(Source::Converter, auto.converter.then_some("converter"));
     names.set(Source::Bearing, bearings.iter().map(|b| b.name.as_str()));
     names.set(Source::Seal, seals.iter().map(|s| s.name.as_str()));
     validate_thermal(spec, &infos, &names, problems)

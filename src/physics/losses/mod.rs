@@ -1,7 +1,12 @@
 //! Power-loss models: churning (per gear), pocketing (per mesh), sliding (per mesh), rolling
-//! bearings and shaft seals.
+//! bearings and shaft seals, and the automatic transmission's own losses: open clutch drag, oil
+//! pump, torque converter.
 pub mod bearings;
 pub mod churning;
+pub mod clutch_drag;
+pub mod converter;
+pub mod curve;
 pub mod pocketing;
+pub mod pump;
 pub mod seals;
 pub mod sliding;

@@ -94,6 +94,9 @@ impl SourceColour for Source {
             Source::Sliding => RGBColor(0, 158, 115),
             Source::Bearing => RGBColor(213, 94, 0),
             Source::Seal => RGBColor(204, 121, 167),
+            Source::ClutchDrag => RGBColor(86, 180, 233),
+            Source::Pump => RGBColor(240, 228, 66),
+            Source::Converter => RGBColor(0, 0, 0),
         }
     }
 }

@@ -38,11 +38,38 @@ pub struct BearingLoad {
     pub axial: f64,
 }
 
-/// Lubricant state at the bearing.
+/// Lubricant state at the bearing: ν in mm²/s and the powers of it the models use, computed
+/// once per oil state and shared by every bearing.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BearingOil {
-    /// Kinematic viscosity ν, m²/s.
+    /// Kinematic viscosity ν, mm²/s.
     pub nu: f64,
+    /// ν^0.6, ν^0.64, ν^1.4, ν^1.379, ν^(2/3).
+    pub p060: f64,
+    /// ν^0.64.
+    pub p064: f64,
+    /// ν^1.4.
+    pub p140: f64,
+    /// ν^1.379.
+    pub p1379: f64,
+    /// ν^(2/3).
+    pub p0667: f64,
+}
+
+impl BearingOil {
+    /// Oil of kinematic viscosity `nu` (m²/s).
+    pub fn new(nu: f64) -> BearingOil {
+        let v = nu * 1e6;
+        let ln = v.ln();
+        BearingOil {
+            nu: v,
+            p060: (0.6 * ln).exp(),
+            p064: (0.64 * ln).exp(),
+            p140: (1.4 * ln).exp(),
+            p1379: (1.379 * ln).exp(),
+            p0667: (ln * 2.0 / 3.0).exp(),
+        }
+    }
 }
 
 /// A bearing friction model.
@@ -63,6 +90,9 @@ pub struct LoadTerms {
     pub g_rr: f64,
     /// SKF: G_sl; Palmgren: M1 = f1·P1·d_m in N·mm.
     pub g_sl: f64,
+    /// Powers of the speed: SKF `[(n d_m)^1.28, n^0.6, n^1.4, n²·(n d_m² f_t)^−1.379]`;
+    /// Palmgren `[n^(2/3), 0, 0, 0]`.
+    pub speed: [f64; 4],
 }
 
 /// Frictional moment of a bearing split in its terms, N·m.

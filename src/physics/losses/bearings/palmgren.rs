@@ -50,6 +50,7 @@ impl Palmgren {
             n_rpm: n,
             g_rr: 0.0,
             g_sl: self.f1_dm * p1,
+            speed: [n.powf(2.0 / 3.0), 0.0, 0.0, 0.0],
         }
     }
 
@@ -58,12 +59,12 @@ impl Palmgren {
         if t.n_rpm == 0.0 {
             return BearingMoment::default();
         }
-        let nnu = t.n_rpm * oil.nu * 1e6;
+
         // Published: (ν n)^(2/3) for ν n ≥ 2000, the constant 160 below — a 0.8 % jump at
         // 2000 (2000^(2/3) = 158.7). The larger of the two is used instead: continuous in the oil
         // temperature (the integrator's error control needs a smooth right-hand side), equal to
         // the published law except for 2000 ≤ ν n < 2024 (docs/physics.md §Bearings).
-        let m0 = 1e-7 * self.f0_dm3 * nnu.powf(2.0 / 3.0).max(160.0);
+        let m0 = 1e-7 * self.f0_dm3 * (t.speed[0] * oil.p0667).max(160.0);
         BearingMoment {
             rolling: 1e-3 * m0,
             sliding: 1e-3 * t.g_sl,

@@ -65,14 +65,10 @@ pub struct SkfConstants {
 pub struct Skf {
     kind: SkfKind,
     c: SkfConstants,
-    /// d_m, d + D, D − d in mm.
+    /// d_m in mm.
     dm: f64,
-    d_plus_d: f64,
-    d_minus_d: f64,
     /// Static load rating C_0, N (for α_F of a deep-groove bearing under axial load).
     c0: f64,
-    /// K_rs: 3e-8 low-level oil bath and oil jet, 6e-8 grease and oil-air.
-    k_rs: f64,
     /// Sliding friction coefficients in boundary and full-film lubrication.
     mu_bl: f64,
     mu_ehl: f64,
@@ -83,6 +79,8 @@ pub struct Skf {
     drag1: f64,
     drag2: f64,
     dm2_ft: f64,
+    /// K_rs·(d + D)·√(K_z/(2(D − d))): φ_rs = exp(−this·ν·n).
+    rs: f64,
 }
 
 /// Lubrication method (sets K_rs).
@@ -166,19 +164,18 @@ impl Skf {
             kind: i.kind,
             c,
             dm,
-            d_plus_d: d + big_d,
-            d_minus_d: big_d - d,
             c0: i.c0,
-            k_rs: match i.lubrication {
-                Lubrication::OilBath => 3e-8,
-                Lubrication::Grease => 6e-8,
-            },
             mu_bl: i.mu_bl,
             mu_ehl: i.mu_ehl,
             m_seal,
             drag1,
             drag2,
             dm2_ft,
+            rs: match i.lubrication {
+                Lubrication::OilBath => 3e-8,
+                Lubrication::Grease => 6e-8,
+            } * (d + big_d)
+                * (c.k_z / (2.0 * (big_d - d))).sqrt(),
         })
     }
 
@@ -206,27 +203,33 @@ impl Skf {
                 )
             }
         };
-        LoadTerms { n_rpm: n, g_rr, g_sl }
+        let drag = if self.drag2 > 0.0 && n > 0.0 {
+            n * n * (n * self.dm2_ft).powf(-1.379)
+        } else {
+            0.0
+        };
+        LoadTerms {
+            n_rpm: n,
+            g_rr,
+            g_sl,
+            speed: [(n * dm).powf(1.28), n.powf(0.6), n.powf(1.4), drag],
+        }
     }
 
-    /// Frictional moment at the oil state `oil` with the load terms `t`. No allocation.
+    /// Frictional moment at the oil state `oil` with the load terms `t`: two exponentials and
+    /// arithmetic (the powers of ν and n are precomputed). No allocation.
     pub fn moment(&self, t: &LoadTerms, oil: BearingOil) -> BearingMoment {
         let n = t.n_rpm;
         if n == 0.0 {
             return BearingMoment::default();
         }
-        let nu = oil.nu * 1e6; // mm²/s
-        let nnu = n * nu;
-        let phi_ish = 1.0 / (1.0 + 1.84e-9 * (n * self.dm).powf(1.28) * nu.powf(0.64));
-        let phi_rs = (-self.k_rs * nnu * self.d_plus_d * (self.c.k_z / (2.0 * self.d_minus_d)).sqrt()).exp();
-        let m_rr = phi_ish * phi_rs * t.g_rr * nnu.powf(0.6);
-        let phi_bl = (-2.6e-8 * nnu.powf(1.4) * self.dm).exp();
+        let [ndm128, n06, n14, drag_n] = t.speed;
+        let phi_ish = 1.0 / (1.0 + 1.84e-9 * ndm128 * oil.p064);
+        let phi_rs = (-self.rs * oil.nu * n).exp();
+        let m_rr = phi_ish * phi_rs * t.g_rr * n06 * oil.p060;
+        let phi_bl = (-2.6e-8 * n14 * oil.p140 * self.dm).exp();
         let mu_sl = phi_bl * self.mu_bl + (1.0 - phi_bl) * self.mu_ehl;
-        let m_drag = if self.drag1 > 0.0 || self.drag2 > 0.0 {
-            n * n * (self.drag1 + self.drag2 * (n * self.dm2_ft / nu).powf(-1.379))
-        } else {
-            0.0
-        };
+        let m_drag = n * n * self.drag1 + self.drag2 * drag_n * oil.p1379;
         BearingMoment {
             rolling: 1e-3 * m_rr,
             sliding: 1e-3 * t.g_sl * mu_sl,

@@ -45,7 +45,7 @@ fn moment(i: &SkfInput, n: f64, fr: f64, fa: f64, nu_cst: f64) -> BearingMoment 
             axial: fa,
         },
     );
-    m.moment(&t, BearingOil { nu: nu_cst * 1e-6 })
+    m.moment(&t, BearingOil::new(nu_cst * 1e-6))
 }
 
 fn close(got: f64, want: f64, tol: f64) {
@@ -154,7 +154,7 @@ fn skf_units_and_scaling() {
         radial: 1000.0,
         axial: 0.0,
     };
-    let oil = BearingOil { nu: 30e-6 };
+    let oil = BearingOil::new(30e-6);
     let w = 1500.0 * RPM;
     close(
         m.power(w, load, oil),
@@ -178,13 +178,13 @@ fn palmgren_units_match_thermca_si_form() {
     let (nu, rpm) = (13.5e-6, 2175.0);
     let w = rpm * RPM;
     let t = m.load_terms(rpm, BearingLoad::default());
-    let got = m.moment(&t, BearingOil { nu }).rolling;
+    let got = m.moment(&t, BearingOil::new(nu)).rolling;
     let r = size.mean() / 2.0;
     close(got, 36008.0 * 3.0 * r.powi(3) * (nu * w).powf(0.666), 0.01);
     // Below ν n = 2000 the load-independent term is constant: 160e-7·f0·d_m³ N·mm.
     let slow = m.moment(
         &m.load_terms(10.0, BearingLoad::default()),
-        BearingOil { nu: 10e-6 },
+        BearingOil::new(10e-6),
     );
     close(slow.rolling, 1e-3 * 160e-7 * 3.0 * 60f64.powi(3), 1e-12);
     // M1 = f1·P1·d_m with P1 = max(F_r, k_a F_a + k_r F_r).
@@ -197,7 +197,7 @@ fn palmgren_units_match_thermca_si_form() {
         },
     );
     close(
-        m.moment(&t, BearingOil { nu }).sliding,
+        m.moment(&t, BearingOil::new(nu)).sliding,
         1e-3 * 3e-4 * 1900.0 * 60.0,
         1e-12,
     );

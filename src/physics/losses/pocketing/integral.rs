@@ -27,6 +27,8 @@
 //! width b/n instead would either give K_helical = K_spur exactly (if each slice gets the share
 //! w/b of the face exits — the phase shift drops out of a full-passage integral) or a loss
 //! falling like 1/n² (if every slice had two full face exits), so that reading was rejected.
+//! The scene uses the model's exact n → ∞ limit (`k_helical_continuum`): one spur pocket history
+//! shifted in phase, integrated over the face width in closed form from the Chebyshev tables.
 
 use super::areas::PocketFamily;
 use super::PocketingError;
@@ -42,6 +44,10 @@ struct Panel {
     darea: Vec<f64>,
     /// g1 + g2 (m)
     gaps: Vec<f64>,
+    /// Antiderivative of g1 + g2 in φ1 on this panel, zero at `lo` (m·rad)
+    gaps_int: Vec<f64>,
+    /// ∫_0^lo (g1 + g2) dφ1 (m·rad)
+    gaps_int_lo: f64,
 }
 
 /// Evaluate Σ c_k T_k(x) by Clenshaw's recurrence [std].
@@ -56,23 +62,47 @@ fn clenshaw(c: &[f64], x: f64) -> f64 {
 }
 
 /// Chebyshev coefficients of values at the n first-kind points `x_j = cos(π(j + ½)/n)` [std].
+/// `T_k(x_j) = cos(kθ_j)` by the three-term recurrence (no trigonometric call per term).
 fn cheb_coeffs(vals: &[f64]) -> Vec<f64> {
     let n = vals.len();
     let nf = n as f64;
-    (0..n)
-        .map(|k| {
-            let s: f64 = vals
-                .iter()
-                .enumerate()
-                .map(|(j, v)| v * (std::f64::consts::PI * k as f64 * (j as f64 + 0.5) / nf).cos())
-                .sum();
-            if k == 0 {
-                s / nf
-            } else {
-                2.0 * s / nf
-            }
-        })
-        .collect()
+    let mut c = vec![0.0; n];
+    for (j, v) in vals.iter().enumerate() {
+        let x = (std::f64::consts::PI * (j as f64 + 0.5) / nf).cos();
+        let (mut t0, mut t1) = (1.0, x);
+        c[0] += v;
+        for ck in c.iter_mut().skip(1) {
+            *ck += v * t1;
+            let t2 = 2.0 * x * t1 - t0;
+            t0 = t1;
+            t1 = t2;
+        }
+    }
+    c[0] /= nf;
+    for ck in c.iter_mut().skip(1) {
+        *ck *= 2.0 / nf;
+    }
+    c
+}
+
+/// Coefficients of the antiderivative (w.r.t. x ∈ [−1, 1]) of a Chebyshev series, zero at
+/// x = −1 [std: `C_1 = c_0 − c_2/2`, `C_k = (c_{k−1} − c_{k+1})/(2k)` for k ≥ 2].
+fn cheb_integral(c: &[f64]) -> Vec<f64> {
+    let n = c.len();
+    let at = |k: usize| c.get(k).copied().unwrap_or(0.0);
+    let mut out = vec![0.0; n + 1];
+    out[1] = at(0) - 0.5 * at(2);
+    for (k, ok) in out.iter_mut().enumerate().skip(2) {
+        *ok = (at(k - 1) - at(k + 1)) / (2.0 * k as f64);
+    }
+    // value at x = −1: Σ C_k (−1)^k
+    let at_minus_one: f64 = out
+        .iter()
+        .enumerate()
+        .map(|(k, v)| if k % 2 == 0 { *v } else { -*v })
+        .sum();
+    out[0] = -at_minus_one;
+    out
 }
 
 /// Coefficients of the derivative (w.r.t. x ∈ [−1, 1]) of a Chebyshev series [std recurrence
@@ -136,6 +166,9 @@ pub struct PocketTable {
 }
 
 const GL_N: usize = 24;
+/// Gauss–Legendre nodes per smooth sub-interval of the helical K, from the convergence study in
+/// docs/performance.md (`k_helical_continuum_with`).
+const HELIX_GL_NODES: usize = 8;
 const MAX_DEG: usize = 256;
 
 impl PocketTable {
@@ -179,6 +212,12 @@ impl PocketTable {
         if panels.is_empty() {
             return Err(PocketingError::Numerical("empty pocket phase".into()));
         }
+        panels.sort_by(|a, b| a.lo.total_cmp(&b.lo));
+        let mut acc = 0.0;
+        for p in &mut panels {
+            p.gaps_int_lo = acc;
+            acc += clenshaw(&p.gaps_int, 1.0);
+        }
         let (gl_x, gl_w) = gauss_legendre(GL_N);
         Ok(Self {
             panels,
@@ -187,6 +226,16 @@ impl PocketTable {
             gl_x,
             gl_w,
         })
+    }
+
+    /// Table of one family built with an 8× finer scan for the phase end and the gap-kind
+    /// switches than the default (high-resolution references in tests and studies).
+    pub fn reference(
+        inp: &super::PocketMeshInput,
+        kind: super::PocketFamilyKind,
+    ) -> Result<Self, PocketingError> {
+        let mp = super::areas::MeshProfiles::new(inp)?;
+        Self::new(&PocketFamily::from_profiles_scanned(&mp, kind, 512)?)
     }
 
     fn fit(
@@ -212,12 +261,15 @@ impl PocketTable {
             if tail(&ca, a_scale) && tail(&cg, g_scale) {
                 let s = 2.0 / (hi - lo);
                 let darea = cheb_derivative(&ca).into_iter().map(|d| d * s).collect();
+                let gaps_int = cheb_integral(&cg).into_iter().map(|v| v / s).collect();
                 return Ok(Some(Panel {
                     lo,
                     hi,
                     area: ca,
                     darea,
                     gaps: cg,
+                    gaps_int,
+                    gaps_int_lo: 0.0,
                 }));
             }
             n *= 2;
@@ -276,6 +328,26 @@ impl PocketTable {
         let t = ((2.0 * x - p.lo - p.hi) / (p.hi - p.lo)).clamp(-1.0, 1.0);
         let sgn = if phi1 < 0.0 { -1.0 } else { 1.0 };
         (sgn * clenshaw(&p.darea, t), clenshaw(&p.gaps, t))
+    }
+
+    /// `(A_axial, G)` at φ1, with `G(φ1) = ∫_0^φ1 (g1 + g2) dφ` (odd in φ1; beyond the phase
+    /// end the gaps keep their end value, so G grows linearly there).
+    fn eval_area_gap_integral(&self, phi1: f64) -> (f64, f64) {
+        let x = phi1.abs();
+        let sgn = if phi1 < 0.0 { -1.0 } else { 1.0 };
+        let xc = x.min(self.phi_max);
+        let i = self
+            .panels
+            .partition_point(|p| p.hi < xc)
+            .min(self.panels.len() - 1);
+        let p = &self.panels[i];
+        let t = ((2.0 * xc - p.lo - p.hi) / (p.hi - p.lo)).clamp(-1.0, 1.0);
+        let a = clenshaw(&p.area, t);
+        let mut gi = p.gaps_int_lo + clenshaw(&p.gaps_int, t);
+        if x > self.phi_max {
+            gi += (x - self.phi_max) * clenshaw(&p.gaps, t);
+        }
+        (a, sgn * gi)
     }
 
     /// Adaptive Gauss–Legendre integral of `f` on [lo, hi] to relative tolerance `rtol`
@@ -377,6 +449,71 @@ impl PocketTable {
         pts.windows(2)
             .map(|s| self.integrate(&f, s[0], s[1], 1e-10, atol))
             .sum()
+    }
+
+    /// Helical K (m⁵) of the connected-slice model (module doc) in its limit of infinitely many
+    /// slices, evaluated exactly: with `h = b·|dφ/dy|/2` the slice sums become integrals over
+    /// the face width of ONE spur pocket history shifted in phase,
+    /// `Σ w A'(ψ + Δ_j) → (A(ψ + h) − A(ψ − h))/|dφ/dy|` and
+    /// `Σ w g(ψ + Δ_j) → (G(ψ + h) − G(ψ − h))/|dφ/dy|` (G the antiderivative of the gap sum,
+    /// exact from its Chebyshev series), and the end faces are at ψ ± h. So the integrand costs
+    /// two table look-ups whatever the helix, and there is no slice count to choose:
+    /// `k_helical(cd, s, n)` converges to it like 1/n (the end faces sit w/2 inside the face;
+    /// measured in the tests and docs/performance.md). Equals `k_spur` for `dphi_dy = 0`.
+    pub fn k_helical_continuum(&self, cd: f64, dphi_dy: f64) -> f64 {
+        self.k_helical_continuum_with(cd, dphi_dy, Some(HELIX_GL_NODES)).0
+    }
+
+    /// [`Self::k_helical_continuum`] with `nodes` Gauss–Legendre nodes on each smooth
+    /// sub-interval (between the shifted panel edges), or `None` for the adaptive reference
+    /// (24-node rule, relative tolerance 1e-13); returns K and the number of integrand
+    /// evaluations (convergence study, docs/performance.md).
+    pub fn k_helical_continuum_with(&self, cd: f64, dphi_dy: f64, nodes: Option<usize>) -> (f64, usize) {
+        let b = self.face_width;
+        let s = dphi_dy.abs();
+        let h = 0.5 * b * s;
+        // below this shift the helical and spur values agree to round-off (K − K_spur ~ h²)
+        if h.is_nan() || h <= 1e-7 * self.phi_max {
+            return (self.k_spur(cd), 0);
+        }
+        let evals = std::cell::Cell::new(0usize);
+        let f = |psi: f64| {
+            evals.set(evals.get() + 1);
+            let (ap, gp) = self.eval_area_gap_integral(psi + h);
+            let (am, gm) = self.eval_area_gap_integral(psi - h);
+            let q = ((ap - am) / s).max(0.0);
+            let aout = cd * (ap + am + (gp - gm) / s);
+            q * q * q / (aout * aout)
+        };
+        let top = self.phi_max + h;
+        let mut pts = vec![0.0, top];
+        for p in &self.panels {
+            for e in [p.lo, p.hi] {
+                for c in [e - h, e + h, -e + h] {
+                    if c > 0.0 && c < top {
+                        pts.push(c);
+                    }
+                }
+            }
+        }
+        pts.sort_by(|a, b| a.total_cmp(b));
+        pts.dedup_by(|a, b| (*a - *b).abs() < 1e-14);
+        let k = match nodes {
+            Some(n) => {
+                let (x, w) = gauss_legendre(n.max(1));
+                pts.windows(2)
+                    .map(|iv| {
+                        let (m, hw) = (0.5 * (iv[0] + iv[1]), 0.5 * (iv[1] - iv[0]));
+                        hw * x.iter().zip(&w).map(|(x, w)| w * f(m + hw * x)).sum::<f64>()
+                    })
+                    .sum()
+            }
+            None => pts
+                .windows(2)
+                .map(|iv| self.integrate(&f, iv[0], iv[1], 1e-13, 0.0))
+                .sum(),
+        };
+        (k, evals.get())
     }
 
     /// K by the discrete rotational-increment form of seed 000 (§3.4, Seetharaman–Kahraman):
@@ -553,6 +690,57 @@ mod tests {
         assert!(((k32 - k128) / k128).abs() < 0.02, "{k8} {k32} {k128}");
         // the helix spreads the squeeze: less loss than spur
         assert!(k128 < ks);
+    }
+
+    #[test]
+    fn gap_antiderivative_matches_quadrature_of_the_gaps() {
+        let f = PocketFamily::new(&cases::unequal_with_backlash(), PocketFamilyKind::SpaceOfGear1).unwrap();
+        let t = PocketTable::new(&f).unwrap();
+        let pm = t.phi_max;
+        assert!(t.eval(0.5 * pm).2 > 1e-3 * cases::unequal_with_backlash().module);
+        for x in [0.1 * pm, 0.5 * pm, 0.97 * pm, 1.3 * pm, -0.6 * pm] {
+            let g = |p: f64| t.eval(p).2;
+            let n = 20000;
+            let h = x / n as f64;
+            let mut s = g(0.0) + g(x);
+            for i in 1..n {
+                s += if i % 2 == 1 { 4.0 } else { 2.0 } * g(i as f64 * h);
+            }
+            let q = s * h / 3.0;
+            let gi = t.eval_area_gap_integral(x).1;
+            assert!((gi - q).abs() < 1e-9 * q.abs(), "x = {x}: {gi} vs {q}");
+        }
+    }
+
+    #[test]
+    fn helical_continuum_is_the_limit_of_the_slices() {
+        let cd = 0.65;
+        for beta in [15f64, 30.0] {
+            let inp = cases::helical(&cases::fzg_c(), beta.to_radians());
+            let f = PocketFamily::new(&inp, PocketFamilyKind::SpaceOfGear2).unwrap();
+            let t = PocketTable::new(&f).unwrap();
+            let s = beta.to_radians().tan() / f.tooth.r_ref;
+            let kc = t.k_helical_continuum(cd, s);
+            // the fixed rule agrees with the adaptive reference to far below 1e-6
+            let (kr, _) = t.k_helical_continuum_with(cd, s, None);
+            assert!(((kc - kr) / kr).abs() < 1e-10, "β {beta}: {kc} vs {kr}");
+            // slices converge to it like 1/n; first-order Richardson closes most of the gap
+            let e: Vec<f64> = [32, 64, 128]
+                .iter()
+                .map(|&n| (t.k_helical(cd, s, n) - kc) / kc)
+                .collect();
+            for w in e.windows(2) {
+                let r = w[0] / w[1];
+                assert!((1.8..2.2).contains(&r), "β {beta}: {e:?}");
+            }
+            let rich = 2.0 * e[2] - e[1];
+            assert!(
+                rich.abs() < 0.05 * e[2].abs(),
+                "β {beta}: {e:?}, Richardson {rich}"
+            );
+            // spur limit
+            assert!(((t.k_helical_continuum(cd, 1e-12) - t.k_spur(cd)) / t.k_spur(cd)).abs() < 1e-12);
+        }
     }
 
     #[test]

@@ -16,15 +16,17 @@ use super::{PocketMeshInput, PocketingError};
 pub struct PocketingOptions {
     /// Discharge coefficient C_d of the leakage openings (default 0.65; physics.md §6 0.6–0.7).
     pub discharge_coefficient: f64,
-    /// Number of transverse slices for helical gears (ignored for spur; default 64).
-    pub helix_slices: usize,
+    /// Helical gears: `None` (default) evaluates the connected-slice model in its exact
+    /// infinitely-many-slices limit (`PocketTable::k_helical_continuum`); `Some(n)` uses n
+    /// discrete transverse slices (kept for convergence studies). Ignored for spur gears.
+    pub helix_slices: Option<usize>,
 }
 
 impl Default for PocketingOptions {
     fn default() -> Self {
         Self {
             discharge_coefficient: 0.65,
-            helix_slices: 64,
+            helix_slices: None,
         }
     }
 }
@@ -61,10 +63,10 @@ impl PocketingMesh {
                 format!("must be in (0, 1], got {cd}"),
             ));
         }
-        if opts.helix_slices == 0 || opts.helix_slices > 4096 {
+        if let Some(n) = opts.helix_slices.filter(|n| *n == 0 || *n > 4096) {
             return Err(PocketingError::InvalidInput(
                 "helix_slices",
-                format!("must be in 1..=4096, got {}", opts.helix_slices),
+                format!("must be in 1..=4096, got {n}"),
             ));
         }
         let mp = MeshProfiles::new(input)?;
@@ -76,10 +78,10 @@ impl PocketingMesh {
         {
             let fam = PocketFamily::from_profiles(&mp, kind)?;
             let table = PocketTable::new(&fam)?;
-            k[i] = if input.helix_angle == 0.0 {
-                table.k_spur(cd)
-            } else {
-                table.k_helical(cd, dphi_dy, opts.helix_slices)
+            k[i] = match opts.helix_slices {
+                _ if input.helix_angle == 0.0 => table.k_spur(cd),
+                None => table.k_helical_continuum(cd, dphi_dy),
+                Some(n) => table.k_helical(cd, dphi_dy, n),
             };
             if !(k[i].is_finite() && k[i] >= 0.0) {
                 return Err(PocketingError::Numerical(format!("K = {} for {kind:?}", k[i])));
@@ -201,7 +203,7 @@ mod tests {
         assert!(PocketingMesh::new(&inp, 0.0).is_err());
         assert!(PocketingMesh::new(&inp, 1.5).is_err());
         let o = PocketingOptions {
-            helix_slices: 0,
+            helix_slices: Some(0),
             ..PocketingOptions::default()
         };
         assert!(PocketingMesh::with_options(&inp, &o).is_err());
