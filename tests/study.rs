@@ -354,3 +354,43 @@ fn the_bundled_example_study_runs_to_its_figures() {
     let csv = std::fs::read_to_string(out.join("study.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 4, "{csv}");
 }
+
+/// A second writer of the same study directory is refused while the first holds it (exit 3, the
+/// holder named), and nothing is journaled or written by the refused run; a different shard of
+/// the same study is not blocked.
+#[test]
+fn a_second_writer_of_the_same_study_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = study_file(tmp.path(), 2, "");
+    let out = tmp.path().join("s");
+    let held = geartherm::report::files::lock_in_place(&out, "journal.jsonl").unwrap();
+    let o = bin()
+        .arg("study")
+        .arg(&file)
+        .args(["--quiet", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(3), "{}", String::from_utf8_lossy(&o.stderr));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains(&std::process::id().to_string()), "{err}");
+    assert!(!out.join("journal.jsonl").exists() && !out.join("study.csv").exists());
+    let o = bin()
+        .arg("study")
+        .arg(&file)
+        .args(["--quiet", "--shard", "0/2", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    drop(held);
+    let o = bin()
+        .arg("study")
+        .arg(&file)
+        .args(["--quiet", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.join("study.csv").is_file());
+}

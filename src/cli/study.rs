@@ -97,6 +97,12 @@ pub fn study(a: &StudyArgs) -> Result<(), Failure> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("studies").join(&study.spec.study.name));
+    // One writer per journal: a second run of the same study (or shard) into this directory
+    // is refused while the first runs; different shards run side by side.
+    let _lock = geartherm::report::files::lock_in_place(&dir, &journal_name(shard)).map_err(|e| Failure {
+        code: EXIT_IO,
+        message: e.to_string(),
+    })?;
     let done = read_journals(&dir, &study.fingerprint).map_err(io(&dir))?;
     let todo: Vec<Case> = cases
         .iter()

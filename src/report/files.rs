@@ -104,7 +104,7 @@ fn io_at(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
 
 /// An exclusive lock on a target directory, released (and its file removed) on drop.
 #[derive(Debug)]
-struct DirLock {
+pub struct DirLock {
     file: File,
     path: PathBuf,
 }
@@ -204,6 +204,26 @@ impl Drop for DirLock {
         let _ = fs::remove_file(&self.path);
         unlock(&self.file);
     }
+}
+
+/// Lock `target` for a writer that fills it in place rather than by a swap (a resumable study
+/// appends to its journal): `part` names what is locked, so writers of different parts (the
+/// shards of one study) run side by side while a second writer of the same part is refused with
+/// [`OutputError::Busy`], naming the holder's pid.
+pub fn lock_in_place(target: &Path, part: &str) -> Result<DirLock, OutputError> {
+    let target = resolve(target)?;
+    let parent = target
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("."));
+    let name = target
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .ok_or_else(|| OutputError::NotADirectory {
+            target: target.clone(),
+        })?;
+    fs::create_dir_all(&parent).map_err(io_at(&parent))?;
+    DirLock::acquire(&target, parent.join(format!(".{name}.{part}.geartherm-lock")))
 }
 
 /// A result set being written: files go into [`OutputDir::path`]; [`OutputDir::commit`] swaps
