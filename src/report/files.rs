@@ -206,11 +206,8 @@ impl Drop for DirLock {
     }
 }
 
-/// Lock `target` for a writer that fills it in place rather than by a swap (a resumable study
-/// appends to its journal): `part` names what is locked, so writers of different parts (the
-/// shards of one study) run side by side while a second writer of the same part is refused with
-/// [`OutputError::Busy`], naming the holder's pid.
-pub fn lock_in_place(target: &Path, part: &str) -> Result<DirLock, OutputError> {
+/// `target` resolved, its parent directory (created) and its file name.
+fn place(target: &Path) -> Result<(PathBuf, PathBuf, String), OutputError> {
     let target = resolve(target)?;
     let parent = target
         .parent()
@@ -223,6 +220,15 @@ pub fn lock_in_place(target: &Path, part: &str) -> Result<DirLock, OutputError> 
             target: target.clone(),
         })?;
     fs::create_dir_all(&parent).map_err(io_at(&parent))?;
+    Ok((target, parent, name))
+}
+
+/// Lock `target` for a writer that fills it in place rather than by a swap (a resumable study
+/// appends to its journal): `part` names what is locked, so writers of different parts (the
+/// shards of one study) run side by side while a second writer of the same part is refused with
+/// [`OutputError::Busy`], naming the holder's pid.
+pub fn lock_in_place(target: &Path, part: &str) -> Result<DirLock, OutputError> {
+    let (target, parent, name) = place(target)?;
     DirLock::acquire(&target, parent.join(format!(".{name}.{part}.geartherm-lock")))
 }
 
@@ -243,18 +249,7 @@ impl OutputDir {
     /// Lock `target`, clean stale temporaries of earlier killed writers, check that `target`
     /// may be replaced, and create the temporary directory beside it.
     pub fn begin(target: &Path) -> Result<Self, OutputError> {
-        let target = resolve(target)?;
-        let parent = target
-            .parent()
-            .map(Path::to_path_buf)
-            .unwrap_or_else(|| PathBuf::from("."));
-        let name = target
-            .file_name()
-            .map(|s| s.to_string_lossy().into_owned())
-            .ok_or_else(|| OutputError::NotADirectory {
-                target: target.clone(),
-            })?;
-        fs::create_dir_all(&parent).map_err(io_at(&parent))?;
+        let (target, parent, name) = place(target)?;
         let lock = DirLock::acquire(&target, parent.join(format!(".{name}.geartherm-lock")))?;
         clean_stale(&parent, &name, &target)?;
         check_replaceable(&target)?;
