@@ -318,7 +318,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
                     ),
                 });
             }
-            geartherm::scene::ranges::print_warnings(&report.warnings);
+            print_warnings(&report.warnings);
             if json {
                 print_json(&report)?;
             } else {
@@ -334,7 +334,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         Command::Map(args) => steady::map(&args),
         Command::Run(args) => {
             let outcome = run::run(&args)?;
-            geartherm::scene::ranges::print_warnings(&outcome.summary.warnings);
+            print_warnings(&outcome.summary.warnings);
             if args.json {
                 print_json(&outcome.summary)?;
             } else {
@@ -342,5 +342,12 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             }
             Ok(())
         }
+    }
+}
+
+/// Print each out-of-range warning as one stderr line (the scene only collects them).
+pub(crate) fn print_warnings(w: &[geartherm::scene::ranges::RangeWarning]) {
+    for x in w {
+        eprintln!("{x}");
     }
 }

@@ -197,7 +197,7 @@ pub fn steady(a: &SteadyArgs) -> Result<(), Failure> {
             log.warnings(&scene.losses)
         },
     };
-    geartherm::scene::ranges::print_warnings(&r.warnings);
+    super::print_warnings(&r.warnings);
     if a.json {
         return print_json(&r);
     }

@@ -118,10 +118,3 @@ fn sig(v: f64) -> String {
         format!("{v:.3}")
     }
 }
-
-/// Print each warning as one stderr line.
-pub fn print_warnings(w: &[RangeWarning]) {
-    for x in w {
-        eprintln!("{x}");
-    }
-}
