@@ -70,19 +70,27 @@ fn a_run_killed_at_any_moment_leaves_the_previous_result_whole_and_the_next_run_
     let out = d.path().join("o");
     complete_run(&out);
     let before = std::fs::read(out.join("summary.json")).unwrap();
+    // A kill before the commit must leave `before` byte for byte: checked at the first delay,
+    // which lands long before any commit (the scene compile and integration come first).
+    let mut child = bin().args(run_args(&out)).spawn().unwrap();
+    std::thread::sleep(Duration::from_millis(2));
+    let _ = child.kill();
+    if !child.wait().unwrap().success() {
+        assert_whole(&out);
+        assert_eq!(std::fs::read(out.join("summary.json")).unwrap(), before);
+    }
     for delay_ms in [20u64, 150, 400, 800, 1500] {
         let mut child = bin().args(run_args(&out)).spawn().unwrap();
         std::thread::sleep(Duration::from_millis(delay_ms));
         let _ = child.kill(); // SIGKILL
         let st = child.wait().unwrap();
         assert_whole(&out);
-        if !st.success() {
-            // Killed before its commit: the previous result, byte for byte.
-            assert_eq!(
-                std::fs::read(out.join("summary.json")).unwrap(),
-                before,
-                "after {delay_ms} ms"
-            );
+        let now = std::fs::read(out.join("summary.json")).unwrap();
+        if !st.success() && now != before {
+            // Killed after its commit and before its exit (a run takes about 0.1 s now): the
+            // new set, whole (checked above) — never a mix. Otherwise the previous set, byte
+            // for byte.
+            eprintln!("killed after {delay_ms} ms, after its commit");
         }
     }
     complete_run(&out);
