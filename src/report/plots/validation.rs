@@ -135,7 +135,11 @@ fn error_vs_speed(root: &Canvas, rows: &[&Row], title: &str, ranges: bool) -> Dr
     let root = style::titled(root, title)?;
     let (w, _) = root.dim_in_pixel();
     let (plot, side) = root.split_horizontally(w - 420);
-    let rows: Vec<&Row> = rows.iter().copied().filter(|r| r.kind.is_range() == ranges).collect();
+    let rows: Vec<&Row> = rows
+        .iter()
+        .copied()
+        .filter(|r| r.kind.is_range() == ranges)
+        .collect();
     if rows.is_empty() {
         style::draw_note_centre(
             &plot,

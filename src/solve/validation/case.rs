@@ -227,9 +227,8 @@ impl Case {
             Some(v) => v
                 .iter()
                 .map(|n| {
-                    Source::parse(n).ok_or_else(|| {
-                        bad(format!("sources: \"{n}\" (allowed: {})", Source::names()))
-                    })
+                    Source::parse(n)
+                        .ok_or_else(|| bad(format!("sources: \"{n}\" (allowed: {})", Source::names())))
                 })
                 .collect::<Result<Vec<_>, _>>()?,
         };

@@ -132,7 +132,10 @@ fn efficiency_choices() -> Vec<Choice> {
     vec![
         ("default", vec![]),
         ("friction iso_tc60", vec![("friction", s("iso_tc60"))]),
-        ("friction benedict_kelley", vec![("friction", s("benedict_kelley"))]),
+        (
+            "friction benedict_kelley",
+            vec![("friction", s("benedict_kelley"))],
+        ),
         ("churning seetharaman", vec![("churning", s("seetharaman"))]),
         ("churning stavytskyi", vec![("churning", s("stavytskyi"))]),
     ]

@@ -193,7 +193,9 @@ fn value(
         Quantity::Efficiency => {
             let p_in = op.input_speed * op.input_torque;
             if p_in <= 0.0 {
-                return Err(format!("efficiency needs input power > 0 ({rpm} rpm, {torque} N·m)"));
+                return Err(format!(
+                    "efficiency needs input power > 0 ({rpm} rpm, {torque} N·m)"
+                ));
             }
             1.0 - loss / p_in
         }
