@@ -240,7 +240,7 @@ pub fn render_validation(
                 validation::draw_parity(
                     r,
                     el,
-                    "Bearings, seals, pocketing, automatic: geartherm vs references",
+                    "Bearings, seals and the automatic's losses: geartherm vs references",
                 )
             })
         }),
