@@ -264,7 +264,9 @@ pub fn integrate(
         .build()
         .map_err(fail_build)?;
     if opts.guards.raise_failure_limit {
-        problem.ode_options.max_nonlinear_solver_failures = usize::MAX / 2;
+        // Bounded by the run's own budget (which counts these failures too), so that no single
+        // step can retry beyond it.
+        problem.ode_options.max_nonlinear_solver_failures = opts.max_steps;
     }
     let ctx = Driver {
         scene,
@@ -463,7 +465,28 @@ impl Driver<'_> {
                         ),
                     ));
                 }
-                match solver.step() {
+                // A derivative that is not finite at the start of a step gives a NaN step size
+                // (diffsol's initial-step estimate, or our restart's), and a NaN step never
+                // becomes "too small": the step would retry for ever. Fail now, naming the item.
+                let h = solver.state().h;
+                if !(h.is_finite() && h != 0.0) {
+                    let st = solver.state();
+                    let (t, y) = (st.t, st.y.inner().as_slice().to_vec());
+                    // Diagnose at the current state, not at the last (possibly NaN) trial.
+                    let mut dy = vec![0.0; y.len()];
+                    let mut w = self.work.borrow_mut();
+                    w.failure = None;
+                    self.scene.rhs(t, &y, &mut w, &mut dy);
+                    drop(w);
+                    let why = format!("step size {h}: the right-hand side is not finite");
+                    return Err(self.failure(t, &y, why));
+                }
+                let stepped = solver.step();
+                if stepped.is_ok() {
+                    // A non-finite trial the solver recovered from is not this run's failure.
+                    self.work.borrow_mut().failure = None;
+                }
+                match stepped {
                     Ok(OdeSolverStopReason::TstopReached) => break,
                     Ok(OdeSolverStopReason::InternalTimestep) => {}
                     Ok(OdeSolverStopReason::RootFound(..)) => {}

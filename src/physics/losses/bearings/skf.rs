@@ -204,7 +204,9 @@ impl Skf {
             }
         };
         let drag = if self.drag2 > 0.0 && n > 0.0 {
-            n * n * (n * self.dm2_ft).powf(-1.379)
+            // n²·(n·f_t dm²)^-1.379 written as one power of n: at vanishing speed n² underflows
+            // to 0 while (n·f_t dm²)^-1.379 overflows, and 0·∞ is NaN.
+            n.powf(2.0 - 1.379) * self.dm2_ft.powf(-1.379)
         } else {
             0.0
         };

@@ -202,3 +202,30 @@ fn palmgren_units_match_thermca_si_form() {
         1e-12,
     );
 }
+
+/// Vanishing speeds (a cycle row of 1e-300 rpm) give finite, non-negative power: the drag term's
+/// n²·(n f_t dm²)^-1.379 once gave 0·∞ = NaN there (issue 16 campaign, case 79658).
+#[test]
+fn vanishing_speeds_give_finite_power() {
+    let mut i = input(
+        SkfKind::DeepGrooveBall,
+        dgbb(4.1e-7, 3.73e-3, 14.6),
+        50.0,
+        80.0,
+        16000.0,
+        (0.12, 0.1),
+    );
+    i.oil_level = 1.0;
+    let m = BearingFriction::Skf(Skf::new(&i).unwrap());
+    let load = BearingLoad {
+        radial: 800.0,
+        axial: 0.0,
+    };
+    for w in [1e-300, 1e-200, 1e-100, 1e-20, 1e-9] {
+        let t = m.load_terms(w, load);
+        let mo = m.moment(&t, BearingOil::new(12e-6));
+        let p = m.power(w, load, BearingOil::new(12e-6));
+        assert!(mo.total().is_finite() && mo.drag >= 0.0, "{w}: {mo:?}");
+        assert!(p.is_finite() && p >= 0.0 && p < 1e-6, "{w}: {p} W");
+    }
+}
