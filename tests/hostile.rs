@@ -521,4 +521,13 @@ fn vanishing_speeds_are_standstill_not_failures() {
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let sum = std::fs::read_to_string(out.join("summary.json")).unwrap();
     assert!(!sum.contains("NaN") && !sum.contains("null"), "{sum}");
+    // The input torque once divided the converter's and the engine-driven pump's loss by the
+    // vanishing input speed: `inf` in timeseries.csv at exit 0 (same campaign, second run).
+    let ts = std::fs::read_to_string(out.join("timeseries.csv")).unwrap();
+    for cell in ts.lines().skip(1).flat_map(|l| l.split(',')) {
+        assert!(
+            cell.is_empty() || cell.parse::<f64>().map_or(true, f64::is_finite),
+            "non-finite cell {cell:?} in timeseries.csv"
+        );
+    }
 }

@@ -316,12 +316,7 @@ pub fn timeseries_csv(
         // The input supplies the transmitted torque and the losses: T_in = T_out/i + P_loss/ω_in
         // (physics spec §9). The loss items themselves are evaluated at the loss-free torque
         // (docs/physics.md §10, "Mesh loads").
-        let w_in = r.input_speed_rpm * std::f64::consts::PI / 30.0;
-        let t_in = if w_in > 0.0 {
-            r.input_torque_nm + total / w_in
-        } else {
-            r.input_torque_nm
-        };
+        let t_in = input_shaft_torque(scene, r, &traj.losses[k]);
         let _ = write!(
             s,
             "{t},{},{},{},{},{}",
@@ -360,6 +355,27 @@ pub fn timeseries_csv(
     s
 }
 
+/// Torque at the gearbox input shaft, N·m: T_in = T_out/i + P_loss/ω_in (physics spec §9) with
+/// only the losses supplied through the input shaft — the converter's slip and an engine-driven
+/// pump are paid ahead of it (the engine columns show that side). The loss items themselves are
+/// evaluated at the loss-free torque (docs/physics.md §10, "Mesh loads").
+fn input_shaft_torque(scene: &Scene, r: &RowInputs, losses: &[f64]) -> f64 {
+    let w_in = r.input_speed_rpm * std::f64::consts::PI / 30.0;
+    let shaft_loss: f64 = scene
+        .losses
+        .items
+        .iter()
+        .zip(losses)
+        .filter(|(it, _)| !it.engine_side)
+        .map(|(_, p)| p)
+        .sum();
+    if w_in > 0.0 {
+        r.input_torque_nm + shaft_loss / w_in
+    } else {
+        r.input_torque_nm
+    }
+}
+
 /// The first non-finite number a run would write, named (`time 12.5 s, node oil`), or `Ok`.
 /// Checked before anything is written: a run whose numbers are not all finite fails (exit 2)
 /// instead of writing blanks or `null`s.
@@ -391,10 +407,14 @@ pub fn check_finite(
             }
         }
         if let Some(r) = rows.get(k) {
+            let t_in = traj
+                .losses
+                .get(k)
+                .map_or(r.input_torque_nm, |q| input_shaft_torque(scene, r, q));
             for (what, v) in [
                 ("vehicle speed", r.vehicle_speed_kmh),
                 ("input speed", r.input_speed_rpm),
-                ("input torque", r.input_torque_nm),
+                ("input torque", t_in),
                 ("output power", r.output_power_w),
             ] {
                 if !v.is_finite() {
