@@ -1,5 +1,6 @@
 //! Solvers: the transient driver (diffsol) and the steady-state equilibrium search.
 pub mod drive;
+pub mod equations;
 pub mod equilibrium;
 pub mod steady;
 pub mod sweep;

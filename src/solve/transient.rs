@@ -17,14 +17,40 @@ use std::cell::RefCell;
 use std::time::Instant;
 
 use diffsol::{
-    NalgebraLU, NalgebraMat, NalgebraVec, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason,
-    Vector, VectorCommon,
+    FaerSparseLU, FaerSparseMat, NalgebraLU, NalgebraMat, OdeBuilder, OdeEquations, OdeSolverMethod,
+    OdeSolverStopReason,
 };
 
+use super::equations::{HostVector, SceneEquations};
 use crate::scene::{Inputs, Scene, Work};
 
-type M = NalgebraMat<f64>;
-type LS = NalgebraLU<f64>;
+/// Linear algebra of the implicit methods' Newton iterations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LinearAlgebra {
+    /// Dense below [`SPARSE_FROM_STATES`] states, sparse from there on.
+    Auto,
+    /// Dense matrices and LU (nalgebra).
+    Dense,
+    /// Compressed-column matrices and faer's sparse LU (fill-reducing ordering, symbolic
+    /// factorisation once per solve).
+    Sparse,
+}
+
+/// State count from which [`LinearAlgebra::Auto`] uses the sparse LU (the measured crossover,
+/// docs/performance.md "Sparse networks and the integration floor").
+pub const SPARSE_FROM_STATES: usize = 64;
+
+impl LinearAlgebra {
+    /// True when a solve of `states` states uses the sparse LU.
+    pub fn is_sparse(self, states: usize) -> bool {
+        match self {
+            LinearAlgebra::Auto => states >= SPARSE_FROM_STATES,
+            LinearAlgebra::Dense => false,
+            LinearAlgebra::Sparse => true,
+        }
+    }
+}
 
 /// Integration method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -110,6 +136,8 @@ pub struct TransientOptions {
     /// Evaluate and keep the loss of every item at every output time (`Trajectory::losses`, for
     /// timeseries.csv and the plots); off when those outputs are not asked for.
     pub record_losses: bool,
+    /// Dense or sparse linear algebra (default: by size).
+    pub linear_algebra: LinearAlgebra,
 }
 
 /// Pitfall guards of the driver.
@@ -151,6 +179,7 @@ impl Default for TransientOptions {
             initial_temp: None,
             guards: Guards::default(),
             record_losses: true,
+            linear_algebra: LinearAlgebra::Auto,
         }
     }
 }
@@ -176,6 +205,8 @@ pub struct Stats {
     pub restarts: usize,
     /// Cycle samples whose loss terms were prepared (once per distinct input sample).
     pub samples_prepared: usize,
+    /// True when the Newton iterations used the sparse LU.
+    pub sparse: bool,
 }
 
 /// The result: the state at every segment boundary, and the losses there.
@@ -241,31 +272,6 @@ pub fn integrate(
         item: None,
         message: format!("could not set up the solver: {e}"),
     };
-    let y0c = y0.clone();
-    let mut problem = OdeBuilder::<M>::new()
-        .t0(first.t0)
-        .rtol(opts.rtol)
-        .atol(atol.clone())
-        .use_coloring(false)
-        .rhs_implicit(
-            |x: &[f64], _p: &[f64], t: f64, y: &mut [f64]| {
-                scene.rhs(t, x, &mut work.borrow_mut(), y);
-            },
-            |x: &[f64], _p: &[f64], t: f64, v: &[f64], y: &mut [f64]| {
-                scene.jvp(t, x, v, &mut work.borrow_mut(), y);
-            },
-        )
-        .init(
-            move |_p: &[f64], _t: f64, y: &mut [f64]| {
-                y.copy_from_slice(&y0c);
-            },
-            ns,
-        )
-        .build()
-        .map_err(fail_build)?;
-    if opts.guards.raise_failure_limit {
-        problem.ode_options.max_nonlinear_solver_failures = usize::MAX / 2;
-    }
     let ctx = Driver {
         scene,
         work: &work,
@@ -281,24 +287,46 @@ pub fn integrate(
         stats: Stats::default(),
         wall_time_s: 0.0,
     };
-    match opts.method {
-        Method::Bdf => {
-            let mut s = problem.bdf::<LS>().map_err(fail_build)?;
-            ctx.run(&mut s, &mut traj, progress)?;
-        }
-        Method::Esdirk34 => {
-            let mut s = problem.esdirk34::<LS>().map_err(fail_build)?;
-            ctx.run(&mut s, &mut traj, progress)?;
-        }
-        Method::TrBdf2 => {
-            let mut s = problem.tr_bdf2::<LS>().map_err(fail_build)?;
-            ctx.run(&mut s, &mut traj, progress)?;
-        }
-        Method::Tsit45 => {
-            let mut s = problem.tsit45().map_err(fail_build)?;
-            ctx.run(&mut s, &mut traj, progress)?;
-        }
+    // One body for both matrix types (the solvers' trait bounds are easiest met by concrete types).
+    macro_rules! solve_with {
+        ($m:ty, $ls:ty) => {{
+            let eqn = SceneEquations::<$m>::new(scene, &work, y0.clone());
+            let mut problem = OdeBuilder::<$m>::new()
+                .t0(first.t0)
+                .rtol(opts.rtol)
+                .atol(atol.clone())
+                .build_from_eqn(eqn)
+                .map_err(fail_build)?;
+            if opts.guards.raise_failure_limit {
+                problem.ode_options.max_nonlinear_solver_failures = usize::MAX / 2;
+            }
+            match opts.method {
+                Method::Bdf => {
+                    let mut s = problem.bdf::<$ls>().map_err(fail_build)?;
+                    ctx.run(&mut s, &mut traj, progress)?;
+                }
+                Method::Esdirk34 => {
+                    let mut s = problem.esdirk34::<$ls>().map_err(fail_build)?;
+                    ctx.run(&mut s, &mut traj, progress)?;
+                }
+                Method::TrBdf2 => {
+                    let mut s = problem.tr_bdf2::<$ls>().map_err(fail_build)?;
+                    ctx.run(&mut s, &mut traj, progress)?;
+                }
+                Method::Tsit45 => {
+                    let mut s = problem.tsit45().map_err(fail_build)?;
+                    ctx.run(&mut s, &mut traj, progress)?;
+                }
+            }
+        }};
     }
+    let sparse = opts.method.is_implicit() && opts.linear_algebra.is_sparse(ns);
+    if sparse {
+        solve_with!(FaerSparseMat<f64>, FaerSparseLU<f64>);
+    } else {
+        solve_with!(NalgebraMat<f64>, NalgebraLU<f64>);
+    }
+    traj.stats.sparse = sparse;
     let w = work.borrow();
     traj.stats.rhs_evals = w.rhs_evals;
     traj.stats.jac_evals = w.jac_evals;
@@ -393,14 +421,14 @@ impl Driver<'_> {
         progress: &mut dyn FnMut(usize, usize),
     ) -> Result<(), NumericalFailure>
     where
-        Eqn: OdeEquations<T = f64, V = NalgebraVec<f64>> + 'a,
+        Eqn: OdeEquations<T = f64, V: HostVector> + 'a,
         S: OdeSolverMethod<'a, Eqn>,
     {
         let segs = self.segments;
         let total = segs.len();
         {
             let st = solver.state();
-            self.record(traj, segs[0].t0, st.y.inner().as_slice(), 0);
+            self.record(traj, segs[0].t0, st.y.host(), 0);
         }
         let mut restarts = 0;
         for (k, seg) in segs.iter().enumerate() {
@@ -418,31 +446,18 @@ impl Driver<'_> {
                     let st = solver.state_mut();
                     *st.t = seg.t0;
                     if g.refresh_derivative {
-                        self.scene.rhs(
-                            seg.t0,
-                            st.y.inner().as_slice(),
-                            &mut self.work.borrow_mut(),
-                            st.dy.inner_mut().as_mut_slice(),
-                        );
+                        self.scene
+                            .rhs(seg.t0, st.y.host(), &mut self.work.borrow_mut(), st.dy.host_mut());
                     }
                     if g.reset_step {
-                        let h = self.restart_step(
-                            st.y.inner().as_slice(),
-                            st.dy.inner().as_slice(),
-                            *st.h,
-                            seg.t1 - seg.t0,
-                        );
+                        let h = self.restart_step(st.y.host(), st.dy.host(), *st.h, seg.t1 - seg.t0);
                         *st.h = h;
                     }
                 }
             }
             solver.set_stop_time(seg.t1).map_err(|e| {
                 let st = solver.state();
-                self.failure(
-                    st.t.min(seg.t1),
-                    st.y.inner().as_slice(),
-                    format!("stop time rejected: {e}"),
-                )
+                self.failure(st.t.min(seg.t1), st.y.host(), format!("stop time rejected: {e}"))
             })?;
             loop {
                 // Attempts, not only accepted steps: a solver that keeps rejecting must also
@@ -455,7 +470,7 @@ impl Driver<'_> {
                     let st = solver.state();
                     return Err(self.failure(
                         st.t,
-                        st.y.inner().as_slice(),
+                        st.y.host(),
                         format!(
                             "step budget of {} exceeded (the network is too stiff for {} at this tolerance, or oscillates)",
                             self.opts.max_steps,
@@ -469,16 +484,12 @@ impl Driver<'_> {
                     Ok(OdeSolverStopReason::RootFound(..)) => {}
                     Err(e) => {
                         let st = solver.state();
-                        return Err(self.failure(
-                            st.t,
-                            st.y.inner().as_slice(),
-                            format!("solver error: {e}"),
-                        ));
+                        return Err(self.failure(st.t, st.y.host(), format!("solver error: {e}")));
                     }
                 }
             }
             let st = solver.state();
-            let y = st.y.inner().as_slice();
+            let y = st.y.host();
             if let Some(i) = y.iter().position(|v| !v.is_finite()) {
                 return Err(self.failure(seg.t1, y, format!("state component {i} is not finite")));
             }
