@@ -38,7 +38,12 @@ struct Row {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut rows = Vec::new();
-    for n in SIZES {
+    // COST_SIZES=500,1000 limits the sizes (for profiling one of them).
+    let sizes: Vec<usize> = match std::env::var("COST_SIZES") {
+        Ok(v) => v.split(',').filter_map(|x| x.trim().parse().ok()).collect(),
+        Err(_) => SIZES.to_vec(),
+    };
+    for n in sizes {
         let (around, along) = wall::grid(n);
         let extra = if n == 0 {
             String::new()
@@ -53,6 +58,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ..TransientOptions::default()
         };
         let t = integrate(&scene, &segs, &o, &mut |_, _| {})?;
+        eprintln!("{n} patches: {} states, one sparse run {:.4} s, {} steps", scene.n_states(), t.wall_time_s, t.stats.steps);
         rows.push(Row {
             patches: n,
             states: scene.n_states(),

@@ -17,11 +17,12 @@ use std::cell::RefCell;
 use std::time::Instant;
 
 use diffsol::{
-    FaerSparseLU, FaerSparseMat, NalgebraLU, NalgebraMat, OdeBuilder, OdeEquations, OdeSolverMethod,
+    FaerSparseMat, NalgebraLU, NalgebraMat, OdeBuilder, OdeEquations, OdeSolverMethod,
     OdeSolverStopReason,
 };
 
 use super::equations::{HostVector, SceneEquations};
+use super::sparse_lu::NetworkSparseLu;
 use crate::scene::{Inputs, Scene, Work};
 
 /// Linear algebra of the implicit methods' Newton iterations.
@@ -322,7 +323,7 @@ pub fn integrate(
     }
     let sparse = opts.method.is_implicit() && opts.linear_algebra.is_sparse(ns);
     if sparse {
-        solve_with!(FaerSparseMat<f64>, FaerSparseLU<f64>);
+        solve_with!(FaerSparseMat<f64>, NetworkSparseLu);
     } else {
         solve_with!(NalgebraMat<f64>, NalgebraLU<f64>);
     }
