@@ -19,6 +19,17 @@ use geartherm::solve::transient::{integrate, LinearAlgebra, TransientOptions};
 
 const SIZES: [usize; 9] = [0, 10, 20, 30, 50, 100, 200, 500, 1000];
 
+/// CPU time of this thread, s (the machine is shared: wall times include waiting for a core).
+fn cpu_time() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: clock_gettime writes into the timespec we own.
+    unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
 /// Criterion's median (s) of `wltc_network/<label>/<n>`, if measured.
 fn median(label: &str, n: usize) -> Option<f64> {
     let p = format!("target/criterion/wltc_network/{label}/{n}/new/estimates.json");
@@ -34,6 +45,8 @@ struct Row {
     rhs: usize,
     sparse_s: Option<f64>,
     dense_s: Option<f64>,
+    sparse_cpu: f64,
+    dense_cpu: Option<f64>,
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -52,13 +65,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         };
         let gb = wall::at6_with(&extra);
         let (scene, segs) = wall::wltc_scene(&gb);
-        let o = TransientOptions {
-            record_losses: false,
-            linear_algebra: LinearAlgebra::Sparse,
-            ..TransientOptions::default()
+        let run = |la: LinearAlgebra| {
+            let o = TransientOptions {
+                record_losses: false,
+                linear_algebra: la,
+                ..TransientOptions::default()
+            };
+            let c0 = cpu_time();
+            let t = integrate(&scene, &segs, &o, &mut |_, _| {});
+            (t, cpu_time() - c0)
         };
-        let t = integrate(&scene, &segs, &o, &mut |_, _| {})?;
-        eprintln!("{n} patches: {} states, one sparse run {:.4} s, {} steps", scene.n_states(), t.wall_time_s, t.stats.steps);
+        let (t, cpu) = run(LinearAlgebra::Sparse);
+        let t = t?;
+        let dense_cpu = (n <= 200).then(|| run(LinearAlgebra::Dense).1);
+        eprintln!(
+            "{n} patches: {} states, one sparse run {:.4} s wall, {:.4} s CPU, {} steps, {} LU",
+            scene.n_states(),
+            t.wall_time_s,
+            cpu,
+            t.stats.steps,
+            t.stats.lu_factorisations
+        );
+        if let Some(d) = dense_cpu {
+            eprintln!("{n} patches: dense run {d:.4} s CPU");
+        }
         rows.push(Row {
             patches: n,
             states: scene.n_states(),
@@ -67,18 +97,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             rhs: t.stats.rhs_evals,
             sparse_s: median("sparse", n),
             dense_s: median("dense", n),
+            sparse_cpu: cpu,
+            dense_cpu,
         });
     }
     let out = Path::new("plots/performance");
     fs::create_dir_all(out)?;
     let mut csv = String::from(
-        "patches,nodes,states,steps,lu_factorisations,rhs_evals,sparse_wltc_s,dense_wltc_s,sparse_us_per_step,dense_us_per_step\n",
+        "patches,nodes,states,steps,lu_factorisations,rhs_evals,sparse_wltc_s,dense_wltc_s,sparse_us_per_step,dense_us_per_step,sparse_cpu_s,dense_cpu_s\n",
     );
     let f = |v: Option<f64>| v.map(|x| format!("{x:.6e}")).unwrap_or_default();
     for r in &rows {
         let per = |v: Option<f64>| v.map(|x| x / r.steps as f64 * 1e6);
         csv += &format!(
-            "{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{}\n",
             r.patches,
             if r.patches == 0 { 5 } else { 4 + r.patches },
             r.states,
@@ -88,7 +120,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             f(r.sparse_s),
             f(r.dense_s),
             f(per(r.sparse_s)),
-            f(per(r.dense_s))
+            f(per(r.dense_s)),
+            f(Some(r.sparse_cpu)),
+            f(r.dense_cpu)
         );
     }
     fs::write(out.join("cost_per_step.csv"), &csv)?;

@@ -96,7 +96,11 @@ impl NetworkSparseLu {
     pub fn split(&self) -> Option<(usize, usize, usize)> {
         self.f.as_ref().map(|f| {
             let n = f.m.nrows();
-            (f.s_index.len(), f.b_index.len(), n - f.s_index.len() - f.b_index.len())
+            (
+                f.s_index.len(),
+                f.b_index.len(),
+                n - f.s_index.len() - f.b_index.len(),
+            )
         })
     }
 }
@@ -118,7 +122,9 @@ fn classify(sym: &SymbolicSparseColMat<usize>) -> (Vec<Kind>, Vec<usize>, Vec<us
     }
     let nodes = is_q.iter().filter(|q| !**q).count();
     let th = hub_threshold(nodes);
-    let mut hub: Vec<bool> = (0..n).map(|i| !is_q[i] && (rows[i] > th || cols[i] > th)).collect();
+    let mut hub: Vec<bool> = (0..n)
+        .map(|i| !is_q[i] && (rows[i] > th || cols[i] > th))
+        .collect();
     if hub.iter().filter(|h| **h).count() >= nodes {
         hub.iter_mut().for_each(|h| *h = false);
     }
@@ -144,7 +150,10 @@ impl LinearSolver<FaerSparseMat<f64>> for NetworkSparseLu {
     ) {
         let n = op.ncols();
         let m = FaerSparseMat::<f64>::new_from_sparsity(op.nrows(), n, op.sparsity(), *op.context());
-        let sym = m.inner()[0].symbolic().to_owned().expect("pattern of the iteration matrix");
+        let sym = m.inner()[0]
+            .symbolic()
+            .to_owned()
+            .expect("pattern of the iteration matrix");
         let (kind, s_index, b_index) = classify(&sym);
         let (cp, ri) = (sym.col_ptr(), sym.row_idx());
         let mut sc = Scatter::default();
@@ -175,8 +184,11 @@ impl LinearSolver<FaerSparseMat<f64>> for NetworkSparseLu {
         let ss_sym = SymbolicSparseColMat::new_checked(ns, ns, ss_cp, None, ss_ri);
         let nnz = ss_sym.row_idx().len();
         let symbolic = factorize_symbolic_lu(ss_sym.as_ref(), Default::default()).expect("symbolic LU");
-        let factor_scratch = MemBuffer::new(symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()));
-        let solve_scratch = RefCell::new(MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)));
+        let factor_scratch =
+            MemBuffer::new(symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()));
+        let solve_scratch = RefCell::new(MemBuffer::new(
+            symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
+        ));
         let nb = b_index.len();
         self.f = Some(Factors {
             m,
@@ -275,7 +287,9 @@ impl LinearSolver<FaerSparseMat<f64>> for NetworkSparseLu {
                 r[a] -= v * y[j];
             }
             if !schur.solve_mut(r) {
-                return Err(LaError::Other("singular Schur complement of the hub nodes".into()));
+                return Err(LaError::Other(
+                    "singular Schur complement of the hub nodes".into(),
+                ));
             }
             for (b, &i) in f.b_index.iter().enumerate() {
                 xs[i] = r[b];

@@ -17,8 +17,7 @@ use std::cell::RefCell;
 use std::time::Instant;
 
 use diffsol::{
-    FaerSparseMat, NalgebraLU, NalgebraMat, OdeBuilder, OdeEquations, OdeSolverMethod,
-    OdeSolverStopReason,
+    FaerSparseMat, NalgebraLU, NalgebraMat, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason,
 };
 
 use super::equations::{HostVector, SceneEquations};
@@ -40,7 +39,7 @@ pub enum LinearAlgebra {
 
 /// State count from which [`LinearAlgebra::Auto`] uses the sparse LU (the measured crossover,
 /// docs/performance.md "Sparse networks and the integration floor").
-pub const SPARSE_FROM_STATES: usize = 64;
+pub const SPARSE_FROM_STATES: usize = 50;
 
 impl LinearAlgebra {
     /// True when a solve of `states` states uses the sparse LU.
