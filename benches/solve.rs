@@ -94,9 +94,6 @@ fn benches(c: &mut Criterion) {
     }
 }
 
-/// Patch counts of the generated networks (the AT6 housing meshed into patches).
-const PATCHES: [usize; 5] = [50, 100, 200, 500, 1000];
-
 /// The WLTC on the AT6 with its housing meshed into N patches (`[thermal.wall_mesh]`), sparse
 /// and dense LU: the cost per step against N (`examples/cost_per_step.rs` divides by the steps
 /// and plots it). Run alone with `cargo bench --bench solve -- wltc_network`.

@@ -30,9 +30,9 @@ fn cpu_time() -> f64 {
     ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
 }
 
-/// Criterion's median (s) of `wltc_network/<label>/<n>`, if measured.
+/// Criterion's median (s) of `wltc_network/<label>/<n>` (stored as `<label>_<n>`), if measured.
 fn median(label: &str, n: usize) -> Option<f64> {
-    let p = format!("target/criterion/wltc_network/{label}/{n}/new/estimates.json");
+    let p = format!("target/criterion/wltc_network/{label}_{n}/new/estimates.json");
     let v: serde_json::Value = serde_json::from_str(&fs::read_to_string(p).ok()?).ok()?;
     Some(v["median"]["point_estimate"].as_f64()? * 1e-9)
 }
@@ -133,17 +133,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
 fn plot(rows: &[Row], path: &Path) -> Result<(), Box<dyn std::error::Error>> {
     style::ensure_fonts()?;
-    let pts = |dense: bool| -> Vec<(f64, f64)> {
+    let per_step = |f: &dyn Fn(&Row) -> Option<f64>| -> Vec<(f64, f64)> {
         rows.iter()
             .filter(|r| r.patches >= 10)
-            .filter_map(|r| {
-                let s = if dense { r.dense_s } else { r.sparse_s }?;
-                Some((r.states as f64, s / r.steps as f64 * 1e6))
-            })
+            .filter_map(|r| Some((r.states as f64, f(r)? / r.steps as f64 * 1e6)))
             .collect()
     };
-    let (sp, de) = (pts(false), pts(true));
-    let all: Vec<f64> = sp.iter().chain(&de).map(|p| p.1).collect();
+    let sp = per_step(&|r| Some(r.sparse_cpu));
+    let de = per_step(&|r| r.dense_cpu);
+    let sp_wall = per_step(&|r| r.sparse_s);
+    let de_wall = per_step(&|r| r.dense_s);
+    let all: Vec<f64> = sp
+        .iter()
+        .chain(&de)
+        .chain(&sp_wall)
+        .chain(&de_wall)
+        .map(|p| p.1)
+        .collect();
     let (ylo, yhi) = (
         all.iter().cloned().fold(f64::INFINITY, f64::min) / 1.5,
         all.iter().cloned().fold(0.0, f64::max) * 1.5,
@@ -163,8 +169,9 @@ fn plot(rows: &[Row], path: &Path) -> Result<(), Box<dyn std::error::Error>> {
         .build_cartesian_2d((xlo..xhi).log_scale(), (ylo..yhi).log_scale())?;
     chart
         .configure_mesh()
-        .x_desc("States (nodes + 4 loss-energy quadratures)")
-        .y_desc("Wall time per accepted step (µs)")
+        .x_desc("States (nodes + per-source loss energies + boundary heat)")
+        .x_labels(12)
+        .y_desc("Time per accepted step (µs)")
         .axis_desc_style(style::font(style::AXIS_DESC_PX))
         .label_style(style::font(style::TICK_PX))
         .light_line_style(style::GRID)
@@ -176,14 +183,29 @@ fn plot(rows: &[Row], path: &Path) -> Result<(), Box<dyn std::error::Error>> {
     let red = style::series_colour(1);
     chart
         .draw_series(LineSeries::new(sp.clone(), blue.stroke_width(3)))?
-        .label("sparse LU (faer)")
+        .label("sparse (network LU), CPU time")
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 30, y)], blue.stroke_width(3)));
     chart.draw_series(sp.iter().map(|&p| Circle::new(p, 6, blue.filled())))?;
     chart
         .draw_series(LineSeries::new(de.clone(), red.stroke_width(3)))?
-        .label("dense LU (nalgebra)")
+        .label("dense LU (nalgebra), CPU time")
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 30, y)], red.stroke_width(3)));
     chart.draw_series(de.iter().map(|&p| TriangleMarker::new(p, 7, red.filled())))?;
+    // Criterion medians (wall time on the shared machine: includes waiting for a core).
+    for (pts, c, label) in [
+        (&sp_wall, blue, "sparse, criterion median (wall, loaded machine)"),
+        (&de_wall, red, "dense, criterion median (wall, loaded machine)"),
+    ] {
+        if pts.is_empty() {
+            continue;
+        }
+        let light = c.mix(0.45);
+        chart
+            .draw_series(LineSeries::new(pts.clone(), light.stroke_width(2)))?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 30, y)], light.stroke_width(2)));
+        chart.draw_series(pts.iter().map(|&p| Cross::new(p, 6, light.stroke_width(2))))?;
+    }
     // N^1.2 guide through the sparse point nearest 50 patches.
     if let Some(&(x0, y0)) = sp
         .iter()

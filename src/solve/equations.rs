@@ -99,6 +99,9 @@ pub struct SceneEquations<'s, M: JacobianMatrix> {
     /// Matrix position of each entry of the scene's Jacobian pattern.
     slots: Vec<usize>,
     vals: RefCell<Vec<f64>>,
+    /// False: build the Jacobian from one Jacobian–vector product per column, as diffsol's
+    /// closures do (only to measure what the assembly saves; dense matrices only).
+    pub assembled: bool,
 }
 
 impl<'s, M: JacobianMatrix> SceneEquations<'s, M> {
@@ -119,6 +122,7 @@ impl<'s, M: JacobianMatrix> SceneEquations<'s, M> {
             sparsity,
             slots,
             vals: RefCell::new(vec![0.0; pattern.len()]),
+            assembled: true,
         }
     }
 
@@ -203,6 +207,10 @@ impl<M: JacobianMatrix> NonLinearOpJacobian for SceneRhs<'_, '_, M> {
 
     fn jacobian_inplace(&self, x: &M::V, t: f64, y: &mut M) {
         let e = self.0;
+        if !e.assembled && e.sparsity.is_none() {
+            self._default_jacobian_inplace(x, t, y);
+            return;
+        }
         let mut vals = e.vals.borrow_mut();
         e.scene
             .jacobian_values(t, x.host(), &mut e.work.borrow_mut(), &mut vals);

@@ -161,8 +161,7 @@ impl LinearSolver<FaerSparseMat<f64>> for NetworkSparseLu {
         let mut ss_cp = vec![0usize; s_index.len() + 1];
         let mut ss_ri = Vec::new();
         for j in 0..n {
-            for p in cp[j]..cp[j + 1] {
-                let r = ri[p];
+            for (p, &r) in ri.iter().enumerate().take(cp[j + 1]).skip(cp[j]) {
                 match (kind[r], kind[j]) {
                     (Kind::S(a), Kind::S(_)) => {
                         sc.ss.push((p, ss_ri.len()));

@@ -138,6 +138,9 @@ pub struct TransientOptions {
     pub record_losses: bool,
     /// Dense or sparse linear algebra (default: by size).
     pub linear_algebra: LinearAlgebra,
+    /// Assemble the Jacobian entry by entry (default). Off: one Jacobian–vector product per
+    /// column, as before issue 15 (dense only; for measuring the difference).
+    pub assembled_jacobian: bool,
 }
 
 /// Pitfall guards of the driver.
@@ -180,6 +183,7 @@ impl Default for TransientOptions {
             guards: Guards::default(),
             record_losses: true,
             linear_algebra: LinearAlgebra::Auto,
+            assembled_jacobian: true,
         }
     }
 }
@@ -290,7 +294,8 @@ pub fn integrate(
     // One body for both matrix types (the solvers' trait bounds are easiest met by concrete types).
     macro_rules! solve_with {
         ($m:ty, $ls:ty) => {{
-            let eqn = SceneEquations::<$m>::new(scene, &work, y0.clone());
+            let mut eqn = SceneEquations::<$m>::new(scene, &work, y0.clone());
+            eqn.assembled = opts.assembled_jacobian;
             let mut problem = OdeBuilder::<$m>::new()
                 .t0(first.t0)
                 .rtol(opts.rtol)
