@@ -130,3 +130,40 @@ fn wall_mesh_errors_name_the_key() {
         other => panic!("expected an invalid model, got {other:?}"),
     }
 }
+
+#[test]
+fn assembled_jacobian_equals_the_jacobian_vector_products() {
+    // The 50-patch AT6 (conduction, convection tables, radiation, the thermostat cooler, rotating
+    // parts in oil), away from the initial state, at a mid-cycle sample.
+    let (around, along) = wall::grid(50);
+    let gb = wall::at6_with(&wall::mesh_toml(around, along, Some(0.3), 100.0));
+    let (scene, segs) = wall::wltc_scene(&gb);
+    let mut work = scene.work(segs[900].inputs);
+    let mut y = scene.initial_state(None);
+    for (i, t) in y.iter_mut().take(scene.nodes()).enumerate() {
+        *t += 40.0 + 0.37 * i as f64;
+    }
+    let pattern = scene.jacobian_pattern();
+    let mut vals = vec![0.0; pattern.len()];
+    scene.jacobian_values(300.0, &y, &mut work, &mut vals);
+    let n = scene.n_states();
+    let mut dense = vec![0.0; n * n];
+    for (&(r, c), v) in pattern.iter().zip(&vals) {
+        dense[r + c * n] += v;
+    }
+    let (mut v, mut col) = (vec![0.0; n], vec![0.0; n]);
+    let mut worst = 0.0f64;
+    for j in 0..n {
+        v.iter_mut().for_each(|x| *x = 0.0);
+        v[j] = 1.0;
+        scene.jvp(300.0, &y, &v, &mut work, &mut col);
+        // Relative to the column's largest entry (sums in another order round differently).
+        let scale = (0..n)
+            .map(|i| dense[i + j * n].abs().max(col[i].abs()))
+            .fold(f64::MIN_POSITIVE, f64::max);
+        for i in 0..n {
+            worst = worst.max((dense[i + j * n] - col[i]).abs() / scale);
+        }
+    }
+    assert!(worst < 1e-12, "assembled vs products: {worst}");
+}
