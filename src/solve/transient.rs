@@ -491,7 +491,7 @@ impl Driver<'_> {
                 let h = solver.state().h;
                 if !(h.is_finite() && h != 0.0) {
                     let st = solver.state();
-                    let (t, y) = (st.t, st.y.inner().as_slice().to_vec());
+                    let (t, y) = (st.t, st.y.host().to_vec());
                     // Diagnose at the current state, not at the last (possibly NaN) trial.
                     let mut dy = vec![0.0; y.len()];
                     let mut w = self.work.borrow_mut();
