@@ -34,21 +34,7 @@ fn benches(c: &mut Criterion) {
         .find(|m| m.name.contains("large_sun"))
         .expect("mesh");
     let (g1, g2) = (&gb.gears[m.gear1].geometry, &gb.gears[m.gear2].geometry);
-    let inp = PocketMeshInput {
-        z1: g1.z(),
-        z2: g2.z(),
-        module: g1.spec.mn,
-        pressure_angle: g1.spec.alpha_n,
-        x1: g1.spec.x,
-        x2: g2.spec.x,
-        tip_radius1: g1.d_a / 2.0,
-        tip_radius2: g2.d_a / 2.0,
-        root_radius1: g1.d_f / 2.0,
-        root_radius2: g2.d_f / 2.0,
-        centre_distance: m.geometry.a_w,
-        face_width: g1.spec.b.min(g2.spec.b),
-        helix_angle: g1.spec.beta,
-    };
+    let inp = PocketMeshInput::from_gears(g1, g2, m.geometry.a_w);
     let s = inp.helix_angle.tan() / (0.5 * inp.module * inp.z1 as f64 / inp.helix_angle.cos());
     c.bench_function("pocket/family_geometry", |b| {
         b.iter(|| PocketFamily::new(black_box(&inp), PocketFamilyKind::SpaceOfGear2))

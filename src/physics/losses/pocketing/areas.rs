@@ -49,7 +49,7 @@
 //! come first, while both gaps have a foot on an involute (beyond, a gap would join two tip
 //! corners). Outside, [`PocketFamily::state`] returns `None`.
 
-use super::profile::{cross, inv, inv_roll, ToothProfile};
+use super::teeth::{cross, inv, inv_roll, PocketTeeth};
 use super::{PocketMeshInput, PocketingError};
 
 /// Which pockets: the space of which gear, entered by a tooth of the other.
@@ -109,10 +109,10 @@ pub struct PocketState {
 /// Mesh-level data shared by both families.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MeshProfiles {
-    /// Gear 1 profile (possibly thinned to remove a rounding-level negative backlash).
-    pub gear1: ToothProfile,
-    /// Gear 2 profile.
-    pub gear2: ToothProfile,
+    /// Gear 1 teeth (possibly thinned to remove a rounding-level negative backlash).
+    pub gear1: PocketTeeth,
+    /// Gear 2 teeth.
+    pub gear2: PocketTeeth,
     /// Operating transverse pressure angle α_wt (rad).
     pub alpha_w: f64,
     /// Normal backlash j_bn (m), ≥ 0.
@@ -127,7 +127,8 @@ impl MeshProfiles {
     /// Build and check both profiles and the operating pressure angle
     /// `cos α_wt = a cos α_t / a_w` [std, physics.md §2].
     pub fn new(inp: &PocketMeshInput) -> Result<Self, PocketingError> {
-        let g1 = ToothProfile::new(
+        let b = super::positive("face_width", inp.face_width)?;
+        let g1 = PocketTeeth::new(
             inp.z1,
             inp.module,
             inp.pressure_angle,
@@ -135,8 +136,10 @@ impl MeshProfiles {
             inp.x1,
             inp.tip_radius1,
             inp.root_radius1,
+            inp.rho_fp1,
+            b,
         )?;
-        let g2 = ToothProfile::new(
+        let g2 = PocketTeeth::new(
             inp.z2,
             inp.module,
             inp.pressure_angle,
@@ -144,9 +147,10 @@ impl MeshProfiles {
             inp.x2,
             inp.tip_radius2,
             inp.root_radius2,
+            inp.rho_fp2,
+            b,
         )?;
         let aw = super::positive("centre_distance", inp.centre_distance)?;
-        let b = super::positive("face_width", inp.face_width)?;
         let cw = (g1.r_ref + g2.r_ref) * g1.alpha_t.cos() / aw;
         if !(cw > 0.0 && cw < 1.0) {
             return Err(PocketingError::InvalidInput(
@@ -205,10 +209,10 @@ impl MeshProfiles {
 pub struct PocketFamily {
     /// Which family.
     pub kind: PocketFamilyKind,
-    /// Profile of the gear owning the space (S).
-    pub space: ToothProfile,
-    /// Profile of the gear owning the entering tooth (T).
-    pub tooth: ToothProfile,
+    /// Teeth of the gear owning the space (S).
+    pub space: PocketTeeth,
+    /// Teeth of the gear owning the entering tooth (T).
+    pub tooth: PocketTeeth,
     a: f64,
     alpha_w: f64,
     /// dv/du = z_S/z_T.
@@ -678,7 +682,19 @@ mod tests {
         assert!((eps - 1.44).abs() < 0.01, "ε_α = {eps}");
         // the data are zero-backlash to rounding: thinned by < 0.1 µm
         assert_eq!(mp.backlash, 0.0);
-        let raw = ToothProfile::new(16, 4.5e-3, 20f64.to_radians(), 0.0, 0.1817, 0.04123, 0.031).unwrap();
+        let inp = cases::fzg_c();
+        let raw = PocketTeeth::new(
+            16,
+            4.5e-3,
+            20f64.to_radians(),
+            0.0,
+            0.1817,
+            inp.tip_radius1,
+            inp.root_radius1,
+            0.25,
+            inp.face_width,
+        )
+        .unwrap();
         let thin = (raw.half_tooth_base - mp.gear1.half_tooth_base) * 2.0 * raw.r_base;
         assert!(thin > 0.0 && thin < 1e-7, "thinning {thin}");
     }

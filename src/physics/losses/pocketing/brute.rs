@@ -10,7 +10,7 @@
 //! case logic of `areas.rs`.
 
 use super::areas::PocketFamily;
-use super::profile::ToothProfile;
+use super::teeth::PocketTeeth;
 
 type P = [f64; 2];
 
@@ -21,8 +21,8 @@ fn involute_polar(rb: f64, l: f64) -> (f64, f64) {
 
 /// The brute-force view of one family at one angle.
 pub struct BruteScene<'a> {
-    s: &'a ToothProfile,
-    t: &'a ToothProfile,
+    s: &'a PocketTeeth,
+    t: &'a PocketTeeth,
     a: f64,
     u: f64,
     v: f64,
@@ -41,8 +41,8 @@ impl<'a> BruteScene<'a> {
         }
     }
 
-    fn l_range(p: &ToothProfile) -> (f64, f64) {
-        let rf = p.r_base.max(p.r_root);
+    fn l_range(p: &PocketTeeth) -> (f64, f64) {
+        let rf = p.r_form();
         (
             (rf * rf - p.r_base * p.r_base).max(0.0).sqrt(),
             (p.r_tip * p.r_tip - p.r_base * p.r_base).sqrt(),
