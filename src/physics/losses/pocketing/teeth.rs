@@ -270,9 +270,10 @@ impl PocketTeeth {
             clock_point(r, pz - th + self.thinning)
         };
         let mut pts = Vec::with_capacity(2 * n + 2);
+        // root arc from the centre line to the (turned) fillet end
+        let c_root = pz - theta_root + self.thinning;
         for i in 0..=n {
-            let th = pz + (theta_root - pz) * i as f64 / n as f64;
-            pts.push(to_pocket(clock_point(self.r_root, th)));
+            pts.push(clock_point(self.r_root, c_root * i as f64 / n as f64));
         }
         for i in 1..=n {
             pts.push(to_pocket(self.profile.fillet_point(i as f64 / n as f64)));
