@@ -856,6 +856,41 @@ mod tests {
                 );
             }
         }
+        // seed 004 table rows (family 2 = family 1 for equal gears)
+        let f = PocketFamily::new(&cases::seed004(), PocketFamilyKind::SpaceOfGear2).unwrap();
+        for d in [-13.0f64, -10.0, -8.0, -6.0, -5.0, -4.0, -3.0, -2.0, -1.0, 0.0] {
+            let s = f.state(d.to_radians()).unwrap();
+            eprintln!(
+                "seed004 {d:>5}°: A {:.3} mm², V {:.1} mm³, S_r1 {:.2} mm², S_r2 {:.2} mm² {:?}",
+                s.area * 1e6,
+                s.volume * 1e9,
+                s.s_r1 * 1e6,
+                s.s_r2 * 1e6,
+                s.kinds
+            );
+        }
+        // FZG C power (both families, ρ 870) and the helical table (normal data kept)
+        let fzg = cases::fzg_c();
+        let pm = super::super::PocketingMesh::new(&fzg, 0.65).unwrap();
+        for rpm in [1000.0, 3000.0, 6000.0] {
+            let w = rpm * std::f64::consts::PI / 30.0;
+            let [a, b] = pm.family_power(w, 870.0);
+            eprintln!("fzg_c {rpm} rpm: {:.2} W ({a:.2} + {b:.2})", a + b);
+        }
+        for beta in [0.0f64, 5.0, 10.0, 15.0, 20.0, 25.0] {
+            let inp = cases::helical(&fzg, beta.to_radians());
+            let mp = MeshProfiles::new(&inp).unwrap();
+            let s = inp.helix_angle.tan() / mp.gear1.r_ref;
+            let (mut kh, mut ks) = (0.0, 0.0);
+            for kind in [PocketFamilyKind::SpaceOfGear2, PocketFamilyKind::SpaceOfGear1] {
+                let t = PocketTable::new(&PocketFamily::from_profiles(&mp, kind).unwrap()).unwrap();
+                ks += t.k_spur(0.65);
+                kh += if beta == 0.0 { t.k_spur(0.65) } else { t.k_helical(0.65, s, 64) };
+            }
+            let w = 3000.0 * std::f64::consts::PI / 30.0;
+            let p = 16.0 * 870.0 * w.powi(3) * kh / (4.0 * std::f64::consts::PI);
+            eprintln!("fzg_c helical β {beta}°: K_hel/K_spur (n = 64) {:.3}, P 3000 rpm {p:.1} W", kh / ks);
+        }
     }
 
     #[test]
