@@ -810,7 +810,12 @@ mod tests {
         // unequal gears: the two families differ (each one is still even in φ1)
         let [ga, gb] = families(&cases::fzg_c());
         let (x, y) = (ga.state(0.0).unwrap(), gb.state(0.0).unwrap());
-        assert!((x.area - y.area).abs() > 0.01 * x.area, "{} vs {}", x.area, y.area);
+        assert!(
+            (x.area - y.area).abs() > 0.01 * x.area,
+            "{} vs {}",
+            x.area,
+            y.area
+        );
     }
 
     /// Figures of docs/physics.md §3/6 (FZG C table, seed 004 K):
@@ -885,11 +890,18 @@ mod tests {
             for kind in [PocketFamilyKind::SpaceOfGear2, PocketFamilyKind::SpaceOfGear1] {
                 let t = PocketTable::new(&PocketFamily::from_profiles(&mp, kind).unwrap()).unwrap();
                 ks += t.k_spur(0.65);
-                kh += if beta == 0.0 { t.k_spur(0.65) } else { t.k_helical(0.65, s, 64) };
+                kh += if beta == 0.0 {
+                    t.k_spur(0.65)
+                } else {
+                    t.k_helical(0.65, s, 64)
+                };
             }
             let w = 3000.0 * std::f64::consts::PI / 30.0;
             let p = 16.0 * 870.0 * w.powi(3) * kh / (4.0 * std::f64::consts::PI);
-            eprintln!("fzg_c helical β {beta}°: K_hel/K_spur (n = 64) {:.3}, P 3000 rpm {p:.1} W", kh / ks);
+            eprintln!(
+                "fzg_c helical β {beta}°: K_hel/K_spur (n = 64) {:.3}, P 3000 rpm {p:.1} W",
+                kh / ks
+            );
         }
     }
 

@@ -297,7 +297,10 @@ mod tests {
                     // its involute flanks: the gaps, found on the involutes only, are the
                     // narrowest passages (the fillet of the generated profile never binds)
                     let g = g1p.min(g2p);
-                    assert!(c >= g - 1e-6 * inp.module, "{kind:?} φ={phi}: fillet {c} < gap {g}");
+                    assert!(
+                        c >= g - 1e-6 * inp.module,
+                        "{kind:?} φ={phi}: fillet {c} < gap {g}"
+                    );
                 }
             }
         }

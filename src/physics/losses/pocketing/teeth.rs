@@ -123,7 +123,7 @@ fn check_gear(
             format!("profile shift must be in [−2, 2], got {x}"),
         ));
     }
-    if !(rho_fp.is_finite() && rho_fp >= 0.0 && rho_fp <= 1.0) {
+    if !(rho_fp.is_finite() && (0.0..=1.0).contains(&rho_fp)) {
         return Err(PocketingError::InvalidInput(
             "rho_fp",
             format!("tool tip radius factor must be in [0, 1], got {rho_fp}"),
@@ -228,8 +228,7 @@ impl PocketTeeth {
             ));
         }
         let rf = self.r_root;
-        self.bottom_integral =
-            2.0 * (-self.profile.space_bottom_integral() - 0.5 * rf * rf * self.thinning);
+        self.bottom_integral = 2.0 * (-self.profile.space_bottom_integral() - 0.5 * rf * rf * self.thinning);
         Ok(())
     }
 
@@ -294,7 +293,18 @@ mod tests {
     fn teeth(z: u32, m: f64, x: f64, beta: f64) -> PocketTeeth {
         let a = 20f64.to_radians();
         let r = 0.5 * m * z as f64 / beta.cos();
-        PocketTeeth::new(z, m, a, beta, x, r + m * (1.0 + x), r - m * (1.25 - x), 0.25, 0.02).unwrap()
+        PocketTeeth::new(
+            z,
+            m,
+            a,
+            beta,
+            x,
+            r + m * (1.0 + x),
+            r - m * (1.25 - x),
+            0.25,
+            0.02,
+        )
+        .unwrap()
     }
 
     #[test]
