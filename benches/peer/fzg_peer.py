@@ -162,9 +162,10 @@ class Changenet:
 #   f = wet share of the band ±2.25 m_n around the pitch point.
 # K itself is NOT recomputed here: it is geartherm's compiled number, recovered from one call of
 # `geartherm losses` (the P ∝ ρ ω³ law and the density mix are then checked at other points).
-# physics.md §3/6 lists K = 1.6929e-9 + 1.6731e-9 m⁵ for this mesh at C_d = 0.65 (fallback).
+# physics.md §3/6 lists K = 1.7398e-9 + 1.5726e-9 m⁵ for this mesh at C_d = 0.65 (fallback;
+# 1.6929e-9 + 1.6731e-9 before issue 15 unified the tooth profile).
 # --------------------------------------------------------------------------------------------
-POCKET_K_DOC = 1.6929e-9 + 1.6731e-9
+POCKET_K_DOC = 1.7398e-9 + 1.5726e-9
 
 
 def peer_model(src: str, dst: str) -> str:
