@@ -13,7 +13,10 @@ use geartherm::scene::{Inputs, Needs, Scene};
 use geartherm::solve::drive::segments;
 use geartherm::solve::equilibrium::equilibrium;
 use geartherm::solve::steady::SteadyOptions;
-use geartherm::solve::transient::{integrate, TransientOptions};
+use geartherm::solve::transient::{integrate, LinearAlgebra, TransientOptions};
+
+#[path = "../tests/common/wall.rs"]
+mod wall;
 
 const MODELS: [&str; 4] = [
     "models/at6_lepelletier.toml",
@@ -91,5 +94,38 @@ fn benches(c: &mut Criterion) {
     }
 }
 
-criterion_group!(solve, benches);
+/// The WLTC on the AT6 with its housing meshed into N patches (`[thermal.wall_mesh]`), sparse
+/// and dense LU: the cost per step against N (`examples/cost_per_step.rs` divides by the steps
+/// and plots it). Run alone with `cargo bench --bench solve -- wltc_network`.
+fn networks(c: &mut Criterion) {
+    let mut g = c.benchmark_group("wltc_network");
+    g.sample_size(10);
+    // Small sizes first: where the sparse LU starts to win.
+    for n in [0usize, 10, 20, 30, 50, 100, 200, 500, 1000] {
+        let (around, along) = wall::grid(n);
+        let extra = if n == 0 {
+            String::new()
+        } else {
+            wall::mesh_toml(around, along, Some(0.3), 100.0)
+        };
+        let gb = wall::at6_with(&extra);
+        let (scene, segs) = wall::wltc_scene(&gb);
+        for (label, la) in [("sparse", LinearAlgebra::Sparse), ("dense", LinearAlgebra::Dense)] {
+            if la == LinearAlgebra::Dense && n > 200 {
+                continue; // 1.5 s and more per run
+            }
+            let o = TransientOptions {
+                record_losses: false,
+                linear_algebra: la,
+                ..TransientOptions::default()
+            };
+            g.bench_function(format!("{label}/{n}"), |b| {
+                b.iter(|| integrate(&scene, &segs, &o, &mut |_, _| {}).unwrap())
+            });
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(solve, benches, networks);
 criterion_main!(solve);

@@ -468,3 +468,66 @@ fn a_second_writer_is_refused_while_the_first_writes() {
         [".geartherm-output", "summary.json", "timeseries.csv"]
     );
 }
+
+/// Campaign of issue 16 (seed 23, case 79658): a cycle of 1e-308 / 1e-300 rpm on the AT6 kept
+/// `run --max-steps 100000` busy for ever (a NaN bearing drag gave a NaN first step size, which
+/// never becomes "too small"), and `losses` at such speeds failed with exit 2 on three models.
+/// Vanishing speeds are standstill: exit 0, finite numbers, at once.
+#[test]
+fn vanishing_speeds_are_standstill_not_failures() {
+    for m in [
+        "models/fzg_c.toml",
+        "models/at6_lepelletier.toml",
+        "models/helical_stage.toml",
+        "models/pt6_spur_pair.toml",
+    ] {
+        for n in ["1e-300", "1e-200", "1e-100"] {
+            let o = run(&[
+                "losses",
+                m,
+                "--gear",
+                "1",
+                "--speed-rpm",
+                n,
+                "--torque-nm",
+                "100",
+                "--oil-temp-c",
+                "23",
+                "--json",
+            ]);
+            assert_eq!(code(&o), 0, "{m} at {n} rpm: {}", stderr(&o));
+            let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+            assert!(v["total_w"].as_f64().is_some_and(f64::is_finite), "{m} at {n}");
+        }
+    }
+    let d = tempfile::tempdir().unwrap();
+    let cycle = write(
+        d.path(),
+        "c.csv",
+        "time_s,input_speed_rpm,input_torque_nm,gear\n0.5,1e-308,100,3\n10.5,1e-300,1e-308,3\n",
+    );
+    let out = d.path().join("o");
+    let o = run(&[
+        "run",
+        "models/at6_lepelletier.toml",
+        "--cycle",
+        s(&cycle),
+        "--out",
+        s(&out),
+        "--quiet",
+        "--max-steps",
+        "100000",
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let sum = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    assert!(!sum.contains("NaN") && !sum.contains("null"), "{sum}");
+    // The input torque once divided the converter's and the engine-driven pump's loss by the
+    // vanishing input speed: `inf` in timeseries.csv at exit 0 (same campaign, second run).
+    let ts = std::fs::read_to_string(out.join("timeseries.csv")).unwrap();
+    for cell in ts.lines().skip(1).flat_map(|l| l.split(',')) {
+        assert!(
+            cell.is_empty() || cell.parse::<f64>().map_or(true, f64::is_finite),
+            "non-finite cell {cell:?} in timeseries.csv"
+        );
+    }
+}

@@ -293,3 +293,48 @@ fn planets_are_in_equilibrium_and_the_input_pinion_drives() {
         }
     }
 }
+
+/// FZG C bearings against the FZG-rig group's own code ([P4] cfernandesFEUP/Gear-Calculation
+/// `GearC/bearings.py` @345f3128, run outside the repository: docs/validation.md §Bearings):
+/// NJ 406 with half the gear resultant each (gear centred), pinion 2175 r/min, wheel 1450 r/min,
+/// ν 13.5 mm²/s, μ_bl 0.12, μ_EHL 0.02, M_rr + M_sl (oil lowered below the bearings so that the
+/// drag term, whose form differs between the two, is off), at K5/K7/K9 (0.5 m arm), to 1 %.
+#[test]
+fn fzg_bearings_match_the_fzg_rig_code() {
+    let text = std::fs::read_to_string(root().join("models/fzg_c.toml")).unwrap();
+    let text = text.replacen("oil_level_mm = 150.0", "oil_level_mm = 100.0", 1);
+    let gb = model::from_str(&text, Path::new("models/fzg_c.toml")).unwrap();
+    let scene = LossScene::compile(&gb).unwrap();
+    let oil = gb.oil.properties(90.0 + KELVIN_OFFSET);
+    assert!((oil.nu * 1e6 / 13.5 - 1.0).abs() < 2e-3);
+    for (torque, pinion_w, wheel_w) in [
+        (94.1, 19.5263, 10.7923),
+        (183.35, 24.5455, 13.8232),
+        (302.0, 29.3464, 16.8535),
+    ] {
+        let op = OperatingPoint {
+            state: gb.state_index("1").unwrap(),
+            input_speed: 2175.0 * std::f64::consts::PI / 30.0,
+            input_torque: torque,
+            oil,
+        };
+        let mut out = vec![0.0; scene.len()];
+        scene.evaluate(&op, &mut out);
+        let mut checked = 0;
+        for (it, w) in scene.items.iter().zip(&out) {
+            let want = match it.name.as_str() {
+                "pinion_a" | "pinion_b" => pinion_w,
+                "wheel_a" | "wheel_b" => wheel_w,
+                _ => continue,
+            };
+            assert_eq!(it.source, Source::Bearing);
+            assert!(
+                (w / want - 1.0).abs() < 0.01,
+                "{} at {torque} N·m: {w} W vs {want} W",
+                it.name
+            );
+            checked += 1;
+        }
+        assert_eq!(checked, 4, "the four bearing items");
+    }
+}

@@ -72,6 +72,7 @@ fn sample_switch_right_hand_side_and_jacobian_product_allocate_nothing() {
         let mut dy = vec![0.0; y.len()];
         let mut v = vec![0.0; y.len()];
         let mut jv = vec![0.0; y.len()];
+        let mut jac = vec![0.0; scene.jacobian_pattern().len()];
         let before = allocs();
         for k in 0..20 {
             y[scene.thermal.oil] += 0.5 * k as f64; // new T_oil: the Jacobian column is recomputed
@@ -88,6 +89,8 @@ fn sample_switch_right_hand_side_and_jacobian_product_allocate_nothing() {
                 v[j] = 1.0;
                 scene.jvp(k as f64, &y, &v, &mut work, &mut jv);
             }
+            // The assembled Jacobian (issue 15) too.
+            scene.jacobian_values(k as f64, &y, &mut work, &mut jac);
         }
         let after = allocs();
         assert_eq!(after - before, 0, "{m}: rhs/jvp allocated");

@@ -48,6 +48,8 @@ fn validate_runs_every_model_choice_and_writes_table_and_plots() {
         "parity_churning.png",
         "error_vs_speed_sliding.png",
         "error_vs_speed_churning.png",
+        "parity_elements.png",
+        "range_distance_efficiency.png",
     ] {
         assert!(out.join(f).is_file(), "{f}");
     }
@@ -92,5 +94,123 @@ fn validate_on_a_directory_without_cases_fails_and_writes_nothing() {
         .output()
         .unwrap();
     assert_eq!(r.status.code(), Some(1));
+    assert!(!out.exists());
+}
+
+fn run_validate(cases: &Path, out: &Path) -> serde_json::Value {
+    let r = Command::new(env!("CARGO_BIN_EXE_geartherm"))
+        .args([
+            "validate",
+            cases.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    serde_json::from_slice(&r.stdout).unwrap()
+}
+
+/// A handbook case on the bundled FZG model (absolute model path, so it runs from a temporary
+/// directory): gear-pair efficiency at K9, 2175 rpm, against a range.
+fn write_handbook_case(cases: &Path, low: f64, high: f64) {
+    let d = cases.join("handbook_fzg");
+    std::fs::create_dir_all(&d).unwrap();
+    let model = root().join("models").join("fzg_c.toml");
+    std::fs::write(
+        d.join("case.toml"),
+        format!(
+            "kind = \"handbook\"\nsource = \"test\"\nmodel = {:?}\nquantity = \"efficiency\"\n\
+             sources = [\"churning\", \"pocketing\", \"sliding\"]\nmodels = [\"default\"]\n\
+             [[range]]\npoint = \"K9\"\ngear = \"1\"\nspeed_rpm = 2175.0\ntorque_nm = 215.513\n\
+             oil_temp_c = 90.0\nlow = {low}\nhigh = {high}\n",
+            model.to_str().unwrap()
+        ),
+    )
+    .unwrap();
+}
+
+#[test]
+fn validate_covers_bearing_seal_converter_pump_and_handbook_ranges() {
+    let d = tempfile::tempdir().unwrap();
+    let cases = d.path().join("cases");
+    for c in [
+        "fernandes_nj406_1000n_bearing",
+        "iso14179_seal_standard",
+        "advisor_jdm_converter",
+        "pump_datasheet_standard",
+    ] {
+        copy_case(c, &cases);
+    }
+    write_handbook_case(&cases, 0.990, 0.998);
+    let v = run_validate(&cases, &d.path().join("out"));
+    let rows = v["rows"].as_array().unwrap();
+    let of = |case: &str| -> Vec<&serde_json::Value> { rows.iter().filter(|r| r["case"] == case).collect() };
+    // Three kinds of reference in one run.
+    let mut kinds: Vec<&str> = rows.iter().map(|r| r["kind"].as_str().unwrap()).collect();
+    kinds.sort_unstable();
+    kinds.dedup();
+    assert_eq!(kinds, ["handbook", "peer", "standard"]);
+    // Bearing: the Palmgren choice only (NJ 406 has no SKF row), one row per peer point.
+    let b = of("fernandes_nj406_1000n_bearing");
+    assert_eq!(b.len(), 6);
+    assert!(b
+        .iter()
+        .all(|r| r["model"] == "palmgren" && r["quantity"] == "bearing"));
+    // Seal law, converter table and pump formula are reproduced (a wrong item, speed or source
+    // would miss by far more).
+    for c in [
+        "iso14179_seal_standard",
+        "advisor_jdm_converter",
+        "pump_datasheet_standard",
+    ] {
+        for r in of(c) {
+            assert!(r["relative_error"].as_f64().unwrap().abs() < 1e-6, "{r}");
+        }
+    }
+    // Efficiency of the FZG pair at K9: a fraction just below 1 (about 1 % of the input power
+    // lost in the mesh), its error the distance to the spur-pair range.
+    let h = of("handbook_fzg");
+    assert_eq!(h.len(), 1);
+    let eta = h[0]["predicted"].as_f64().unwrap();
+    assert!(eta > 0.98 && eta < 1.0, "{eta}");
+    let inside = eta.clamp(0.990, 0.998);
+    let e = h[0]["relative_error"].as_f64().unwrap();
+    assert!((e - (eta - inside) / inside).abs() < 1e-12, "{e}");
+}
+
+#[test]
+fn a_handbook_range_the_value_misses_gives_the_distance_to_it() {
+    let d = tempfile::tempdir().unwrap();
+    let cases = d.path().join("cases");
+    // A range above any gear-pair efficiency: the error is (η − 0.9999)/0.9999 < 0.
+    write_handbook_case(&cases, 0.9999, 1.0);
+    let v = run_validate(&cases, &d.path().join("out"));
+    let r = &v["rows"][0];
+    let eta = r["predicted"].as_f64().unwrap();
+    assert_eq!(r["reference"].as_f64().unwrap(), 0.9999);
+    let e = r["relative_error"].as_f64().unwrap();
+    assert!((e - (eta - 0.9999) / 0.9999).abs() < 1e-12 && e < 0.0, "{e}");
+}
+
+#[test]
+fn a_range_with_low_above_high_is_rejected_naming_the_point() {
+    let d = tempfile::tempdir().unwrap();
+    let cases = d.path().join("cases");
+    write_handbook_case(&cases, 0.998, 0.990);
+    let out = d.path().join("out");
+    let r = Command::new(env!("CARGO_BIN_EXE_geartherm"))
+        .args([
+            "validate",
+            cases.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(r.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(err.contains("range K9") && err.contains("case.toml"), "{err}");
     assert!(!out.exists());
 }

@@ -313,8 +313,11 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
                 return Err(Failure {
                     code: EXIT_NUMERICAL,
                     message: format!(
-                        "{}: {what} is not finite at gear {gear}, {speed_rpm} rpm, {torque_nm} N m, {oil_temp_c} °C",
-                        model.display()
+                        "{}: {what} is not finite at gear {gear}, {} rpm, {} N m, {} °C",
+                        model.display(),
+                        short(speed_rpm),
+                        short(torque_nm),
+                        short(oil_temp_c)
                     ),
                 });
             }
@@ -349,5 +352,15 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
 pub(crate) fn print_warnings(w: &[geartherm::scene::ranges::RangeWarning]) {
     for x in w {
         eprintln!("{x}");
+    }
+}
+
+/// A number as a user typed it: plain in the usual range, in exponent form outside it (so that
+/// 1e-300 is not printed with 300 zeros).
+fn short(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e9).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
     }
 }

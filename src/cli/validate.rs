@@ -4,6 +4,7 @@
 
 use std::path::PathBuf;
 
+use geartherm::report::files::OutputDir;
 use geartherm::report::validation::{rows_csv, summary_csv, summary_markdown, ValidationReport};
 use geartherm::solve::validation::{run_all, summarise};
 
@@ -28,6 +29,9 @@ pub fn validate(a: &ValidateArgs) -> Result<(), Failure> {
     if !a.dir.is_dir() {
         return Err(invalid(format!("validate: {}: not a directory", a.dir.display())));
     }
+    // Lock the output directory before the work (a second writer is refused now) and write the
+    // result set as one transaction: the previous set stays whole until the commit.
+    let out = OutputDir::begin(&a.out)?;
     let rows = run_all(&a.dir).map_err(|e| invalid(format!("validate: {e}")))?;
     if rows.is_empty() {
         return Err(invalid(format!(
@@ -53,10 +57,11 @@ pub fn validate(a: &ValidateArgs) -> Result<(), Failure> {
         ("validation_summary.csv", summary_csv(&sum)),
         ("validation.md", summary_markdown(&sum)),
     ];
-    geartherm::report::plots::render_validation(&a.out, &rows, &texts).map_err(|e| Failure {
+    geartherm::report::plots::render_validation(out.path(), &rows, &texts).map_err(|e| Failure {
         code: EXIT_IO,
         message: format!("validate: {e}"),
     })?;
+    let target = out.commit()?;
     if a.json {
         print_json(&ValidationReport {
             rows: &rows,
@@ -64,7 +69,7 @@ pub fn validate(a: &ValidateArgs) -> Result<(), Failure> {
         })
     } else {
         print!("{}", summary_markdown(&sum));
-        println!("\n{} rows written to {}", rows.len(), a.out.display());
+        println!("\n{} rows written to {}", rows.len(), target.display());
         Ok(())
     }
 }

@@ -43,11 +43,17 @@ impl BearingType {
         }
     }
 
-    /// True for the types the SKF model covers here (their table rows were found).
+    /// True for the types the SKF model covers here (their table rows were found; needle roller
+    /// bearings have no row in any source found).
     pub fn has_skf(self) -> bool {
+        !matches!(self, BearingType::NeedleRoller)
+    }
+
+    /// Roller (line-contact) type: μ_EHL and the drag form differ from ball bearings.
+    pub fn is_roller(self) -> bool {
         matches!(
             self,
-            BearingType::DeepGrooveBall | BearingType::AngularContactBall
+            BearingType::CylindricalRoller | BearingType::TaperedRoller | BearingType::NeedleRoller
         )
     }
 }
@@ -61,9 +67,10 @@ pub struct SeriesEntry {
     /// Bearing type the row applies to.
     #[serde(rename = "type")]
     pub kind: BearingType,
-    /// R1, R2, R3 (R3 angular contact only), S1, S2.
+    /// R1, R2, R3 (R3 angular and four-point contact only), S1, S2, S3.
     pub r1: f64,
-    /// R2.
+    /// R2 (0 where the form has none: cylindrical roller).
+    #[serde(default)]
     pub r2: f64,
     /// R3.
     #[serde(default)]
@@ -72,8 +79,14 @@ pub struct SeriesEntry {
     pub s1: f64,
     /// S2.
     pub s2: f64,
+    /// S3 (angular and four-point contact only).
+    #[serde(default)]
+    pub s3: f64,
     /// K_z.
     pub k_z: f64,
+    /// K_L (roller bearings' drag term; 0 for ball bearings).
+    #[serde(default)]
+    pub k_l: f64,
     /// Source.
     pub source: String,
 }
@@ -101,6 +114,9 @@ pub struct CatalogueBearing {
     /// Rows of rolling elements (default 1).
     #[serde(default)]
     pub rows: Option<f64>,
+    /// Axial load factor Y (tapered roller bearings: required by the SKF form).
+    #[serde(default)]
+    pub y: Option<f64>,
     /// Source of the dimensions and C0.
     pub source: String,
 }
@@ -123,7 +139,7 @@ pub fn catalogue() -> (Vec<SeriesEntry>, Vec<CatalogueBearing>) {
 #[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum BearingModelChoice {
-    /// SKF (2004) (deep-groove and angular-contact ball bearings).
+    /// SKF (2004) (every type with a catalogue row: all but needle roller bearings).
     Skf,
     /// Palmgren.
     Palmgren,
@@ -268,6 +284,15 @@ mod tests {
                 "{}",
                 s.series
             );
+            assert!(s.kind.has_skf(), "{}: no SKF form for {:?}", s.series, s.kind);
+            // Roller rows carry K_L (drag); the angular forms carry R3 and S3.
+            assert_eq!(s.kind.is_roller(), s.k_l > 0.0, "{}", s.series);
+            if matches!(
+                s.kind,
+                BearingType::AngularContactBall | BearingType::FourPointContactBall
+            ) {
+                assert!(s.r3 > 0.0 && s.s3 > 0.0, "{}", s.series);
+            }
         }
         for b in &c.bearing {
             assert!(
@@ -282,6 +307,9 @@ mod tests {
                     "{}",
                     b.designation
                 );
+            }
+            if b.kind == BearingType::TaperedRoller {
+                assert!(b.y.is_some_and(|y| y > 0.0), "{}: Y", b.designation);
             }
         }
         let mut names: Vec<&str> = c.bearing.iter().map(|b| b.designation.as_str()).collect();

@@ -15,6 +15,7 @@ pub mod schema;
 pub mod source;
 pub mod thermal;
 pub mod validate;
+pub mod wall_mesh;
 
 use std::path::{Path, PathBuf};
 

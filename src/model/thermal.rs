@@ -39,6 +39,9 @@ pub struct ThermalSpec {
     /// `[[thermal.heat]]`: where loss heat goes (overrides of the defaults).
     #[serde(default)]
     pub heat: Vec<HeatSpec>,
+    /// `[thermal.wall_mesh]`: discretise a wall node into patches (see [`super::wall_mesh`]).
+    #[serde(default)]
+    pub wall_mesh: Option<super::wall_mesh::WallMeshSpec>,
 }
 
 /// A node with heat capacity: `capacity_j_per_k`, or `mass_kg` × `cp_j_per_kgk`.
@@ -383,6 +386,9 @@ pub struct ThermalNetwork {
     pub oil_node: usize,
     /// Default initial temperature, K.
     pub initial_temp: f64,
+    /// Names that stand for several nodes (a meshed wall): heat sent to the name is split over
+    /// (node, fraction).
+    pub groups: Vec<(String, Vec<(usize, f64)>)>,
 }
 
 impl ThermalNetwork {
@@ -914,7 +920,7 @@ pub fn validate_thermal(
     if problems.len() > start {
         return None;
     }
-    Some(ThermalNetwork {
+    let net = ThermalNetwork {
         nodes,
         boundaries,
         links,
@@ -922,5 +928,10 @@ pub fn validate_thermal(
         heat,
         oil_node: oil_node?,
         initial_temp: initial + KELVIN_OFFSET,
+        groups: Vec::new(),
+    };
+    Some(match &spec.wall_mesh {
+        Some(m) => super::wall_mesh::mesh_wall(net, m, problems),
+        None => net,
     })
 }

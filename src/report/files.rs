@@ -209,8 +209,10 @@ impl Drop for DirLock {
 /// `target` resolved, its parent directory (created) and its file name.
 fn place(target: &Path) -> Result<(PathBuf, PathBuf, String), OutputError> {
     let target = resolve(target)?;
+    // `Path::new("out").parent()` is `Some("")`: a bare name lives in the working directory.
     let parent = target
         .parent()
+        .filter(|p| !p.as_os_str().is_empty())
         .map(Path::to_path_buf)
         .unwrap_or_else(|| PathBuf::from("."));
     let name = target

@@ -98,6 +98,56 @@ pub struct Summary {
     /// Loss models used outside their fitted range over the output rows, and items not counted
     /// (docs/validation.md).
     pub warnings: Vec<RangeWarning>,
+    /// Engine side of a run with a launch device (absent without one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub launch: Option<LaunchSummary>,
+}
+
+/// Engine side of a run with a launch device (torque converter), from the output rows: each row
+/// holds its segment's inputs until the next row.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct LaunchSummary {
+    /// Highest engine (impeller) speed, rpm.
+    pub engine_speed_max_rpm: f64,
+    /// Time with the lock-up clutch closed, s.
+    pub lockup_time_s: f64,
+    /// Time at standstill in gear (gearbox input at rest, engine idling against the stalled
+    /// converter), s.
+    pub standstill_time_s: f64,
+    /// Converter slip energy at standstill in gear, J.
+    pub converter_standstill_j: f64,
+    /// Converter slip energy while the input turns, J.
+    pub converter_driving_j: f64,
+}
+
+/// The engine-side figures of `rows` over `times` (None when the rows carry no engine side).
+pub fn launch_summary(times: &[f64], rows: &[RowInputs]) -> Option<LaunchSummary> {
+    let mut s = LaunchSummary {
+        engine_speed_max_rpm: 0.0,
+        lockup_time_s: 0.0,
+        standstill_time_s: 0.0,
+        converter_standstill_j: 0.0,
+        converter_driving_j: 0.0,
+    };
+    let mut any = false;
+    for (k, r) in rows.iter().enumerate() {
+        let Some(e) = r.engine else { continue };
+        any = true;
+        s.engine_speed_max_rpm = s.engine_speed_max_rpm.max(e.speed_rpm);
+        let Some(dt) = times.get(k + 1).map(|t1| t1 - times[k]) else {
+            continue;
+        };
+        if e.lockup {
+            s.lockup_time_s += dt;
+        }
+        if r.input_speed_rpm == 0.0 {
+            s.standstill_time_s += dt;
+            s.converter_standstill_j += e.converter_loss_w * dt;
+        } else {
+            s.converter_driving_j += e.converter_loss_w * dt;
+        }
+    }
+    any.then_some(s)
 }
 
 /// Range warnings over the output rows of a run (gear state by name, oil temperature of the row).
@@ -225,6 +275,7 @@ pub fn summary(
         skipped: scene.skipped.clone(),
         frozen_viscosity: scene.frozen_oil_temp.is_some(),
         warnings: run_warnings(scene, traj, rows),
+        launch: launch_summary(&traj.times, rows),
     }
 }
 
@@ -245,6 +296,11 @@ pub fn timeseries_csv(
     let n = scene.nodes();
     let mut s = String::with_capacity(traj.times.len() * 64 * (n + scene.items() + 10));
     s.push_str("time_s,vehicle_speed_kmh,gear,input_speed_rpm,input_torque_nm,output_power_w");
+    // Engine side only for runs with a launch device (docs/outputs.md).
+    let engine = rows.iter().any(|r| r.engine.is_some());
+    if engine {
+        s.push_str(",engine_speed_rpm,engine_torque_nm,lockup");
+    }
     for name in scene.thermal.names.iter().chain(&scene.thermal.boundary_names) {
         let _ = write!(s, ",temp_{name}_c");
     }
@@ -260,17 +316,20 @@ pub fn timeseries_csv(
         // The input supplies the transmitted torque and the losses: T_in = T_out/i + P_loss/ω_in
         // (physics spec §9). The loss items themselves are evaluated at the loss-free torque
         // (docs/physics.md §10, "Mesh loads").
-        let w_in = r.input_speed_rpm * std::f64::consts::PI / 30.0;
-        let t_in = if w_in > 0.0 {
-            r.input_torque_nm + total / w_in
-        } else {
-            r.input_torque_nm
-        };
+        let t_in = input_shaft_torque(scene, r, &traj.losses[k]);
         let _ = write!(
             s,
             "{t},{},{},{},{},{}",
             r.vehicle_speed_kmh, r.gear, r.input_speed_rpm, t_in, r.output_power_w
         );
+        if engine {
+            match r.engine {
+                Some(e) => {
+                    let _ = write!(s, ",{},{},{}", e.speed_rpm, e.torque_nm, u8::from(e.lockup));
+                }
+                None => s.push_str(",,,"),
+            }
+        }
         for v in y.iter().take(n) {
             s.push(',');
             num(&mut s, v - KELVIN_OFFSET);
@@ -294,6 +353,27 @@ pub fn timeseries_csv(
         s.push('\n');
     }
     s
+}
+
+/// Torque at the gearbox input shaft, N·m: T_in = T_out/i + P_loss/ω_in (physics spec §9) with
+/// only the losses supplied through the input shaft — the converter's slip and an engine-driven
+/// pump are paid ahead of it (the engine columns show that side). The loss items themselves are
+/// evaluated at the loss-free torque (docs/physics.md §10, "Mesh loads").
+fn input_shaft_torque(scene: &Scene, r: &RowInputs, losses: &[f64]) -> f64 {
+    let w_in = r.input_speed_rpm * std::f64::consts::PI / 30.0;
+    let shaft_loss: f64 = scene
+        .losses
+        .items
+        .iter()
+        .zip(losses)
+        .filter(|(it, _)| !it.engine_side)
+        .map(|(_, p)| p)
+        .sum();
+    if w_in > 0.0 {
+        r.input_torque_nm + shaft_loss / w_in
+    } else {
+        r.input_torque_nm
+    }
 }
 
 /// The first non-finite number a run would write, named (`time 12.5 s, node oil`), or `Ok`.
@@ -327,14 +407,29 @@ pub fn check_finite(
             }
         }
         if let Some(r) = rows.get(k) {
+            let t_in = traj
+                .losses
+                .get(k)
+                .map_or(r.input_torque_nm, |q| input_shaft_torque(scene, r, q));
             for (what, v) in [
                 ("vehicle speed", r.vehicle_speed_kmh),
                 ("input speed", r.input_speed_rpm),
-                ("input torque", r.input_torque_nm),
+                ("input torque", t_in),
                 ("output power", r.output_power_w),
             ] {
                 if !v.is_finite() {
                     return Err(format!("{what} at t = {t} s is not finite"));
+                }
+            }
+            if let Some(e) = r.engine {
+                for (what, v) in [
+                    ("engine speed", e.speed_rpm),
+                    ("engine torque", e.torque_nm),
+                    ("converter loss", e.converter_loss_w),
+                ] {
+                    if !v.is_finite() {
+                        return Err(format!("{what} at t = {t} s is not finite"));
+                    }
                 }
             }
         }
@@ -368,6 +463,11 @@ impl Summary {
             named.push((format!("temperatures_c.{n}.min"), t.min));
             named.push((format!("temperatures_c.{n}.max"), t.max));
             named.push((format!("temperatures_c.{n}.final"), t.r#final));
+        }
+        if let Some(l) = &self.launch {
+            named.push(("launch.engine_speed_max_rpm".into(), l.engine_speed_max_rpm));
+            named.push(("launch.converter_standstill_j".into(), l.converter_standstill_j));
+            named.push(("launch.converter_driving_j".into(), l.converter_driving_j));
         }
         match named.into_iter().find(|(_, v)| !v.is_finite()) {
             Some((n, v)) => Err(format!("summary value {n} = {v} is not finite")),

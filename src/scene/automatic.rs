@@ -100,6 +100,7 @@ impl AutoLosses {
                 name: cp.name.clone(),
                 gears: Vec::new(),
                 heat: DefaultHeat::Oil,
+                engine_side: false,
             });
         }
         let pump = gb.pump.as_ref().map(|m| {
@@ -119,6 +120,7 @@ impl AutoLosses {
                 name: "pump".into(),
                 gears: Vec::new(),
                 heat: DefaultHeat::Oil,
+                engine_side: gb.launch.is_some() && matches!(m.drive, PumpDrive::Engine),
             });
             e
         });
@@ -128,6 +130,7 @@ impl AutoLosses {
                 name: "converter".into(),
                 gears: Vec::new(),
                 heat: DefaultHeat::Oil,
+                engine_side: true,
             });
             items.len() - 1
         });

@@ -120,6 +120,7 @@ impl ElementLosses {
                 name: b.name.clone(),
                 gears: Vec::new(),
                 heat: default_heat(&b.heat_to, heat_gear),
+                engine_side: false,
             });
         }
         for s in &gb.seals {
@@ -150,6 +151,7 @@ impl ElementLosses {
                 name: s.name.clone(),
                 gears: Vec::new(),
                 heat: default_heat(&s.heat_to, heat_gear),
+                engine_side: false,
             });
         }
         out

@@ -59,6 +59,10 @@ pub struct LossItem {
     pub gears: Vec<(usize, f64)>,
     /// Default heat destination.
     pub heat: DefaultHeat,
+    /// Supplied by the engine ahead of the gearbox input shaft (the converter's slip, a pump
+    /// driven by the engine side of the launch device), not through the input shaft: the input
+    /// torque (T_in = T_out/i + P_loss/ω_in) leaves it out.
+    pub engine_side: bool,
 }
 
 /// A part of the model the scene left out, and why.
@@ -307,6 +311,7 @@ impl LossScene {
                         name: g.name.clone(),
                         gears: vec![(gi, 1.0)],
                         heat: DefaultHeat::Oil,
+                        engine_side: false,
                     });
                 }
             }
@@ -384,6 +389,7 @@ impl LossScene {
                         name: m.name.clone(),
                         gears: vec![(m.gear1, 0.5), (m.gear2, 0.5)],
                         heat: DefaultHeat::Oil,
+                        engine_side: false,
                     });
                 }
             }
@@ -465,6 +471,7 @@ impl LossScene {
                     name: m.name.clone(),
                     gears: vec![(m.gear1, f1), (m.gear2, 1.0 - f1)],
                     heat: DefaultHeat::Gears,
+                    engine_side: false,
                 });
             }
         }

@@ -16,7 +16,7 @@ use crate::physics::oil::OilProperties;
 use super::losses::{
     LossScene, Needs, OperatingPoint, PerSource, SampleTerms, SceneError, Skipped, N_SOURCES,
 };
-use super::thermal::{NetworkWork, Operating, ThermalScene};
+use super::thermal::{End, NetworkWork, Operating, ThermalScene};
 
 /// Inputs that hold during one cycle interval.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -384,47 +384,114 @@ impl Scene {
         if self.frozen_oil_temp.is_some() || v[oil_i] == 0.0 {
             return;
         }
-        // ∂f/∂T_oil through the oil properties, by a forward difference, cached per (T_oil, sample).
-        let key = (t_oil.to_bits(), work.sample_id);
-        if work.col_key != Some(key) {
-            work.jac_evals += 1;
-            let h = 1e-4 * (1.0 + t_oil.abs() / 300.0);
-            let inputs = work.inputs;
-            let b0 = self.heat_balance(
-                y,
-                t_oil,
-                &inputs,
-                &work.terms,
-                &work.net,
-                &mut work.q2,
-                &mut work.heat2,
-            );
-            work.oil_col[..n].copy_from_slice(&work.heat2);
-            work.q_base.copy_from_slice(&work.q2);
-            // Only the oil properties move (t_oil + h); the node temperatures stay those of y, whose
-            // effect is the analytic part above.
-            let b1 = self.heat_balance(
-                y,
-                t_oil + h,
-                &inputs,
-                &work.terms,
-                &work.net,
-                &mut work.q2,
-                &mut work.heat2,
-            );
-            for i in 0..n {
-                work.oil_col[i] = (work.heat2[i] - work.oil_col[i]) / h / self.thermal.capacity[i];
-            }
-            work.oil_col[n..n + e].iter_mut().for_each(|x| *x = 0.0);
-            for ((q1, q0), &slot) in work.q2.iter().zip(&work.q_base).zip(&self.energy_slot) {
-                work.oil_col[n + slot] += (q1 - q0) / h;
-            }
-            work.oil_col[n + e] = (b1 - b0) / h;
-            work.col_key = Some(key);
-        }
+        self.update_oil_column(y, t_oil, work);
         let s = v[oil_i];
         for (o, c) in out.iter_mut().zip(&work.oil_col) {
             *o += c * s;
+        }
+    }
+
+    /// ∂f/∂T_oil through the oil properties (all rows of the state), by a forward difference,
+    /// cached per (T_oil, sample) in `work.oil_col`.
+    fn update_oil_column(&self, y: &[f64], t_oil: f64, work: &mut Work) {
+        let n = self.nodes();
+        let e = self.energies;
+        let key = (t_oil.to_bits(), work.sample_id);
+        if work.col_key == Some(key) {
+            return;
+        }
+        work.jac_evals += 1;
+        let h = 1e-4 * (1.0 + t_oil.abs() / 300.0);
+        let inputs = work.inputs;
+        let b0 = self.heat_balance(
+            y,
+            t_oil,
+            &inputs,
+            &work.terms,
+            &work.net,
+            &mut work.q2,
+            &mut work.heat2,
+        );
+        work.oil_col[..n].copy_from_slice(&work.heat2);
+        work.q_base.copy_from_slice(&work.q2);
+        // Only the oil properties move (t_oil + h); the node temperatures stay those of y, whose
+        // effect is the analytic part.
+        let b1 = self.heat_balance(
+            y,
+            t_oil + h,
+            &inputs,
+            &work.terms,
+            &work.net,
+            &mut work.q2,
+            &mut work.heat2,
+        );
+        for i in 0..n {
+            work.oil_col[i] = (work.heat2[i] - work.oil_col[i]) / h / self.thermal.capacity[i];
+        }
+        work.oil_col[n..n + e].iter_mut().for_each(|x| *x = 0.0);
+        for ((q1, q0), &slot) in work.q2.iter().zip(&work.q_base).zip(&self.energy_slot) {
+            work.oil_col[n + slot] += (q1 - q0) / h;
+        }
+        work.oil_col[n + e] = (b1 - b0) / h;
+        work.col_key = Some(key);
+    }
+
+    /// State row of a network end: its node, or the boundary-heat quadrature.
+    fn row_of(&self, e: End) -> usize {
+        match e {
+            End::Node(i) => i,
+            End::Boundary(_) => self.boundary_energy_index(),
+        }
+    }
+
+    /// The (row, column) of every Jacobian entry [`Self::jacobian_values`] writes, in its order
+    /// (entries may repeat: they add up). The network's analytic terms, then the whole oil column
+    /// (the losses and the oil-dependent links through ν(T_oil)). Built once per solve; its length
+    /// is O(links + states), so a sparse solver can use it as the pattern.
+    pub fn jacobian_pattern(&self) -> Vec<(usize, usize)> {
+        let n = self.nodes();
+        let work = self.work(Inputs {
+            state: 0,
+            input_speed: 0.0,
+            input_torque: 0.0,
+            vehicle_speed: 0.0,
+        });
+        let y = self.initial_state(None);
+        let oil = self.thermal.oil_properties(self.oil_temp(&y));
+        let op = Self::operating(&work.inputs);
+        let mut out = Vec::new();
+        self.thermal
+            .network_heat_partials(&y[..n], &oil, &op, &work.net, &mut |r, c, _| {
+                out.push((self.row_of(r), c))
+            });
+        out.extend((0..self.n_states()).map(|r| (r, self.thermal.oil)));
+        out
+    }
+
+    /// Values of the Jacobian entries of [`Self::jacobian_pattern`], in its order, at (t, y):
+    /// ∂(dy_row)/∂y_col. Allocation-free; `vals` has the pattern's length.
+    pub fn jacobian_values(&self, t: f64, y: &[f64], work: &mut Work, vals: &mut [f64]) {
+        let n = self.nodes();
+        self.thermal.boundary_temperatures(t, &mut work.net);
+        let t_oil = self.oil_temp(y);
+        let oil = self.thermal.oil_properties(t_oil);
+        let op = Self::operating(&work.inputs);
+        let mut k = 0;
+        let cap = &self.thermal.capacity;
+        self.thermal
+            .network_heat_partials(&y[..n], &oil, &op, &work.net, &mut |r, _, d| {
+                vals[k] = match r {
+                    End::Node(i) => d / cap[i],
+                    End::Boundary(_) => d,
+                };
+                k += 1;
+            });
+        let col = &mut vals[k..];
+        if self.frozen_oil_temp.is_some() {
+            col.iter_mut().for_each(|x| *x = 0.0);
+        } else {
+            self.update_oil_column(y, t_oil, work);
+            col.copy_from_slice(&work.oil_col);
         }
     }
 

@@ -277,14 +277,18 @@ impl ThermalScene {
                         DefaultHeat::Member(gears) => gears.iter().map(|&(g, f)| (body(g), f)).collect(),
                         DefaultHeat::Nodes(nodes) => nodes
                             .iter()
-                            .map(|(name, f)| {
-                                (
-                                    net.nodes
-                                        .iter()
-                                        .position(|x| &x.name == name)
-                                        .unwrap_or(net.oil_node),
-                                    *f,
-                                )
+                            .flat_map(|(name, f)| {
+                                // A meshed wall's name stands for its patches.
+                                match net.groups.iter().find(|g| &g.0 == name) {
+                                    Some(g) => g.1.iter().map(|&(i, s)| (i, f * s)).collect(),
+                                    None => vec![(
+                                        net.nodes
+                                            .iter()
+                                            .position(|x| &x.name == name)
+                                            .unwrap_or(net.oil_node),
+                                        *f,
+                                    )],
+                                }
                             })
                             .collect(),
                     },
@@ -458,6 +462,56 @@ impl ThermalScene {
     /// True when some network term depends on the oil properties (rotating parts in oil).
     pub fn has_oil_links(&self) -> bool {
         !self.oil_links.is_empty()
+    }
+
+    /// Partial derivatives of [`Self::network_heat`] (the analytic Jacobian of the network, oil
+    /// properties held fixed as in [`Self::network_heat_jvp`]): calls `add(row, col, ∂q_row/∂T_col)`
+    /// in W/K for every term, where `row` is the node receiving the heat or a boundary (the heat
+    /// into boundaries). The sequence of `(row, col)` does not depend on the state, so a caller
+    /// can record the pattern once and then fill values in the same order.
+    pub fn network_heat_partials(
+        &self,
+        temps: &[f64],
+        oil: &OilProperties,
+        op: &Operating,
+        work: &NetworkWork,
+        add: &mut impl FnMut(End, usize, f64),
+    ) {
+        let bt = &work.boundary_t;
+        // q flows a → b with ∂q/∂T_a = da and ∂q/∂T_b = db.
+        let mut pair = |a: End, b: End, da: f64, db: f64| {
+            for (e, d) in [(a, da), (b, db)] {
+                if let End::Node(col) = e {
+                    add(a, col, -d);
+                    add(b, col, d);
+                }
+            }
+        };
+        for c in &self.fixed {
+            pair(c.a, c.b, c.g, -c.g);
+        }
+        for (l, g) in self.sample.iter().zip(&work.sample_g) {
+            pair(l.a, l.b, *g, -g);
+        }
+        for l in &self.oil_links {
+            let g = self.oil_link_conductance(l, oil, op);
+            pair(l.a, l.b, g, -g);
+        }
+        for r in &self.radiation {
+            let (ta, tb) = (Self::temp(r.a, temps, bt), Self::temp(r.b, temps, bt));
+            pair(
+                r.a,
+                r.b,
+                radiation_derivative(r.k, ta),
+                -radiation_derivative(r.k, tb),
+            );
+        }
+        for c in &self.coolers {
+            let th = temps[c.hot];
+            let tc = Self::temp(c.cold, temps, bt);
+            let (x, dx) = c.opening(th, tc);
+            pair(End::Node(c.hot), c.cold, c.g * (x + dx * (th - tc)), -c.g * x);
+        }
     }
 
     /// Directional derivative of [`Self::network_heat`] along `v` (K), holding the oil properties

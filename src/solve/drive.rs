@@ -52,6 +52,22 @@ pub struct RowInputs {
     pub input_torque_nm: f64,
     /// Output power, W.
     pub output_power_w: f64,
+    /// With a launch device: engine-side (converter impeller) speed, rpm, torque into the
+    /// launch device, N·m, and the lock-up clutch state (`None` without one).
+    pub engine: Option<EngineRow>,
+}
+
+/// Engine side of a row of a run with a launch device (`cycle::Interval`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EngineRow {
+    /// Impeller (engine) speed, rpm.
+    pub speed_rpm: f64,
+    /// Impeller torque for the loss-free turbine demand, N·m.
+    pub torque_nm: f64,
+    /// The lock-up clutch is closed.
+    pub lockup: bool,
+    /// Converter slip loss, W.
+    pub converter_loss_w: f64,
 }
 
 /// Row inputs of a trajectory's output rows (each row shows the inputs of its segment).
@@ -66,6 +82,12 @@ pub fn row_inputs(gb: &Gearbox, sched: &Schedule, traj: &Trajectory) -> Vec<RowI
                 input_speed_rpm: iv.input_speed * 30.0 / std::f64::consts::PI,
                 input_torque_nm: iv.input_torque,
                 output_power_w: iv.output_power,
+                engine: gb.launch.as_ref().map(|_| EngineRow {
+                    speed_rpm: iv.engine_speed * 30.0 / std::f64::consts::PI,
+                    torque_nm: iv.engine_torque,
+                    lockup: iv.lockup,
+                    converter_loss_w: iv.converter_loss,
+                }),
             }
         })
         .collect()

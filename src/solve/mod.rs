@@ -1,6 +1,8 @@
 //! Solvers: the transient driver (diffsol) and the steady-state equilibrium search.
 pub mod drive;
+pub mod equations;
 pub mod equilibrium;
+pub mod sparse_lu;
 pub mod steady;
 pub mod sweep;
 pub mod transient;

@@ -2,7 +2,7 @@
 //! intervals) with a diffsol solver.
 //!
 //! How the pitfalls of docs/numerics.md are handled (each has a test in `tests/transient.rs`):
-//! 1. `max_nonlinear_solver_failures` counts over the solver's life: raised to `usize::MAX / 2`;
+//! 1. `max_nonlinear_solver_failures` counts over the solver's life: raised to the step budget;
 //!    runaway runs are stopped by our own step budget instead.
 //! 2. `TstopReached` may leave `t` one ulp short of the stop time: the segment index is kept here,
 //!    never derived from `t`; the time is reset to the exact segment start at a restart.
@@ -17,14 +17,40 @@ use std::cell::RefCell;
 use std::time::Instant;
 
 use diffsol::{
-    NalgebraLU, NalgebraMat, NalgebraVec, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason,
-    Vector, VectorCommon,
+    FaerSparseMat, NalgebraLU, NalgebraMat, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason,
 };
 
+use super::equations::{HostVector, SceneEquations};
+use super::sparse_lu::NetworkSparseLu;
 use crate::scene::{Inputs, Scene, Work};
 
-type M = NalgebraMat<f64>;
-type LS = NalgebraLU<f64>;
+/// Linear algebra of the implicit methods' Newton iterations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LinearAlgebra {
+    /// Dense below [`SPARSE_FROM_STATES`] states, sparse from there on.
+    Auto,
+    /// Dense matrices and LU (nalgebra).
+    Dense,
+    /// Compressed-column matrices and faer's sparse LU (fill-reducing ordering, symbolic
+    /// factorisation once per solve).
+    Sparse,
+}
+
+/// State count from which [`LinearAlgebra::Auto`] uses the sparse LU (the measured crossover,
+/// docs/performance.md "Sparse networks and the integration floor").
+pub const SPARSE_FROM_STATES: usize = 50;
+
+impl LinearAlgebra {
+    /// True when a solve of `states` states uses the sparse LU.
+    pub fn is_sparse(self, states: usize) -> bool {
+        match self {
+            LinearAlgebra::Auto => states >= SPARSE_FROM_STATES,
+            LinearAlgebra::Dense => false,
+            LinearAlgebra::Sparse => true,
+        }
+    }
+}
 
 /// Integration method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -110,6 +136,11 @@ pub struct TransientOptions {
     /// Evaluate and keep the loss of every item at every output time (`Trajectory::losses`, for
     /// timeseries.csv and the plots); off when those outputs are not asked for.
     pub record_losses: bool,
+    /// Dense or sparse linear algebra (default: by size).
+    pub linear_algebra: LinearAlgebra,
+    /// Assemble the Jacobian entry by entry (default). Off: one Jacobian–vector product per
+    /// column, as before issue 15 (dense only; for measuring the difference).
+    pub assembled_jacobian: bool,
 }
 
 /// Pitfall guards of the driver.
@@ -151,6 +182,8 @@ impl Default for TransientOptions {
             initial_temp: None,
             guards: Guards::default(),
             record_losses: true,
+            linear_algebra: LinearAlgebra::Auto,
+            assembled_jacobian: true,
         }
     }
 }
@@ -176,6 +209,8 @@ pub struct Stats {
     pub restarts: usize,
     /// Cycle samples whose loss terms were prepared (once per distinct input sample).
     pub samples_prepared: usize,
+    /// True when the Newton iterations used the sparse LU.
+    pub sparse: bool,
 }
 
 /// The result: the state at every segment boundary, and the losses there.
@@ -241,31 +276,6 @@ pub fn integrate(
         item: None,
         message: format!("could not set up the solver: {e}"),
     };
-    let y0c = y0.clone();
-    let mut problem = OdeBuilder::<M>::new()
-        .t0(first.t0)
-        .rtol(opts.rtol)
-        .atol(atol.clone())
-        .use_coloring(false)
-        .rhs_implicit(
-            |x: &[f64], _p: &[f64], t: f64, y: &mut [f64]| {
-                scene.rhs(t, x, &mut work.borrow_mut(), y);
-            },
-            |x: &[f64], _p: &[f64], t: f64, v: &[f64], y: &mut [f64]| {
-                scene.jvp(t, x, v, &mut work.borrow_mut(), y);
-            },
-        )
-        .init(
-            move |_p: &[f64], _t: f64, y: &mut [f64]| {
-                y.copy_from_slice(&y0c);
-            },
-            ns,
-        )
-        .build()
-        .map_err(fail_build)?;
-    if opts.guards.raise_failure_limit {
-        problem.ode_options.max_nonlinear_solver_failures = usize::MAX / 2;
-    }
     let ctx = Driver {
         scene,
         work: &work,
@@ -281,24 +291,49 @@ pub fn integrate(
         stats: Stats::default(),
         wall_time_s: 0.0,
     };
-    match opts.method {
-        Method::Bdf => {
-            let mut s = problem.bdf::<LS>().map_err(fail_build)?;
-            ctx.run(&mut s, &mut traj, progress)?;
-        }
-        Method::Esdirk34 => {
-            let mut s = problem.esdirk34::<LS>().map_err(fail_build)?;
-            ctx.run(&mut s, &mut traj, progress)?;
-        }
-        Method::TrBdf2 => {
-            let mut s = problem.tr_bdf2::<LS>().map_err(fail_build)?;
-            ctx.run(&mut s, &mut traj, progress)?;
-        }
-        Method::Tsit45 => {
-            let mut s = problem.tsit45().map_err(fail_build)?;
-            ctx.run(&mut s, &mut traj, progress)?;
-        }
+    // One body for both matrix types (the solvers' trait bounds are easiest met by concrete types).
+    macro_rules! solve_with {
+        ($m:ty, $ls:ty) => {{
+            let mut eqn = SceneEquations::<$m>::new(scene, &work, y0.clone());
+            eqn.assembled = opts.assembled_jacobian;
+            let mut problem = OdeBuilder::<$m>::new()
+                .t0(first.t0)
+                .rtol(opts.rtol)
+                .atol(atol.clone())
+                .build_from_eqn(eqn)
+                .map_err(fail_build)?;
+            if opts.guards.raise_failure_limit {
+                // Bounded by the run's own budget (which counts these failures too), so that
+                // no single step can retry beyond it (a NaN step size never gets "too small").
+                problem.ode_options.max_nonlinear_solver_failures = opts.max_steps;
+            }
+            match opts.method {
+                Method::Bdf => {
+                    let mut s = problem.bdf::<$ls>().map_err(fail_build)?;
+                    ctx.run(&mut s, &mut traj, progress)?;
+                }
+                Method::Esdirk34 => {
+                    let mut s = problem.esdirk34::<$ls>().map_err(fail_build)?;
+                    ctx.run(&mut s, &mut traj, progress)?;
+                }
+                Method::TrBdf2 => {
+                    let mut s = problem.tr_bdf2::<$ls>().map_err(fail_build)?;
+                    ctx.run(&mut s, &mut traj, progress)?;
+                }
+                Method::Tsit45 => {
+                    let mut s = problem.tsit45().map_err(fail_build)?;
+                    ctx.run(&mut s, &mut traj, progress)?;
+                }
+            }
+        }};
     }
+    let sparse = opts.method.is_implicit() && opts.linear_algebra.is_sparse(ns);
+    if sparse {
+        solve_with!(FaerSparseMat<f64>, NetworkSparseLu);
+    } else {
+        solve_with!(NalgebraMat<f64>, NalgebraLU<f64>);
+    }
+    traj.stats.sparse = sparse;
     let w = work.borrow();
     traj.stats.rhs_evals = w.rhs_evals;
     traj.stats.jac_evals = w.jac_evals;
@@ -393,14 +428,14 @@ impl Driver<'_> {
         progress: &mut dyn FnMut(usize, usize),
     ) -> Result<(), NumericalFailure>
     where
-        Eqn: OdeEquations<T = f64, V = NalgebraVec<f64>> + 'a,
+        Eqn: OdeEquations<T = f64, V: HostVector> + 'a,
         S: OdeSolverMethod<'a, Eqn>,
     {
         let segs = self.segments;
         let total = segs.len();
         {
             let st = solver.state();
-            self.record(traj, segs[0].t0, st.y.inner().as_slice(), 0);
+            self.record(traj, segs[0].t0, st.y.host(), 0);
         }
         let mut restarts = 0;
         for (k, seg) in segs.iter().enumerate() {
@@ -418,31 +453,18 @@ impl Driver<'_> {
                     let st = solver.state_mut();
                     *st.t = seg.t0;
                     if g.refresh_derivative {
-                        self.scene.rhs(
-                            seg.t0,
-                            st.y.inner().as_slice(),
-                            &mut self.work.borrow_mut(),
-                            st.dy.inner_mut().as_mut_slice(),
-                        );
+                        self.scene
+                            .rhs(seg.t0, st.y.host(), &mut self.work.borrow_mut(), st.dy.host_mut());
                     }
                     if g.reset_step {
-                        let h = self.restart_step(
-                            st.y.inner().as_slice(),
-                            st.dy.inner().as_slice(),
-                            *st.h,
-                            seg.t1 - seg.t0,
-                        );
+                        let h = self.restart_step(st.y.host(), st.dy.host(), *st.h, seg.t1 - seg.t0);
                         *st.h = h;
                     }
                 }
             }
             solver.set_stop_time(seg.t1).map_err(|e| {
                 let st = solver.state();
-                self.failure(
-                    st.t.min(seg.t1),
-                    st.y.inner().as_slice(),
-                    format!("stop time rejected: {e}"),
-                )
+                self.failure(st.t.min(seg.t1), st.y.host(), format!("stop time rejected: {e}"))
             })?;
             loop {
                 // Attempts, not only accepted steps: a solver that keeps rejecting must also
@@ -455,7 +477,7 @@ impl Driver<'_> {
                     let st = solver.state();
                     return Err(self.failure(
                         st.t,
-                        st.y.inner().as_slice(),
+                        st.y.host(),
                         format!(
                             "step budget of {} exceeded (the network is too stiff for {} at this tolerance, or oscillates)",
                             self.opts.max_steps,
@@ -463,22 +485,39 @@ impl Driver<'_> {
                         ),
                     ));
                 }
-                match solver.step() {
+                // A derivative that is not finite at the start of a step gives a NaN step size
+                // (diffsol's initial-step estimate, or our restart's), and a NaN step never
+                // becomes "too small": the step would retry for ever. Fail now, naming the item.
+                let h = solver.state().h;
+                if !(h.is_finite() && h != 0.0) {
+                    let st = solver.state();
+                    let (t, y) = (st.t, st.y.host().to_vec());
+                    // Diagnose at the current state, not at the last (possibly NaN) trial.
+                    let mut dy = vec![0.0; y.len()];
+                    let mut w = self.work.borrow_mut();
+                    w.failure = None;
+                    self.scene.rhs(t, &y, &mut w, &mut dy);
+                    drop(w);
+                    let why = format!("step size {h}: the right-hand side is not finite");
+                    return Err(self.failure(t, &y, why));
+                }
+                let stepped = solver.step();
+                if stepped.is_ok() {
+                    // A non-finite trial the solver recovered from is not this run's failure.
+                    self.work.borrow_mut().failure = None;
+                }
+                match stepped {
                     Ok(OdeSolverStopReason::TstopReached) => break,
                     Ok(OdeSolverStopReason::InternalTimestep) => {}
                     Ok(OdeSolverStopReason::RootFound(..)) => {}
                     Err(e) => {
                         let st = solver.state();
-                        return Err(self.failure(
-                            st.t,
-                            st.y.inner().as_slice(),
-                            format!("solver error: {e}"),
-                        ));
+                        return Err(self.failure(st.t, st.y.host(), format!("solver error: {e}")));
                     }
                 }
             }
             let st = solver.state();
-            let y = st.y.inner().as_slice();
+            let y = st.y.host();
             if let Some(i) = y.iter().position(|v| !v.is_finite()) {
                 return Err(self.failure(seg.t1, y, format!("state component {i} is not finite")));
             }

@@ -14,8 +14,44 @@ use crate::physics::losses::seals::{LipSeal, SealLaw};
 
 /// μ_bl of the SKF sliding term (both peers of docs/physics.md §Bearings).
 const MU_BL: f64 = 0.12;
-/// μ_EHL for mineral oils (the SKF online calculator's value, as the MATLAB peer notes).
+/// μ_EHL for mineral oils (the SKF online calculator's value, as the MATLAB peer notes; the SKF
+/// catalogue text gives 0.05 for mineral oils, "other bearings").
 const MU_EHL: f64 = 0.05;
+/// μ_EHL of cylindrical roller bearings (SKF catalogue friction chapter, as shown at
+/// yumpu.com/en/document/view/55668573/skf-rolling-bearings/105; the same in peer [P5]).
+const MU_EHL_CYLINDRICAL: f64 = 0.02;
+/// μ_EHL of tapered roller bearings (same source).
+const MU_EHL_TAPERED: f64 = 0.002;
+/// V_M of the roller drag term against H/d_m: SKF's diagram as digitised by peer [P5]
+/// (`drag.py`, "graph digitization" — numbers read from a figure), linear in between, constant
+/// beyond 1.2.
+const DRAG_VM_ROLLER: [(f64, f64); 14] = [
+    (0.0, 0.0),
+    (0.025, 5e-6),
+    (0.05, 3.0e-5),
+    (0.075, 6.0e-5),
+    (0.10, 1.0e-4),
+    (0.125, 1.5e-4),
+    (0.15, 2.1e-4),
+    (0.175, 2.6e-4),
+    (0.20, 3.0e-4),
+    (0.30, 4.8e-4),
+    (0.50, 6.8e-4),
+    (0.80, 1.0e-3),
+    (1.00, 1.25e-3),
+    (1.20, 1.5e-3),
+];
+
+/// V_M of a roller bearing at oil height `h_over_dm` (H/d_m).
+fn drag_vm_roller(h_over_dm: f64) -> f64 {
+    let x = h_over_dm.clamp(0.0, 1.2);
+    DRAG_VM_ROLLER
+        .windows(2)
+        .find(|w| x <= w[1].0)
+        .map_or(DRAG_VM_ROLLER[13].1, |w| {
+            w[0].1 + (w[1].1 - w[0].1) * (x - w[0].0) / (w[1].0 - w[0].0)
+        })
+}
 /// V_M of the SKF drag term, read from the SKF diagram at full immersion by the Python
 /// deep-groove peer (a number read from a figure), used for any immersion depth.
 const DRAG_VM: f64 = 0.0012;
@@ -236,8 +272,8 @@ pub(super) fn validate_bearings(
                         format!("{p}.model"),
                         "skf",
                         format!(
-                            "{} ({:?}): no SKF geometry constants for this type in the catalogue (the SKF rows of \
-                             four-point, cylindrical, tapered and needle roller bearings were not found in a source); use model = \"palmgren\"",
+                            "{} ({:?}): no SKF geometry constants for this bearing in the catalogue (needle roller \
+                             bearings have no SKF row in any source found; other types need a `series` row); use model = \"palmgren\"",
                             entry.designation, entry.kind
                         ),
                     );
@@ -256,28 +292,47 @@ pub(super) fn validate_bearings(
                 } else {
                     None
                 };
+                let kind = match entry.kind {
+                    BearingType::AngularContactBall => SkfKind::AngularContactBall,
+                    BearingType::FourPointContactBall => SkfKind::FourPointContactBall,
+                    BearingType::CylindricalRoller => SkfKind::CylindricalRoller,
+                    BearingType::TaperedRoller => SkfKind::TaperedRoller,
+                    _ => SkfKind::DeepGrooveBall,
+                };
+                let (mu_ehl, drag_vm) = match entry.kind {
+                    BearingType::CylindricalRoller | BearingType::TaperedRoller => (
+                        if entry.kind == BearingType::TaperedRoller {
+                            MU_EHL_TAPERED
+                        } else {
+                            MU_EHL_CYLINDRICAL
+                        },
+                        drag_vm_roller(oil_above / size.mean()),
+                    ),
+                    _ => (MU_EHL, DRAG_VM),
+                };
                 let input = SkfInput {
-                    kind: match entry.kind {
-                        BearingType::AngularContactBall => SkfKind::AngularContactBall,
-                        _ => SkfKind::DeepGrooveBall,
-                    },
+                    kind,
                     constants: SkfConstants {
                         r1: row.r1,
                         r2: row.r2,
                         r3: row.r3,
                         s1: row.s1,
                         s2: row.s2,
+                        s3: row.s3,
                         k_z: row.k_z,
+                        k_l: row.k_l,
                     },
                     size,
                     c0: entry.c0_kn * 1e3,
                     lubrication,
                     mu_bl: MU_BL,
-                    mu_ehl: MU_EHL,
+                    mu_ehl,
                     seal,
                     oil_level: oil_above,
-                    drag_vm: DRAG_VM,
+                    drag_vm,
                     rows: entry.rows.unwrap_or(1.0),
+                    width: entry.b_mm * MM,
+                    axial_factor_y: entry.y.unwrap_or(0.0),
                 };
                 match Skf::new(&input) {
                     Ok(m) => BearingFriction::Skf(m),
@@ -403,4 +458,20 @@ fn validate_seals(ctx: &Ctx<'_>, nodes: &BTreeSet<&str>, problems: &mut Problems
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::drag_vm_roller;
+
+    /// The roller V_M curve as the peer P5 interpolates it (its printed values,
+    /// docs/validation.md §Bearings).
+    #[test]
+    fn roller_vm_interpolates_like_the_p5_peer() {
+        for (x, want) in [(0.75, 9.466667e-4), (1.2, 1.5e-3), (10.0 / 46.0, 3.313043e-4)] {
+            assert!((drag_vm_roller(x) / want - 1.0).abs() < 1e-6, "{x}");
+        }
+        assert_eq!(drag_vm_roller(-1.0), 0.0);
+        assert_eq!(drag_vm_roller(5.0), 1.5e-3);
+    }
 }

@@ -208,7 +208,12 @@ pub fn render_validation(
         rows.iter().filter(|r| r.quantity == q).collect()
     };
     let (sl, ch) = (pick("sliding"), pick("churning"));
-    let (sl, ch) = (&sl, &ch);
+    let el: Vec<&crate::solve::validation::Row> = rows
+        .iter()
+        .filter(|r| !matches!(r.quantity, "sliding" | "churning" | "efficiency"))
+        .collect();
+    let eff = pick("efficiency");
+    let (sl, ch, el, eff) = (&sl, &ch, &el, &eff);
     let mut jobs: Vec<Box<dyn FnOnce() -> Result<Staged, PlotError> + Send + '_>> = vec![
         Box::new(move || {
             stage_png(dir, "parity_sliding.png", |r| {
@@ -228,6 +233,24 @@ pub fn render_validation(
         Box::new(move || {
             stage_png(dir, "error_vs_speed_churning.png", |r| {
                 validation::draw_error_vs_speed(r, ch, "Churning loss: relative error vs input speed")
+            })
+        }),
+        Box::new(move || {
+            stage_png(dir, "parity_elements.png", |r| {
+                validation::draw_parity(
+                    r,
+                    el,
+                    "Bearings, seals and the automatic's losses: geartherm vs references",
+                )
+            })
+        }),
+        Box::new(move || {
+            stage_png(dir, "range_distance_efficiency.png", |r| {
+                validation::draw_range_distance(
+                    r,
+                    eff,
+                    "Efficiency: distance to the handbook ranges vs input speed",
+                )
             })
         }),
     ];

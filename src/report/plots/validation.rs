@@ -1,12 +1,12 @@
 //! Validation plots: parity (predicted vs reference, ±10/±20 % bands, log axes) per quantity and
-//! relative error vs input speed. Trend rows (not in watts) are left out of both.
+//! relative error vs input speed. Range rows (trend and handbook checks) are left out of both.
 
 use plotters::prelude::*;
 use plotters::series::DashedLineSeries;
 
 use super::style::{self, LegendEntry, Marker, Swatch};
 use super::{Canvas, DrawResult};
-use crate::solve::validation::{Kind, Row};
+use crate::solve::validation::Row;
 
 /// Model choices in first-seen order (colour index).
 fn models(rows: &[&Row]) -> Vec<String> {
@@ -50,11 +50,11 @@ pub fn draw_parity(root: &Canvas, rows: &[&Row], title: &str) -> DrawResult {
     let root = style::titled(root, title)?;
     let (w, _) = root.dim_in_pixel();
     let (plot, side) = root.split_horizontally(w - 420);
-    let rows: Vec<&Row> = rows.iter().copied().filter(|r| r.kind != Kind::Trend).collect();
+    let rows: Vec<&Row> = rows.iter().copied().filter(|r| !r.kind.is_range()).collect();
     if rows.is_empty() {
         style::draw_note_centre(
             &plot,
-            "no reference values in watts (trend checks only: see validation.csv)",
+            "no reference values in watts (range checks only: see validation.csv)",
         )?;
         return Ok(());
     }
@@ -122,17 +122,40 @@ pub fn draw_parity(root: &Canvas, rows: &[&Row], title: &str) -> DrawResult {
 
 /// Relative error (%) vs input speed.
 pub fn draw_error_vs_speed(root: &Canvas, rows: &[&Row], title: &str) -> DrawResult {
+    error_vs_speed(root, rows, title, false)
+}
+
+/// Distance (%) to the range of each range check (0 inside; trend and handbook rows) vs input
+/// speed.
+pub fn draw_range_distance(root: &Canvas, rows: &[&Row], title: &str) -> DrawResult {
+    error_vs_speed(root, rows, title, true)
+}
+
+fn error_vs_speed(root: &Canvas, rows: &[&Row], title: &str, ranges: bool) -> DrawResult {
     let root = style::titled(root, title)?;
     let (w, _) = root.dim_in_pixel();
     let (plot, side) = root.split_horizontally(w - 420);
-    let rows: Vec<&Row> = rows.iter().copied().filter(|r| r.kind != Kind::Trend).collect();
+    let rows: Vec<&Row> = rows
+        .iter()
+        .copied()
+        .filter(|r| r.kind.is_range() == ranges)
+        .collect();
     if rows.is_empty() {
         style::draw_note_centre(
             &plot,
-            "no reference values in watts (trend checks only: see validation.csv)",
+            if ranges {
+                "no range checks"
+            } else {
+                "no reference values in watts (range checks only: see validation.csv)"
+            },
         )?;
         return Ok(());
     }
+    let y_desc = if ranges {
+        "distance to the range, % (0 inside)"
+    } else {
+        "(geartherm − reference)/reference, %"
+    };
     let (x0, x1) = style::padded_range(rows.iter().map(|r| r.speed_rpm), 0.05);
     let (y0, y1) = style::padded_range(
         rows.iter().map(|r| 100.0 * r.relative_error).chain([-25.0, 25.0]),
@@ -145,7 +168,7 @@ pub fn draw_error_vs_speed(root: &Canvas, rows: &[&Row], title: &str) -> DrawRes
         .build_cartesian_2d(x0..x1, y0..y1)?;
     ch.configure_mesh()
         .x_desc("input speed, rpm")
-        .y_desc("(geartherm − reference)/reference, %")
+        .y_desc(y_desc)
         .label_style(style::text(22))
         .axis_desc_style(style::text(24))
         .draw()?;

@@ -18,6 +18,9 @@ pub enum Kind {
     Measurement,
     /// A trend a source reports (a range the metric must fall in).
     Trend,
+    /// A handbook's range of values (e.g. typical efficiencies of a kind of gearbox): neither a
+    /// measurement of this gearbox nor a model's output; the value must fall in the range.
+    Handbook,
 }
 
 impl Kind {
@@ -28,83 +31,17 @@ impl Kind {
             Kind::Standard => "standard",
             Kind::Measurement => "measurement",
             Kind::Trend => "trend",
-        }
-    }
-}
-
-/// The loss quantity a case compares.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Quantity {
-    /// Mesh friction.
-    Sliding,
-    /// Churning.
-    Churning,
-}
-
-/// `[losses]` keys of one model choice.
-pub type Choice = (&'static str, Vec<(&'static str, toml::Value)>);
-
-fn s(v: &str) -> toml::Value {
-    toml::Value::String(v.into())
-}
-
-impl Quantity {
-    /// Source of the loss items compared.
-    pub fn source(self) -> Source {
-        match self {
-            Quantity::Sliding => Source::Sliding,
-            Quantity::Churning => Source::Churning,
+            Kind::Handbook => "handbook",
         }
     }
 
-    /// Name.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Quantity::Sliding => "sliding",
-            Quantity::Churning => "churning",
-        }
-    }
-
-    /// Every applicable model choice (label, `[losses]` keys); the other sources are off.
-    pub fn choices(self) -> Vec<Choice> {
-        let off = |k: &'static str| (k, s("off"));
-        match self {
-            Quantity::Sliding => {
-                // Every key explicit, so a label means the same whatever the defaults are.
-                let det = |f: &'static str, ls: &'static str, hd: &'static str| {
-                    vec![
-                        off("churning"),
-                        off("pocketing"),
-                        ("sliding", s("detailed")),
-                        ("friction", s(f)),
-                        ("load_sharing", s(ls)),
-                        ("helical_distribution", s(hd)),
-                    ]
-                };
-                vec![
-                    ("iso_tc60", det("iso_tc60", "uniform", "uniform")),
-                    ("benedict_kelley", det("benedict_kelley", "uniform", "uniform")),
-                    ("schlenk", det("schlenk", "uniform", "uniform")),
-                    ("schlenk 33:67", det("schlenk", "33:67", "uniform")),
-                    ("schlenk ramp", det("schlenk", "ramp", "uniform")),
-                    (
-                        "schlenk niemann_richer",
-                        det("schlenk", "uniform", "niemann_richer"),
-                    ),
-                    (
-                        "iso14179",
-                        vec![off("churning"), off("pocketing"), ("sliding", s("iso14179"))],
-                    ),
-                ]
-            }
-            Quantity::Churning => ["changenet", "seetharaman", "stavytskyi"]
-                .into_iter()
-                .map(|m| (m, vec![off("sliding"), off("pocketing"), ("churning", s(m))]))
-                .collect(),
-        }
+    /// Rows of this kind hold a range check, not a value in watts.
+    pub fn is_range(self) -> bool {
+        matches!(self, Kind::Trend | Kind::Handbook)
     }
 }
+
+pub use super::choices::{Choice, Quantity};
 
 /// A trend metric between two speeds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
@@ -151,6 +88,26 @@ pub struct TrendCheck {
     pub high: f64,
 }
 
+/// One range check at one operating point (a handbook's range of a quantity).
+#[derive(Debug, Clone, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RangePoint {
+    /// Label.
+    pub point: String,
+    /// Gear state.
+    pub gear: String,
+    /// Input speed, rpm.
+    pub speed_rpm: f64,
+    /// Input torque, N·m.
+    pub torque_nm: f64,
+    /// Oil temperature, °C.
+    pub oil_temp_c: f64,
+    /// Range the quantity must lie in.
+    pub low: f64,
+    /// Upper end of the range.
+    pub high: f64,
+}
+
 /// One reference point.
 #[derive(Debug, Clone, serde::Deserialize)]
 pub struct Point {
@@ -181,6 +138,12 @@ struct CaseFile {
     overrides: toml::Table,
     #[serde(default)]
     trend: Vec<TrendCheck>,
+    #[serde(default)]
+    range: Vec<RangePoint>,
+    /// Efficiency: the loss sources counted (default: all).
+    sources: Option<Vec<String>>,
+    /// Only these model choices (labels; default: every applicable one).
+    models: Option<Vec<String>>,
 }
 
 /// A loaded case.
@@ -206,6 +169,12 @@ pub struct Case {
     pub points: Vec<Point>,
     /// Trend checks.
     pub trends: Vec<TrendCheck>,
+    /// Range checks at operating points.
+    pub ranges: Vec<RangePoint>,
+    /// Loss sources an efficiency counts.
+    pub sources: Vec<Source>,
+    /// Model choices the case is evaluated with.
+    pub choices: Vec<Choice>,
 }
 
 impl Case {
@@ -243,9 +212,27 @@ impl Case {
                 points.push(p);
             }
         }
-        if points.is_empty() && f.trend.is_empty() {
-            return Err(bad("no reference points and no trend checks".into()));
+        if points.is_empty() && f.trend.is_empty() && f.range.is_empty() {
+            return Err(bad("no reference points, trend or range checks".into()));
         }
+        if let Some(r) = f
+            .range
+            .iter()
+            .find(|r| !(r.low.is_finite() && r.high.is_finite() && r.low <= r.high))
+        {
+            return Err(bad(format!("range {}: needs finite low <= high", r.point)));
+        }
+        let sources = match &f.sources {
+            None => Source::ALL.to_vec(),
+            Some(v) => v
+                .iter()
+                .map(|n| {
+                    Source::parse(n)
+                        .ok_or_else(|| bad(format!("sources: \"{n}\" (allowed: {})", Source::names())))
+                })
+                .collect::<Result<Vec<_>, _>>()?,
+        };
+        let choices = super::choices::select(f.quantity, f.models.as_deref()).map_err(bad)?;
         Ok(Case {
             name: dir
                 .file_name()
@@ -259,6 +246,9 @@ impl Case {
             overrides: f.overrides.into_iter().collect(),
             points,
             trends: f.trend,
+            ranges: f.range,
+            sources,
+            choices,
         })
     }
 

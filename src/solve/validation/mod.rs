@@ -1,18 +1,20 @@
 //! Reference cases (`validation/<case>/case.toml`) evaluated with every applicable model choice
 //! (issue 14; docs/validation.md).
 //!
-//! A case names a model file, a loss quantity (sliding, churning or pocketing, optionally one
-//! item), the kind of reference (peer, standard, measurement, trend) and its source, and either a
-//! reference CSV (`point,gear,speed_rpm,torque_nm,oil_temp_c,reference_w`; speed and torque at
-//! the model's input) or trend checks (a speed exponent or a power ratio that must lie in a
-//! range). Each model choice is a set of `[losses]` keys written over the model file's own.
+//! A case names a model file, a quantity (any loss source, optionally one item, or the
+//! efficiency over chosen sources), the kind of reference (peer, standard, measurement, trend,
+//! handbook) and its source, and a reference CSV (`point,gear,speed_rpm,torque_nm,oil_temp_c,
+//! reference_w`; speed and torque at the model's input), trend checks (a speed exponent or a
+//! power ratio that must lie in a range) or range checks at operating points (`[[range]]`).
+//! Each model choice is a set of keys written over the model file's own (`choices`).
 
 pub mod case;
+pub mod choices;
 pub mod stats;
 
 use std::path::{Path, PathBuf};
 
-pub use case::{Case, Kind, Quantity, TrendCheck};
+pub use case::{Case, Kind, Quantity, RangePoint, TrendCheck};
 pub use stats::{summarise, SummaryRow};
 
 use crate::model::{self, Gearbox};
@@ -28,7 +30,7 @@ pub struct Row {
     pub point: String,
     /// Model choice label.
     pub model: String,
-    /// Quantity compared (`sliding`, `churning`).
+    /// Quantity compared (a loss source's name, or `efficiency`).
     pub quantity: &'static str,
     /// Input speed, rpm (for the error-vs-speed plot).
     pub speed_rpm: f64,
@@ -85,8 +87,8 @@ pub fn run_all(dir: &Path) -> Result<Vec<Row>, ValidationError> {
 /// Evaluate one case.
 pub fn run_case(c: &Case) -> Result<Vec<Row>, ValidationError> {
     let mut rows = Vec::new();
-    for (label, keys) in c.quantity.choices() {
-        let gb = c.gearbox(&keys).map_err(|msg| ValidationError::Model {
+    for (label, keys) in &c.choices {
+        let gb = c.gearbox(keys).map_err(|msg| ValidationError::Model {
             path: c.model_path.clone(),
             choice: label.to_string(),
             msg,
@@ -117,6 +119,22 @@ pub fn run_case(c: &Case) -> Result<Vec<Row>, ValidationError> {
                 relative_error: (predicted - p.reference_w) / p.reference_w,
             });
         }
+        for r in &c.ranges {
+            let predicted = eval(&r.gear, r.speed_rpm, r.torque_nm, r.oil_temp_c)?;
+            let reference = predicted.clamp(r.low, r.high);
+            rows.push(Row {
+                case: c.name.clone(),
+                point: r.point.clone(),
+                model: label.to_string(),
+                quantity: c.quantity.as_str(),
+                speed_rpm: r.speed_rpm,
+                predicted,
+                reference,
+                kind: c.kind,
+                source: c.source.clone(),
+                relative_error: (predicted - reference) / reference,
+            });
+        }
         for t in &c.trends {
             let pa = eval(&t.gear, t.speed_a_rpm, t.torque_nm, t.oil_temp_c)?;
             let pb = eval(&t.gear, t.speed_b_rpm, t.torque_nm, t.oil_temp_c)?;
@@ -139,7 +157,7 @@ pub fn run_case(c: &Case) -> Result<Vec<Row>, ValidationError> {
     Ok(rows)
 }
 
-/// The case's quantity (W) at one point.
+/// The case's quantity at one point: W, or the efficiency (–).
 fn value(
     gb: &Gearbox,
     scene: &LossScene,
@@ -160,14 +178,29 @@ fn value(
     };
     let mut out = vec![0.0; scene.len()];
     scene.evaluate(&op, &mut out);
-    let want: Source = c.quantity.source();
-    let v: f64 = scene
+    let counts = |src: Source| match c.quantity.source() {
+        Some(want) => src == want,
+        None => c.sources.contains(&src),
+    };
+    let loss: f64 = scene
         .items
         .iter()
         .zip(&out)
-        .filter(|(it, _)| it.source == want && c.item.as_ref().map_or(true, |n| *n == it.name))
+        .filter(|(it, _)| counts(it.source) && c.item.as_ref().map_or(true, |n| *n == it.name))
         .map(|(_, w)| *w)
         .sum();
+    let v = match c.quantity {
+        Quantity::Efficiency => {
+            let p_in = op.input_speed * op.input_torque;
+            if p_in <= 0.0 {
+                return Err(format!(
+                    "efficiency needs input power > 0 ({rpm} rpm, {torque} N·m)"
+                ));
+            }
+            1.0 - loss / p_in
+        }
+        _ => loss,
+    };
     if v.is_finite() {
         Ok(v)
     } else {
@@ -175,17 +208,27 @@ fn value(
     }
 }
 
-/// Load a model file with `[losses]` keys written over its own.
+/// Load a model file with `[losses]` keys written over its own; a key `bearings.<k>` is written
+/// into every `[[bearings]]` entry instead.
 pub fn load_with(path: &Path, keys: &[(&str, toml::Value)]) -> Result<Gearbox, String> {
     let text = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
     let mut doc: toml::Table = text.parse().map_err(|e: toml::de::Error| e.to_string())?;
-    let losses = doc
-        .entry("losses")
-        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-    let Some(t) = losses.as_table_mut() else {
-        return Err("[losses] is not a table".into());
-    };
     for (k, v) in keys {
+        if let Some(bk) = k.strip_prefix("bearings.") {
+            let Some(list) = doc.get_mut("bearings").and_then(|b| b.as_array_mut()) else {
+                return Err(format!("{k}: the model has no [[bearings]]"));
+            };
+            for b in list.iter_mut().filter_map(|b| b.as_table_mut()) {
+                b.insert(bk.to_string(), v.clone());
+            }
+            continue;
+        }
+        let losses = doc
+            .entry("losses")
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        let Some(t) = losses.as_table_mut() else {
+            return Err("[losses] is not a table".into());
+        };
         t.insert((*k).to_string(), v.clone());
     }
     let text = toml::to_string(&doc).map_err(|e| e.to_string())?;

@@ -8,7 +8,8 @@
 //! M_sl = G_sl·μ_sl,  μ_sl = φ_bl·μ_bl + (1 − φ_bl)·μ_EHL               sliding
 //! φ_bl = exp(−2.6e-8·(n·ν)^1.4·d_m)                                   film weighting
 //! M_seal = K_S1·d_s^β + K_S2                                          integral contact seals
-//! M_drag = 0.4·V_M·K_ball·d_m^5·n² + 1.093e-7·n²·d_m³·(n·d_m²·f_t/ν)^−1.379·R_s   oil bath (balls)
+//! M_drag = 0.4·V_M·K_ball·d_m^5·n² + 1.093e-7·n²·d_m³·(n·d_m²·f_t/ν)^−1.379·R_s   oil bath (balls;
+//!          rollers: first term 4·V_M·K_roll·C_w·B·d_m^4·n², below)
 //! ```
 //!
 //! with n in r/min, ν in mm²/s, lengths in mm, loads in N.
@@ -23,13 +24,21 @@
 //!   `G_sl = S1·d_m^−0.26·F_r^(5/3)`; F_a > 0: `α_F = 24.6·(F_a/C_0)^0.24` (deg),
 //!   `G_rr = R1·d_m^1.96·(F_r + R2/sin α_F·F_a)^0.54`,
 //!   `G_sl = S1·d_m^−0.145·(F_r^5 + S2·d_m^1.5/sin α_F·F_a^4)^(1/3)`;
-//! - angular-contact ball bearings: `F_g = R3·d_m^4·n²`,
-//!   `G_rr = R1·d_m^1.97·(F_r + F_g + R2·F_a)^0.54`,
-//!   `G_sl = S1·d_m^0.26·((F_r + F_g)^(4/3) + S2·F_a^(4/3))`.
+//! - angular-contact and four-point-contact ball bearings: `F_g = R3·d_m^4·n²` (rolling),
+//!   `F_g,s = S3·d_m^4·n²` (sliding), `G_rr = R1·d_m^1.97·(F_r + F_g + R2·F_a)^0.54`,
+//!   `G_sl = S1·d_m^0.26·((F_r + F_g,s)^(4/3) + S2·F_a^(4/3))`;
+//! - cylindrical roller bearings: `G_rr = R1·d_m^2.41·F_r^0.31`, `G_sl = S1·d_m^0.9·F_a + S2·d_m·F_r`;
+//! - tapered roller bearings: `G_rr = R1·d_m^2.38·(F_r + R2·Y·F_a)^0.31`,
+//!   `G_sl = S1·d_m^0.82·(F_r + S2·Y·F_a)` (Y: the bearing's axial load factor).
 //!
-//! The rows of the SKF tables for four-point-contact ball, cylindrical, tapered and needle
-//! roller bearings were not found in any accessible source; those bearings use
-//! [`super::Palmgren`] (docs/physics.md says so).
+//! The forms are those of SKF's table "Geometric and load dependent variables for rolling and
+//! sliding frictional moments – radial bearings" (SKF Rolling Bearings catalogue, friction
+//! chapter, as shown at yumpu.com/en/document/view/55668573/skf-rolling-bearings/106), the same
+//! in the peers. Roller bearings in an oil bath: `M_drag = 4·V_M·K_roll·C_w·B·d_m^4·n² + (the
+//! common term)`, `K_roll = K_L·K_z·(d + D)/(D − d)·1e-12`, `l_D = 5·K_L·B/d_m`,
+//! `C_w = 2.789e-10·l_D³ − 2.786e-4·l_D² + 0.0195·l_D + 0.6439` (as read from two open peers,
+//! docs/physics.md §Bearings). Needle roller bearings have no row in any source found: they use
+//! [`super::Palmgren`].
 
 use super::{BearingError, BearingLoad, BearingMoment, BearingOil, BearingSize, LoadTerms};
 
@@ -40,6 +49,19 @@ pub enum SkfKind {
     DeepGrooveBall,
     /// Single-row angular-contact ball bearing (axial form with the ball centrifugal load F_g).
     AngularContactBall,
+    /// Four-point-contact ball bearing (QJ): the angular-contact form with its own row.
+    FourPointContactBall,
+    /// Cylindrical roller bearing (caged or full complement, by the row's constants).
+    CylindricalRoller,
+    /// Single-row tapered roller bearing (needs the bearing's axial load factor Y).
+    TaperedRoller,
+}
+
+impl SkfKind {
+    /// Roller bearing (line contact): roller drag form.
+    pub fn is_roller(self) -> bool {
+        matches!(self, SkfKind::CylindricalRoller | SkfKind::TaperedRoller)
+    }
 }
 
 /// Geometry constants of one bearing series (SKF table, catalogue units).
@@ -49,15 +71,19 @@ pub struct SkfConstants {
     pub r1: f64,
     /// R2.
     pub r2: f64,
-    /// R3 (angular contact: centrifugal term; 0 otherwise).
+    /// R3 (angular and four-point contact: centrifugal term of G_rr; 0 otherwise).
     pub r3: f64,
     /// S1.
     pub s1: f64,
     /// S2.
     pub s2: f64,
+    /// S3 (angular and four-point contact: centrifugal term of G_sl; 0 otherwise).
+    pub s3: f64,
     /// Bearing-type constant K_z of φ_rs and the drag term (3.1 deep groove, 4.4 angular
-    /// contact).
+    /// contact, 5.1 caged cylindrical roller, 6.0 tapered roller, per the catalogue rows).
     pub k_z: f64,
+    /// Roller-bearing drag constant K_L (0 for ball bearings).
+    pub k_l: f64,
 }
 
 /// An SKF bearing model with everything that does not change precomputed.
@@ -118,6 +144,10 @@ pub struct SkfInput {
     pub drag_vm: f64,
     /// Rows of rolling elements i_rw.
     pub rows: f64,
+    /// Width B, m (roller drag term; unused for ball bearings).
+    pub width: f64,
+    /// Axial load factor Y of a tapered roller bearing (catalogue value; unused otherwise).
+    pub axial_factor_y: f64,
 }
 
 impl Skf {
@@ -129,17 +159,28 @@ impl Skf {
                 "bore {d} mm and outside diameter {big_d} mm: need 0 < d < D"
             )));
         }
-        let c = i.constants;
+        let mut c = i.constants;
         for (name, v) in [("R1", c.r1), ("S1", c.s1), ("K_z", c.k_z)] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(BearingError(format!("{name} = {v}: must be > 0")));
             }
         }
+        if i.kind == SkfKind::TaperedRoller {
+            let y = i.axial_factor_y;
+            if !(y.is_finite() && y > 0.0) {
+                return Err(BearingError(format!(
+                    "axial load factor Y = {y}: a tapered roller bearing needs Y > 0"
+                )));
+            }
+            // R2·Y and S2·Y are constants of the bearing: fold Y in once.
+            c.r2 *= y;
+            c.s2 *= y;
+        }
         let dm = 0.5 * (d + big_d);
         let m_seal = i
             .seal
             .map_or(0.0, |(k1, k2, beta, ds)| k1 * (ds * 1e3).powf(beta) + k2);
-        // Drag (ball bearings): SKF with t from the oil level H over d_m (H clamped to 1.2 d_m, where
+        // Drag: SKF with t from the oil level H over d_m (H clamped to 1.2 d_m, where
         // the bearing is fully immersed).
         let h = (i.oil_level * 1e3).clamp(0.0, 1.2 * dm);
         let (drag1, drag2, dm2_ft) = if h > 0.0 {
@@ -151,12 +192,23 @@ impl Skf {
             };
             let f_a = 0.05 * c.k_z * (big_d + d) / (big_d - d);
             let r_s = 0.36 * dm * dm * (t - t.sin()) * f_a;
-            let k_ball = i.rows * c.k_z * (d + big_d) / (big_d - d) * 1e-12;
-            (
-                0.4 * i.drag_vm * k_ball * dm.powi(5),
-                1.093e-7 * dm.powi(3) * r_s,
-                dm * dm * f_t,
-            )
+            let first = if i.kind.is_roller() {
+                let b = i.width * 1e3;
+                if !(b > 0.0 && c.k_l > 0.0) {
+                    return Err(BearingError(format!(
+                        "roller drag needs the width B ({b} mm) and K_L ({}) > 0",
+                        c.k_l
+                    )));
+                }
+                let k_roll = c.k_l * c.k_z * (d + big_d) / (big_d - d) * 1e-12;
+                let l_d = 5.0 * c.k_l * b / dm;
+                let c_w = (2.789e-10 * l_d.powi(3) - 2.786e-4 * l_d * l_d + 0.0195 * l_d + 0.6439).max(0.0);
+                4.0 * i.drag_vm * k_roll * c_w * b * dm.powi(4)
+            } else {
+                let k_ball = i.rows * c.k_z * (d + big_d) / (big_d - d) * 1e-12;
+                0.4 * i.drag_vm * k_ball * dm.powi(5)
+            };
+            (first, 1.093e-7 * dm.powi(3) * r_s, dm * dm * f_t)
         } else {
             (0.0, 0.0, 0.0)
         };
@@ -195,16 +247,27 @@ impl Skf {
                 c.r1 * dm.powf(1.96) * fr.powf(0.54),
                 c.s1 * dm.powf(-0.26) * fr.powf(5.0 / 3.0),
             ),
-            SkfKind::AngularContactBall => {
-                let fg = c.r3 * dm.powi(4) * n * n;
+            SkfKind::AngularContactBall | SkfKind::FourPointContactBall => {
+                let dm4n2 = dm.powi(4) * n * n;
                 (
-                    c.r1 * dm.powf(1.97) * (fr + fg + c.r2 * fa).powf(0.54),
-                    c.s1 * dm.powf(0.26) * ((fr + fg).powf(4.0 / 3.0) + c.s2 * fa.powf(4.0 / 3.0)),
+                    c.r1 * dm.powf(1.97) * (fr + c.r3 * dm4n2 + c.r2 * fa).powf(0.54),
+                    c.s1 * dm.powf(0.26) * ((fr + c.s3 * dm4n2).powf(4.0 / 3.0) + c.s2 * fa.powf(4.0 / 3.0)),
                 )
             }
+            SkfKind::CylindricalRoller => (
+                c.r1 * dm.powf(2.41) * fr.powf(0.31),
+                c.s1 * dm.powf(0.9) * fa + c.s2 * dm * fr,
+            ),
+            // r2 and s2 carry Y (folded in by `new`).
+            SkfKind::TaperedRoller => (
+                c.r1 * dm.powf(2.38) * (fr + c.r2 * fa).powf(0.31),
+                c.s1 * dm.powf(0.82) * (fr + c.s2 * fa),
+            ),
         };
         let drag = if self.drag2 > 0.0 && n > 0.0 {
-            n * n * (n * self.dm2_ft).powf(-1.379)
+            // n²·(n·f_t dm²)^-1.379 written as one power of n: at vanishing speed n² underflows
+            // to 0 while (n·f_t dm²)^-1.379 overflows, and 0·∞ is NaN.
+            n.powf(2.0 - 1.379) * self.dm2_ft.powf(-1.379)
         } else {
             0.0
         };

@@ -22,6 +22,8 @@ fn input(kind: SkfKind, c: SkfConstants, d: f64, big_d: f64, c0: f64, mu: (f64, 
         oil_level: 0.0,
         drag_vm: 0.0012,
         rows: 1.0,
+        width: 0.0,
+        axial_factor_y: 0.0,
     }
 }
 
@@ -32,7 +34,9 @@ fn dgbb(r1: f64, s1: f64, s2: f64) -> SkfConstants {
         r3: 0.0,
         s1,
         s2,
+        s3: 0.0,
         k_z: 3.1,
+        k_l: 0.0,
     }
 }
 
@@ -105,7 +109,9 @@ fn angular_contact_and_sealed_deep_groove_match_the_emotres_peer() {
         r3: 2.44e-12,
         s1: 1.0e-2,
         s2: 0.8,
+        s3: 2.44e-12,
         k_z: 4.4,
+        k_l: 0.0,
     };
     let i = input(SkfKind::AngularContactBall, c, 20.0, 47.0, 0.0, mu);
     close(moment(&i, 3000.0, 800.0, 600.0, 20.0).total(), 0.032567802, 1e-6);
@@ -201,4 +207,217 @@ fn palmgren_units_match_thermca_si_form() {
         1e-3 * 3e-4 * 1900.0 * 60.0,
         1e-12,
     );
+}
+
+fn roller(r1: f64, r2: f64, s1: f64, s2: f64, k_z: f64, k_l: f64) -> SkfConstants {
+    SkfConstants {
+        r1,
+        r2,
+        r3: 0.0,
+        s1,
+        s2,
+        s3: 0.0,
+        k_z,
+        k_l,
+    }
+}
+
+/// Peer P4 (cfernandesFEUP/Gear-Calculation `GearC/bearings.py` @345f3128, the FZG-rig code):
+/// M_rr + M_sl of NJ 406 and QJ 308 N2MA with its own constants, oil bath (K_rs 3e-8), μ_bl 0.12,
+/// μ_EHL 0.02 (roller) / 0.05 (ball). Its drag term is an older SKF form (10·V_M·K_roll·B·d_m^4·n²,
+/// doubled) and is not compared (docs/validation.md).
+#[test]
+fn cylindrical_and_four_point_match_the_fernandes_peer() {
+    let mut i = input(
+        SkfKind::CylindricalRoller,
+        roller(1.0e-6, 0.0, 0.16, 0.0015, 5.1, 0.65),
+        30.0,
+        90.0,
+        53000.0,
+        (0.12, 0.02),
+    );
+    i.lubrication = Lubrication::OilBath;
+    let rr_sl = |i: &SkfInput, n, fr, fa, nu| {
+        let m = moment(i, n, fr, fa, nu);
+        assert_eq!(m.drag, 0.0);
+        m.rolling + m.sliding
+    };
+    close(rr_sl(&i, 2175.0, 2000.0, 0.0, 13.5), 9.698774876e-02, 1e-6);
+    close(rr_sl(&i, 2175.0, 2000.0, 500.0, 13.5), 1.800069787e-01, 1e-6);
+    close(rr_sl(&i, 1450.0, 6000.0, 0.0, 40.0), 2.007201539e-01, 1e-6);
+    let mut i = input(
+        SkfKind::FourPointContactBall,
+        SkfConstants {
+            r1: 4.78e-7,
+            r2: 2.42,
+            r3: 1.40e-12,
+            s1: 1.20e-2,
+            s2: 0.9,
+            s3: 1.40e-12,
+            k_z: 3.1,
+            k_l: 0.0,
+        },
+        40.0,
+        90.0,
+        1.0,
+        (0.12, 0.05),
+    );
+    i.lubrication = Lubrication::OilBath;
+    close(rr_sl(&i, 3000.0, 1000.0, 1500.0, 20.0), 1.654140363e-01, 1e-6);
+    close(rr_sl(&i, 6000.0, 300.0, 2500.0, 8.0), 1.997516925e-01, 1e-6);
+}
+
+/// Peer P6 (`geometry_variables.py`, SKF Table 1a, search-index file 52327465425): G_rr and
+/// G_sl of tapered (R2·Y, S2·Y given to the peer, which omits Y) and cylindrical roller bearings.
+#[test]
+fn tapered_and_cylindrical_forms_match_the_table_peer() {
+    let g = |i: &SkfInput, fr: f64, fa: f64| {
+        let t = Skf::new(i).unwrap().load_terms(
+            1500.0,
+            BearingLoad {
+                radial: fr,
+                axial: fa,
+            },
+        );
+        (t.g_rr, t.g_sl)
+    };
+    let mut i = input(
+        SkfKind::TaperedRoller,
+        roller(1.76e-6, 10.9, 0.017, 2.0, 6.0, 0.7),
+        30.0,
+        62.0,
+        44000.0,
+        (0.12, 0.002),
+    );
+    i.axial_factor_y = 1.6;
+    let (rr, sl) = g(&i, 3000.0, 0.0);
+    close(rr, 1.908903157e-01, 1e-6);
+    close(sl, 1.177691656e+03, 1e-6);
+    let (rr, sl) = g(&i, 3000.0, 1200.0);
+    close(rr, 3.633601459e-01, 1e-6);
+    close(sl, 2.685136976e+03, 1e-6);
+    i.size = BearingSize {
+        bore: 0.040,
+        outside: 0.080,
+    };
+    let (rr, sl) = g(&i, 5000.0, 2500.0);
+    close(rr, 8.518632585e-01, 1e-6);
+    close(sl, 6.345652695e+03, 1e-6);
+    let i = input(
+        SkfKind::CylindricalRoller,
+        roller(1.09e-6, 0.0, 0.16, 0.0015, 5.1, 0.65),
+        50.0,
+        90.0,
+        69500.0,
+        (0.12, 0.02),
+    );
+    let (rr, sl) = g(&i, 4000.0, 300.0);
+    close(rr, 3.987965308e-01, 1e-6);
+    close(sl, 2.616997048e+03, 1e-6);
+    // A tapered bearing without Y is refused.
+    let mut bad = i;
+    bad.kind = SkfKind::TaperedRoller;
+    assert!(Skf::new(&bad).is_err());
+}
+
+/// Peer P5 (`drag.py`, roller branch, search-index file 67381577723): oil-bath drag of NJ 406
+/// (H 45 and 72 mm) and of a 30206 (H 10 mm), with the V_M the peer interpolates.
+#[test]
+fn roller_drag_matches_the_p5_peer() {
+    let vm = |x: f64, (x0, v0): (f64, f64), (x1, v1): (f64, f64)| v0 + (v1 - v0) * (x - x0) / (x1 - x0);
+    let mut i = input(
+        SkfKind::CylindricalRoller,
+        roller(1.0e-6, 0.0, 0.16, 0.0015, 5.1, 0.65),
+        30.0,
+        90.0,
+        53000.0,
+        (0.12, 0.02),
+    );
+    i.lubrication = Lubrication::OilBath;
+    i.width = 0.023;
+    i.oil_level = 0.045;
+    i.drag_vm = vm(0.75, (0.5, 6.8e-4), (0.8, 1.0e-3));
+    close(moment(&i, 2175.0, 2000.0, 0.0, 13.5).drag, 2.707901818e-02, 1e-6);
+    i.oil_level = 0.072;
+    i.drag_vm = 1.5e-3;
+    close(moment(&i, 3000.0, 2000.0, 0.0, 30.0).drag, 9.047268662e-02, 1e-6);
+    let mut i = input(
+        SkfKind::TaperedRoller,
+        roller(1.76e-6, 10.9, 0.017, 2.0, 6.0, 0.7),
+        30.0,
+        62.0,
+        44000.0,
+        (0.12, 0.002),
+    );
+    i.axial_factor_y = 1.6;
+    i.width = 0.01725;
+    i.oil_level = 0.010;
+    i.drag_vm = vm(10.0 / 46.0, (0.2, 3.0e-4), (0.3, 4.8e-4));
+    close(moment(&i, 1500.0, 2000.0, 0.0, 20.0).drag, 3.038937437e-03, 1e-6);
+    // Drag without width or K_L is refused.
+    i.width = 0.0;
+    assert!(Skf::new(&i).is_err());
+}
+
+/// Roller forms: rolling ∝ F_r^0.31, sliding linear in the loads; tapered axial load enters
+/// through Y.
+#[test]
+fn roller_units_and_scaling() {
+    let i = input(
+        SkfKind::CylindricalRoller,
+        roller(1.0e-6, 0.0, 0.16, 0.0015, 5.1, 0.65),
+        30.0,
+        90.0,
+        53000.0,
+        (0.12, 0.02),
+    );
+    let (a, b) = (
+        moment(&i, 1500.0, 1000.0, 0.0, 30.0),
+        moment(&i, 1500.0, 3000.0, 0.0, 30.0),
+    );
+    close(b.rolling / a.rolling, 3f64.powf(0.31), 1e-12);
+    close(b.sliding / a.sliding, 3.0, 1e-12);
+    let mut t = input(
+        SkfKind::TaperedRoller,
+        roller(1.76e-6, 10.9, 0.017, 2.0, 6.0, 0.7),
+        30.0,
+        62.0,
+        44000.0,
+        (0.12, 0.002),
+    );
+    t.axial_factor_y = 2.0;
+    let (m1, m2) = (
+        moment(&t, 1500.0, 1000.0, 100.0, 30.0),
+        moment(&t, 1500.0, 1000.0 + 10.9 * 2.0 * 100.0, 0.0, 30.0),
+    );
+    // F_r + R2·Y·F_a in G_rr: the same rolling moment as a purely radial load of that size.
+    close(m1.rolling, m2.rolling, 1e-12);
+    assert_eq!(moment(&t, 0.0, 1000.0, 100.0, 30.0).total(), 0.0);
+}
+
+/// Vanishing speeds (a cycle row of 1e-300 rpm) give finite, non-negative power: the drag term's
+/// n²·(n f_t dm²)^-1.379 once gave 0·∞ = NaN there (issue 16 campaign, case 79658).
+#[test]
+fn vanishing_speeds_give_finite_power() {
+    let mut i = input(
+        SkfKind::DeepGrooveBall,
+        dgbb(4.1e-7, 3.73e-3, 14.6),
+        50.0,
+        80.0,
+        16000.0,
+        (0.12, 0.1),
+    );
+    i.oil_level = 1.0;
+    let m = BearingFriction::Skf(Skf::new(&i).unwrap());
+    let load = BearingLoad {
+        radial: 800.0,
+        axial: 0.0,
+    };
+    for w in [1e-300, 1e-200, 1e-100, 1e-20, 1e-9] {
+        let t = m.load_terms(w, load);
+        let mo = m.moment(&t, BearingOil::new(12e-6));
+        let p = m.power(w, load, BearingOil::new(12e-6));
+        assert!(mo.total().is_finite() && mo.drag >= 0.0, "{w}: {mo:?}");
+        assert!((0.0..1e-6).contains(&p), "{w}: {p} W");
+    }
 }

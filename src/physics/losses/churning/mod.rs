@@ -268,6 +268,10 @@ pub struct ChurningConfig {
     pub changenet: ChangenetParams,
 }
 
+/// Angular speed below which a gear churns nothing (rad/s; about 1e-8 rpm): see
+/// [`GearChurning::power`].
+pub const STANDSTILL_RAD_S: f64 = 1e-9;
+
 /// Precomputed churning model of one gear: the single entry point for the scene.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum GearChurning {
@@ -296,7 +300,15 @@ impl GearChurning {
     /// Churning power at angular speed `omega` (rad/s, sign irrelevant) and oil state `oil`.
     /// Zero when the gear is not immersed or `omega == 0`. Precondition: `oil` has finite,
     /// positive density and viscosity (validated by the oil module).
+    ///
+    /// Below [`STANDSTILL_RAD_S`] the gear is at standstill (zero power): there the laws'
+    /// powers of Fr ∝ ω² and Re ∝ ω underflow to 0 and overflow to ∞ (ω = 1e-200 rad/s gives
+    /// Fr = 0, Fr^-0.6 = ∞ and 0·∞ = NaN), while every law's power vanishes like ω^p, p > 1,
+    /// so that what is cut off is below 1e-12 W on any gear (test `tiny_speeds_are_standstill`).
     pub fn power(&self, omega: f64, oil: &OilState) -> ChurningPower {
+        if omega.abs() < STANDSTILL_RAD_S {
+            return ChurningPower::default();
+        }
         match self {
             GearChurning::Seetharaman(g) => g.power(omega, oil),
             GearChurning::Stavytskyi(g) => g.power(omega, oil),
@@ -519,6 +531,26 @@ mod tests {
             // sign of ω irrelevant
             assert_eq!(c.power(-200.0, &oil()), p);
             assert!((p.torque(-200.0) - p.total / 200.0).abs() < 1e-12);
+        }
+    }
+
+    /// Vanishing speeds (a cycle row of 1e-300 rpm) give a finite power, zero below the
+    /// standstill speed, and the power just above it is negligible for every model.
+    #[test]
+    fn tiny_speeds_are_standstill() {
+        for m in MODELS {
+            let c = GearChurning::new(&config(m), &fzg_wheel(0.02)).unwrap();
+            for w in [1e-300, 1e-200, 1e-100, 1e-20, 0.5 * STANDSTILL_RAD_S] {
+                assert_eq!(c.power(w, &oil()), ChurningPower::default(), "{m:?} at {w}");
+            }
+            for w in [STANDSTILL_RAD_S, 1e-6, 1e-3] {
+                let p = c.power(w, &oil()).total;
+                assert!(p.is_finite() && p >= 0.0, "{m:?} at {w}: {p}");
+            }
+            let edge = c.power(STANDSTILL_RAD_S, &oil()).total;
+            assert!(edge < 1e-12, "{m:?}: {edge} W cut off at standstill");
+            // the cut removes nothing a user can see: power keeps falling towards it
+            assert!(edge <= c.power(1e-6, &oil()).total);
         }
     }
 

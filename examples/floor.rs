@@ -1,0 +1,144 @@
+//! The integration floor of issue 15 per example model: samples × (one cached RHS + one LU of
+//! the iteration matrix's size), against the WLTC integration as `geartherm run` does it
+//! (per-item energies, losses recorded per row) and as `run --summary-only` does it.
+//!
+//! `cargo run --release --example floor` — CPU time of this thread (the 2-core machine is shared:
+//! wall time includes waiting for a core), medians of repeats. `FLOOR_REPEATS` (default 7) and
+//! `FLOOR_PROFILE=model.toml` (integrate that model 200 times, for `perf record`).
+
+use std::hint::black_box;
+use std::path::Path;
+
+use geartherm::cycle::DriveCycle;
+use geartherm::model;
+use geartherm::scene::{Inputs, Needs, Scene};
+use geartherm::solve::drive::segments;
+use geartherm::solve::transient::{integrate, Segment, TransientOptions};
+
+const MODELS: [&str; 4] = [
+    "models/at6_lepelletier.toml",
+    "models/fzg_c.toml",
+    "models/helical_stage.toml",
+    "models/pt6_spur_pair.toml",
+];
+
+fn cpu_time() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: clock_gettime writes into the timespec we own.
+    unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Median CPU seconds per call of `f` (batches of `n` calls).
+fn per_call(n: usize, repeats: usize, mut f: impl FnMut()) -> f64 {
+    median(
+        (0..repeats)
+            .map(|_| {
+                let c0 = cpu_time();
+                for _ in 0..n {
+                    f();
+                }
+                (cpu_time() - c0) / n as f64
+            })
+            .collect(),
+    )
+}
+
+fn scene_for(gb: &model::Gearbox, segs: &[Segment], summary_only: bool) -> Scene {
+    let needs = Needs {
+        states: Some(segs.iter().map(|s| s.inputs.state).collect()),
+        energy_per_source_only: summary_only,
+        ..Needs::default()
+    };
+    Scene::compile_for(gb, &needs).unwrap()
+}
+
+fn main() {
+    let repeats: usize = std::env::var("FLOOR_REPEATS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(7);
+    let cycle = DriveCycle::resolve("wltc").unwrap();
+    if let Ok(m) = std::env::var("FLOOR_PROFILE") {
+        let gb = model::load(Path::new(&m)).unwrap();
+        let (_, segs) = segments(&gb, &cycle).unwrap();
+        let scene = scene_for(&gb, &segs, true);
+        let o = TransientOptions {
+            record_losses: false,
+            ..TransientOptions::default()
+        };
+        for _ in 0..200 {
+            black_box(integrate(&scene, &segs, &o, &mut |_, _| {}).unwrap());
+        }
+        return;
+    }
+    println!("model,mode,states,samples,steps,rhs_evals,lu,rhs_us,lu_us,floor_ms,wltc_ms,ratio");
+    for m in MODELS {
+        let gb = model::load(Path::new(m)).unwrap();
+        let name = Path::new(m).file_stem().unwrap().to_string_lossy().into_owned();
+        let (_, segs) = segments(&gb, &cycle).unwrap();
+        for (mode, summary, assembled) in [
+            ("run", false, true),
+            ("summary-only", true, true),
+            ("summary-only, Jacobian from products", true, false),
+        ] {
+            let scene = scene_for(&gb, &segs, summary);
+            let o = TransientOptions {
+                record_losses: !summary,
+                assembled_jacobian: assembled,
+                ..TransientOptions::default()
+            };
+            // One cached RHS at a mid-cycle sample (the per-sample terms prepared once).
+            let mid = segs[segs.len() / 2].inputs;
+            let inp = Inputs { ..mid };
+            let mut work = scene.work(inp);
+            let y = scene.initial_state(None);
+            let mut dy = vec![0.0; y.len()];
+            let rhs = per_call(20_000, repeats, || {
+                scene.rhs(black_box(0.0), black_box(&y), &mut work, &mut dy)
+            });
+            let n = scene.n_states();
+            let a = nalgebra::DMatrix::<f64>::from_fn(n, n, |i, j| {
+                if i == j {
+                    4.0 + i as f64
+                } else {
+                    1.0 / (1.0 + (i + 2 * j) as f64)
+                }
+            });
+            let lu = per_call(2_000, repeats, || {
+                black_box(black_box(a.clone()).lu());
+            });
+            let mut times = Vec::new();
+            let mut last = None;
+            for _ in 0..repeats {
+                let c0 = cpu_time();
+                let t = integrate(&scene, &segs, &o, &mut |_, _| {}).unwrap();
+                times.push(cpu_time() - c0);
+                last = Some(t);
+            }
+            let t = last.unwrap();
+            let wltc = median(times);
+            let samples = segs.len();
+            let floor = samples as f64 * (rhs + lu);
+            println!(
+                "{name},{mode},{n},{samples},{},{},{},{:.3},{:.3},{:.3},{:.3},{:.2}",
+                t.stats.steps,
+                t.stats.rhs_evals,
+                t.stats.lu_factorisations,
+                rhs * 1e6,
+                lu * 1e6,
+                floor * 1e3,
+                wltc * 1e3,
+                wltc / floor
+            );
+        }
+    }
+}
