@@ -2,6 +2,12 @@
 //! example model, and the pocket integral K of one AT6 helical mesh family, exact helical limit
 //! (the default) vs the former 48 discrete slices.
 //!
+//! Since the pocket model reads its tooth outline from `physics::geometry::ToothProfile`
+//! (issue 15, one tooth profile), also: the pocket teeth of one gear (geometry build + the space
+//! bottom integral along the generated fillet) and the loss scene with every external mesh's
+//! pocketing counted (`pocketing_mixture_density_kg_m3` set: by default the AT6, helical and PT6
+//! meshes run above the oil and build no pocket table).
+//!
 //! Run: `cargo bench --bench compile`. Figures are recorded in docs/performance.md.
 
 use std::hint::black_box;
@@ -9,7 +15,9 @@ use std::path::PathBuf;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use geartherm::model;
-use geartherm::physics::losses::pocketing::{PocketFamily, PocketFamilyKind, PocketMeshInput, PocketTable};
+use geartherm::physics::losses::pocketing::{
+    PocketFamily, PocketFamilyKind, PocketMeshInput, PocketTable, PocketTeeth,
+};
 use geartherm::scene::{LossScene, Scene};
 
 fn benches(c: &mut Criterion) {
@@ -25,6 +33,23 @@ fn benches(c: &mut Criterion) {
         c.bench_function(&format!("compile/load_model/{name}"), |b| {
             b.iter(|| model::load(black_box(&root.join(format!("models/{name}.toml")))))
         });
+        // every external mesh's pocket table built (mixture density set for the share above
+        // the oil)
+        let path = root.join(format!("models/{name}.toml"));
+        let text = std::fs::read_to_string(&path).expect("model text");
+        let text = if text.contains("\n[losses]\n") {
+            text.replacen(
+                "\n[losses]\n",
+                "\n[losses]\npocketing_mixture_density_kg_m3 = 800.0\n",
+                1,
+            )
+        } else {
+            format!("{text}\n[losses]\npocketing_mixture_density_kg_m3 = 800.0\n")
+        };
+        let gb = model::from_str(&text, &path).expect("model with mixture density");
+        c.bench_function(&format!("compile/loss_scene_all_pockets/{name}"), |b| {
+            b.iter(|| LossScene::compile(black_box(&gb)))
+        });
     }
     // AT6 Ravigneaux large sun / long pinion (z 34/37 are read from the model)
     let gb = model::load(&root.join("models/at6_lepelletier.toml")).expect("bundled model");
@@ -34,22 +59,27 @@ fn benches(c: &mut Criterion) {
         .find(|m| m.name.contains("large_sun"))
         .expect("mesh");
     let (g1, g2) = (&gb.gears[m.gear1].geometry, &gb.gears[m.gear2].geometry);
-    let inp = PocketMeshInput {
-        z1: g1.z(),
-        z2: g2.z(),
-        module: g1.spec.mn,
-        pressure_angle: g1.spec.alpha_n,
-        x1: g1.spec.x,
-        x2: g2.spec.x,
-        tip_radius1: g1.d_a / 2.0,
-        tip_radius2: g2.d_a / 2.0,
-        root_radius1: g1.d_f / 2.0,
-        root_radius2: g2.d_f / 2.0,
-        centre_distance: m.geometry.a_w,
-        face_width: g1.spec.b.min(g2.spec.b),
-        helix_angle: g1.spec.beta,
-    };
+    let inp = PocketMeshInput::from_gears(g1, g2, m.geometry.a_w);
     let s = inp.helix_angle.tan() / (0.5 * inp.module * inp.z1 as f64 / inp.helix_angle.cos());
+    c.bench_function("pocket/teeth", |b| {
+        b.iter(|| {
+            PocketTeeth::new(
+                inp.z1,
+                inp.module,
+                inp.pressure_angle,
+                inp.helix_angle,
+                inp.x1,
+                black_box(inp.tip_radius1),
+                inp.root_radius1,
+                inp.rho_fp1,
+                inp.face_width,
+            )
+        })
+    });
+    let profile = *g1.profile();
+    c.bench_function("pocket/space_bottom_integral", |b| {
+        b.iter(|| black_box(&profile).space_bottom_integral())
+    });
     c.bench_function("pocket/family_geometry", |b| {
         b.iter(|| PocketFamily::new(black_box(&inp), PocketFamilyKind::SpaceOfGear2))
     });

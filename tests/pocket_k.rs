@@ -2,7 +2,9 @@
 //! infinitely-many-slices limit of the helical connected-slice model, 8-node Gauss–Legendre per
 //! smooth sub-interval), against a high-resolution reference: the same integrand by adaptive
 //! 24-node Gauss–Legendre to 1e-13 on a pocket table whose phase end and gap-kind switches were
-//! located with an 8× finer scan. Issue 15 criterion: within 1e-6 relative.
+//! located with an 8× finer scan. Issue 15 criterion: within 1e-6 relative. Both sides use the
+//! same pocket geometry: the teeth of `physics::geometry::ToothProfile` (involute + generated
+//! trochoid root), the pocket model's only tooth outline since issue 15.
 
 use std::path::PathBuf;
 
@@ -20,21 +22,7 @@ fn inputs(file: &str) -> Vec<(String, PocketMeshInput)> {
         .filter(|m| m.geometry.kind != MeshKind::Internal)
         .map(|m| {
             let (g1, g2) = (&gb.gears[m.gear1].geometry, &gb.gears[m.gear2].geometry);
-            let input = PocketMeshInput {
-                z1: g1.z(),
-                z2: g2.z(),
-                module: g1.spec.mn,
-                pressure_angle: g1.spec.alpha_n,
-                x1: g1.spec.x,
-                x2: g2.spec.x,
-                tip_radius1: g1.d_a / 2.0,
-                tip_radius2: g2.d_a / 2.0,
-                root_radius1: g1.d_f / 2.0,
-                root_radius2: g2.d_f / 2.0,
-                centre_distance: m.geometry.a_w,
-                face_width: g1.spec.b.min(g2.spec.b),
-                helix_angle: g1.spec.beta,
-            };
+            let input = PocketMeshInput::from_gears(g1, g2, m.geometry.a_w);
             (m.name.clone(), input)
         })
         .collect()

@@ -25,6 +25,7 @@ import json
 import math
 import os
 import subprocess
+import tempfile
 import sys
 import time
 import tomllib
@@ -161,9 +162,29 @@ class Changenet:
 #   f = wet share of the band ±2.25 m_n around the pitch point.
 # K itself is NOT recomputed here: it is geartherm's compiled number, recovered from one call of
 # `geartherm losses` (the P ∝ ρ ω³ law and the density mix are then checked at other points).
-# physics.md §3/6 lists K = 1.6929e-9 + 1.6731e-9 m⁵ for this mesh at C_d = 0.65 (fallback).
+# physics.md §3/6 lists K = 1.7398e-9 + 1.5726e-9 m⁵ for this mesh at C_d = 0.65 (fallback;
+# 1.6929e-9 + 1.6731e-9 before issue 15 unified the tooth profile).
 # --------------------------------------------------------------------------------------------
-POCKET_K_DOC = 1.6929e-9 + 1.6731e-9
+POCKET_K_DOC = 1.7398e-9 + 1.5726e-9
+
+
+def peer_model(src: str, dst: str) -> str:
+    """Copy a model file without its [[bearings]] and [[seals]] tables (issue 12; the peer does
+    not model them) and with the friction law the peer implements pinned in [losses]
+    (geartherm's default became Schlenk in issue 14); both tools then run the same network and
+    the same equations from `dst`."""
+    out, skip = [], False
+    with open(src) as f:
+        for line in f:
+            if line.startswith("["):
+                skip = line.strip() in ("[[bearings]]", "[[seals]]")
+                assert line.strip() != "[losses]", "model has its own [losses]: edit peer_model"
+            if not skip:
+                out.append(line)
+    out.append('\n[losses]\nfriction = "iso_tc60"\n')
+    with open(dst, "w") as f:
+        f.writelines(out)
+    return dst
 
 
 def pocket_k_from_geartherm(root: str, exe: str, model: str, z1: int, rho_p_of) -> float | None:
@@ -258,11 +279,17 @@ def rotating_disc_h(w: float, r: float, nu: float, pr: float, k: float) -> float
 # State y = [T_nodes (K) | E_items (J) | E_to_boundaries (J)]
 # --------------------------------------------------------------------------------------------
 class Scene:
-    def __init__(self, root: str = ".", exe: str | None = None, pocket_k: float | None = None):
+    def __init__(self, root: str = ".", exe: str | None = None, pocket_k: float | None = None,
+                 model: str | None = None):
         self.root = root
-        model_path = os.path.join(root, "models", "fzg_c.toml")
+        model_path = os.path.abspath(model or os.path.join(root, "models", "fzg_c.toml"))
+        self.model_path = model_path
         with open(model_path, "rb") as f:
             md = tomllib.load(f)
+        # rolling bearings and seals (issue 12) are not modelled here: compare.py runs both tools
+        # on a copy of models/fzg_c.toml without them (see peer_model)
+        assert not md.get("bearings") and not md.get("seals"), \
+            "peer models no bearings/seals: use peer_model(models/fzg_c.toml)"
         with open(os.path.join(root, "models", "oils.toml"), "rb") as f:
             oils = tomllib.load(f)
         self.md = md
@@ -283,7 +310,7 @@ class Scene:
         losses = md.get("losses", {})
         assert losses.get("churning", "changenet") == "changenet"
         assert losses.get("sliding", "detailed") == "detailed"
-        assert losses.get("friction", "iso_tc60") == "iso_tc60"
+        assert losses.get("friction") == "iso_tc60"  # geartherm's default is schlenk
         assert losses.get("load_sharing", "uniform") == "uniform"
         # churning items (gears reaching the oil)
         self.churn = []
@@ -294,7 +321,8 @@ class Scene:
         # pocketing density: wet share of the mesh band
         cd = losses.get("pocketing_discharge_coefficient", 0.65)
         assert cd == 0.65
-        rho_mix = losses.get("pocketing_mixture_density_kg_m3", 10.0)
+        # unset: the share of the mesh zone above the oil pumps nothing (src/scene/losses.rs)
+        rho_mix = losses.get("pocketing_mixture_density_kg_m3", 0.0)
         h1 = lub["centre_height_mm"][g1.name] * 1e-3
         h2 = lub["centre_height_mm"][g2.name] * 1e-3
         sl = Sliding(g1, g2, a_w)
@@ -306,7 +334,7 @@ class Scene:
         self.rho_mix = rho_mix
         self.rho_pocket = lambda rho: self.wet * rho + (1 - self.wet) * rho_mix
         if pocket_k is None and exe is not None:
-            pocket_k = pocket_k_from_geartherm(root, exe, "models/fzg_c.toml", g1.z, self.rho_pocket)
+            pocket_k = pocket_k_from_geartherm(root, exe, model_path, g1.z, self.rho_pocket)
         self.pocket_k = pocket_k if pocket_k is not None else POCKET_K_DOC
         self.pocket_z1 = g1.z
         self.item_names = [f"churning:{n}" for n, _ in self.churn] + \
@@ -620,7 +648,7 @@ def check_losses(scene: Scene, exe: str, points=None, verbose=True):
     rows = []
     for rpm, tq, tc in points:
         js = json.loads(subprocess.run(
-            [exe, "losses", "models/fzg_c.toml", "--gear", "1", "--speed-rpm", str(rpm),
+            [exe, "losses", scene.model_path, "--gear", "1", "--speed-rpm", str(rpm),
              "--torque-nm", str(tq), "--oil-temp-c", str(tc), "--json"],
             cwd=scene.root, capture_output=True, text=True, check=True).stdout)
         q = scene.losses(rpm * math.pi / 30, tq, tc + KELVIN)
@@ -649,7 +677,9 @@ def main():
     ap.add_argument("--check", action="store_true", help="compare losses with `geartherm losses`")
     args = ap.parse_args()
     exe = os.path.join(args.root, args.exe) if not os.path.isabs(args.exe) else args.exe
-    scene = Scene(args.root, exe if os.path.exists(exe) else None)
+    model = peer_model(os.path.join(args.root, "models", "fzg_c.toml"),
+                             os.path.join(tempfile.mkdtemp(prefix="fzg_peer_"), "fzg_c.toml"))
+    scene = Scene(args.root, exe if os.path.exists(exe) else None, model=model)
     print(f"pocketing K = {scene.pocket_k:.10e} m^5 (doc {POCKET_K_DOC:.5e}); sliding G = "
           f"{scene.sliding.G:.10e}; eps_alpha = {scene.sliding.eps_alpha:.6f}")
     if args.check:

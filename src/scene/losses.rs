@@ -359,21 +359,7 @@ impl LossScene {
                         continue;
                     }
                     let (g1, g2) = (&gb.gears[m.gear1], &gb.gears[m.gear2]);
-                    let input = PocketMeshInput {
-                        z1: g1.geometry.z(),
-                        z2: g2.geometry.z(),
-                        module: g1.geometry.spec.mn,
-                        pressure_angle: g1.geometry.spec.alpha_n,
-                        x1: g1.geometry.spec.x,
-                        x2: g2.geometry.spec.x,
-                        tip_radius1: g1.geometry.d_a / 2.0,
-                        tip_radius2: g2.geometry.d_a / 2.0,
-                        root_radius1: g1.geometry.d_f / 2.0,
-                        root_radius2: g2.geometry.d_f / 2.0,
-                        centre_distance: geo.a_w,
-                        face_width: g1.geometry.spec.b.min(g2.geometry.spec.b),
-                        helix_angle: g1.geometry.spec.beta,
-                    };
+                    let input = PocketMeshInput::from_gears(&g1.geometry, &g2.geometry, geo.a_w);
                     let popts = crate::physics::losses::pocketing::PocketingOptions {
                         discharge_coefficient: opt.discharge_coefficient,
                         helix_slices: HELIX_POCKET_SLICES,

@@ -49,7 +49,7 @@
 //! come first, while both gaps have a foot on an involute (beyond, a gap would join two tip
 //! corners). Outside, [`PocketFamily::state`] returns `None`.
 
-use super::profile::{cross, inv, inv_roll, ToothProfile};
+use super::teeth::{cross, inv, inv_roll, PocketTeeth};
 use super::{PocketMeshInput, PocketingError};
 
 /// Which pockets: the space of which gear, entered by a tooth of the other.
@@ -109,10 +109,10 @@ pub struct PocketState {
 /// Mesh-level data shared by both families.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MeshProfiles {
-    /// Gear 1 profile (possibly thinned to remove a rounding-level negative backlash).
-    pub gear1: ToothProfile,
-    /// Gear 2 profile.
-    pub gear2: ToothProfile,
+    /// Gear 1 teeth (possibly thinned to remove a rounding-level negative backlash).
+    pub gear1: PocketTeeth,
+    /// Gear 2 teeth.
+    pub gear2: PocketTeeth,
     /// Operating transverse pressure angle α_wt (rad).
     pub alpha_w: f64,
     /// Normal backlash j_bn (m), ≥ 0.
@@ -127,7 +127,8 @@ impl MeshProfiles {
     /// Build and check both profiles and the operating pressure angle
     /// `cos α_wt = a cos α_t / a_w` [std, physics.md §2].
     pub fn new(inp: &PocketMeshInput) -> Result<Self, PocketingError> {
-        let g1 = ToothProfile::new(
+        let b = super::positive("face_width", inp.face_width)?;
+        let g1 = PocketTeeth::new(
             inp.z1,
             inp.module,
             inp.pressure_angle,
@@ -135,8 +136,10 @@ impl MeshProfiles {
             inp.x1,
             inp.tip_radius1,
             inp.root_radius1,
+            inp.rho_fp1,
+            b,
         )?;
-        let g2 = ToothProfile::new(
+        let g2 = PocketTeeth::new(
             inp.z2,
             inp.module,
             inp.pressure_angle,
@@ -144,9 +147,10 @@ impl MeshProfiles {
             inp.x2,
             inp.tip_radius2,
             inp.root_radius2,
+            inp.rho_fp2,
+            b,
         )?;
         let aw = super::positive("centre_distance", inp.centre_distance)?;
-        let b = super::positive("face_width", inp.face_width)?;
         let cw = (g1.r_ref + g2.r_ref) * g1.alpha_t.cos() / aw;
         if !(cw > 0.0 && cw < 1.0) {
             return Err(PocketingError::InvalidInput(
@@ -205,10 +209,10 @@ impl MeshProfiles {
 pub struct PocketFamily {
     /// Which family.
     pub kind: PocketFamilyKind,
-    /// Profile of the gear owning the space (S).
-    pub space: ToothProfile,
-    /// Profile of the gear owning the entering tooth (T).
-    pub tooth: ToothProfile,
+    /// Teeth of the gear owning the space (S).
+    pub space: PocketTeeth,
+    /// Teeth of the gear owning the entering tooth (T).
+    pub tooth: PocketTeeth,
     a: f64,
     alpha_w: f64,
     /// dv/du = z_S/z_T.
@@ -678,7 +682,19 @@ mod tests {
         assert!((eps - 1.44).abs() < 0.01, "ε_α = {eps}");
         // the data are zero-backlash to rounding: thinned by < 0.1 µm
         assert_eq!(mp.backlash, 0.0);
-        let raw = ToothProfile::new(16, 4.5e-3, 20f64.to_radians(), 0.0, 0.1817, 0.04123, 0.031).unwrap();
+        let inp = cases::fzg_c();
+        let raw = PocketTeeth::new(
+            16,
+            4.5e-3,
+            20f64.to_radians(),
+            0.0,
+            0.1817,
+            inp.tip_radius1,
+            inp.root_radius1,
+            0.25,
+            inp.face_width,
+        )
+        .unwrap();
         let thin = (raw.half_tooth_base - mp.gear1.half_tooth_base) * 2.0 * raw.r_base;
         assert!(thin > 0.0 && thin < 1e-7, "thinning {thin}");
     }
@@ -794,7 +810,99 @@ mod tests {
         // unequal gears: the two families differ (each one is still even in φ1)
         let [ga, gb] = families(&cases::fzg_c());
         let (x, y) = (ga.state(0.0).unwrap(), gb.state(0.0).unwrap());
-        assert!((x.area - y.area).abs() > 0.05 * x.area);
+        assert!(
+            (x.area - y.area).abs() > 0.01 * x.area,
+            "{} vs {}",
+            x.area,
+            y.area
+        );
+    }
+
+    /// Figures of docs/physics.md §3/6 (FZG C table, seed 004 K):
+    /// `cargo test --release --lib pocket_figures -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn pocket_figures() {
+        use super::super::integral::PocketTable;
+        for (name, inp) in [("fzg_c", cases::fzg_c()), ("seed004", cases::seed004())] {
+            let mp = MeshProfiles::new(&inp).unwrap();
+            for (g, t) in [("gear 1", &mp.gear1), ("gear 2", &mp.gear2)] {
+                eprintln!(
+                    "{name} {g}: r_b {:.4} mm, r_form {:.4} mm, r_f {:.4} mm, roll_form {:.5}, \
+                     fillet ρ {:.4} mm, undercut {}",
+                    t.r_base * 1e3,
+                    t.r_form() * 1e3,
+                    t.r_root * 1e3,
+                    t.roll_form,
+                    t.profile.rho() * 1e3,
+                    t.profile.undercut()
+                );
+            }
+            for f in families(&inp) {
+                let pm = f.phase_limit();
+                let (a, b) = f.contact_interval_leading().unwrap();
+                let (s0, se) = (f.state(0.0).unwrap(), f.state(pm).unwrap());
+                let table = PocketTable::new(&f).unwrap();
+                let k: Vec<String> = [0.6, 0.65, 0.7]
+                    .iter()
+                    .map(|cd| format!("{:.4e}", table.k_spur(*cd)))
+                    .collect();
+                eprintln!(
+                    "{name} {:?}: φ_max {:.2}° (entry {}), S_r2 = 0 on [{:.2}°, {:.2}°], A(0) {:.3} mm², \
+                     V(0) {:.2} mm³, A(φ_max) {:.2} mm², K(0.60/0.65/0.70) {k:?}",
+                    f.kind,
+                    pm.to_degrees(),
+                    f.phase_limited_by_entry(),
+                    a.to_degrees(),
+                    b.to_degrees(),
+                    s0.area * 1e6,
+                    s0.volume * 1e9,
+                    se.area * 1e6
+                );
+            }
+        }
+        // seed 004 table rows (family 2 = family 1 for equal gears)
+        let f = PocketFamily::new(&cases::seed004(), PocketFamilyKind::SpaceOfGear2).unwrap();
+        for d in [-13.0f64, -10.0, -8.0, -6.0, -5.0, -4.0, -3.0, -2.0, -1.0, 0.0] {
+            let s = f.state(d.to_radians()).unwrap();
+            eprintln!(
+                "seed004 {d:>5}°: A {:.3} mm², V {:.1} mm³, S_r1 {:.2} mm², S_r2 {:.2} mm² {:?}",
+                s.area * 1e6,
+                s.volume * 1e9,
+                s.s_r1 * 1e6,
+                s.s_r2 * 1e6,
+                s.kinds
+            );
+        }
+        // FZG C power (both families, ρ 870) and the helical table (normal data kept)
+        let fzg = cases::fzg_c();
+        let pm = super::super::PocketingMesh::new(&fzg, 0.65).unwrap();
+        for rpm in [1000.0, 3000.0, 6000.0] {
+            let w = rpm * std::f64::consts::PI / 30.0;
+            let [a, b] = pm.family_power(w, 870.0);
+            eprintln!("fzg_c {rpm} rpm: {:.2} W ({a:.2} + {b:.2})", a + b);
+        }
+        for beta in [0.0f64, 5.0, 10.0, 15.0, 20.0, 25.0] {
+            let inp = cases::helical(&fzg, beta.to_radians());
+            let mp = MeshProfiles::new(&inp).unwrap();
+            let s = inp.helix_angle.tan() / mp.gear1.r_ref;
+            let (mut kh, mut ks) = (0.0, 0.0);
+            for kind in [PocketFamilyKind::SpaceOfGear2, PocketFamilyKind::SpaceOfGear1] {
+                let t = PocketTable::new(&PocketFamily::from_profiles(&mp, kind).unwrap()).unwrap();
+                ks += t.k_spur(0.65);
+                kh += if beta == 0.0 {
+                    t.k_spur(0.65)
+                } else {
+                    t.k_helical(0.65, s, 64)
+                };
+            }
+            let w = 3000.0 * std::f64::consts::PI / 30.0;
+            let p = 16.0 * 870.0 * w.powi(3) * kh / (4.0 * std::f64::consts::PI);
+            eprintln!(
+                "fzg_c helical β {beta}°: K_hel/K_spur (n = 64) {:.3}, P 3000 rpm {p:.1} W",
+                kh / ks
+            );
+        }
     }
 
     #[test]

@@ -5,7 +5,8 @@
 //! `A_axial(φ1)` (the axial leakage area, also the pocket cross-section), a volume
 //! `V = A_axial·b` and two radial leakage surfaces `S_r1 = g1·b`, `S_r2 = g2·b` (g = minimal
 //! distance between the two flanks on each side). Everything is closed-form (involute properties,
-//! closed-form polar integrals); see `areas.rs`.
+//! closed-form polar integrals); see `areas.rs`. The tooth outline (involute and hob-generated
+//! trochoid root) is the one of `physics::geometry::ToothProfile`, read through `teeth.rs`.
 //!
 //! Power after physics.md §6 [derived from seeds 000 and 004]: with
 //! `A_out = 2·A_axial + S_r1 + S_r2`, outflow `Q = −ω1·dV/dφ1` while the pocket closes, Bernoulli
@@ -13,14 +14,14 @@
 //! `K = ∫ (−dV/dφ1)³/(C_d A_out)² dφ1` (closing phase only), and per family
 //! `P = z1·ρ·ω1³·K/(4π)`. `K` is geometric and precomputed once (`PocketingMesh::new`).
 //!
-//! Files: `profile.rs` (minimal transverse tooth description), `areas.rs` (pocket geometry vs
+//! Files: `teeth.rs` (what the pocket geometry reads from `geometry::ToothProfile`), `areas.rs` (pocket geometry vs
 //! φ1), `integral.rs` (tables, derivative, K, helical slices), `power.rs` (the run-time object).
 //! All quantities SI (m, rad, m², m³, W); no allocation in `PocketingMesh::power`.
 
 pub mod areas;
 pub mod integral;
 pub mod power;
-pub mod profile;
+pub mod teeth;
 
 #[cfg(test)]
 mod brute;
@@ -28,7 +29,7 @@ mod brute;
 pub use areas::{GapKind, PocketFamily, PocketFamilyKind, PocketState};
 pub use integral::PocketTable;
 pub use power::{PocketingMesh, PocketingOptions};
-pub use profile::{RootShape, ToothProfile};
+pub use teeth::PocketTeeth;
 
 use std::fmt;
 
@@ -37,8 +38,9 @@ use std::fmt;
 /// `module` and `pressure_angle` are the normal values (m_n, α_n); for `helix_angle = 0` they are
 /// the transverse ones. Tooth thicknesses follow the standard formula
 /// `s_n = m_n(π/2 + 2x·tan α_n)` [std] (no thickness allowance); tip and root radii are given
-/// (physics.md §2: `r_f = r − m_n(1.25 − x)` if not known). Gear 1 is the driver: φ1 is its
-/// rotation angle, gear 2 turns by −φ1·z1/z2.
+/// (physics.md §2: `r_f = r − m_n(1.25 − x)` if not known), and the tool tip radius factor
+/// ρ_fP* of the hob that generated the root fillet (ISO 53: 0.25 unless known). Gear 1 is the
+/// driver: φ1 is its rotation angle, gear 2 turns by −φ1·z1/z2.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PocketMeshInput {
     /// Number of teeth of gear 1 (driver).
@@ -67,6 +69,11 @@ pub struct PocketMeshInput {
     pub face_width: f64,
     /// Reference helix angle β (rad); 0 for spur gears.
     pub helix_angle: f64,
+    /// Tool tip radius factor ρ_fP* of gear 1 (−): fillet radius of the generating rack
+    /// ρ_fP*·m_n (physics.md §2).
+    pub rho_fp1: f64,
+    /// Tool tip radius factor ρ_fP* of gear 2 (−).
+    pub rho_fp2: f64,
 }
 
 /// Why a pocketing geometry could not be built.
@@ -107,6 +114,33 @@ pub(crate) fn positive(field: &'static str, v: f64) -> Result<f64, PocketingErro
 }
 
 impl PocketMeshInput {
+    /// The pocket input of an external mesh of two gears built by the geometry module, at the
+    /// operating centre distance `a_w` (m): their tip and root diameters, normal data, tool tip
+    /// radius factors and the smaller face width.
+    pub fn from_gears(
+        g1: &crate::physics::geometry::GearGeometry,
+        g2: &crate::physics::geometry::GearGeometry,
+        a_w: f64,
+    ) -> Self {
+        Self {
+            z1: g1.z(),
+            z2: g2.z(),
+            module: g1.spec.mn,
+            pressure_angle: g1.spec.alpha_n,
+            x1: g1.spec.x,
+            x2: g2.spec.x,
+            tip_radius1: g1.d_a / 2.0,
+            tip_radius2: g2.d_a / 2.0,
+            root_radius1: g1.d_f / 2.0,
+            root_radius2: g2.d_f / 2.0,
+            centre_distance: a_w,
+            face_width: g1.spec.b.min(g2.spec.b),
+            helix_angle: g1.spec.beta,
+            rho_fp1: g1.spec.rho_fp,
+            rho_fp2: g2.spec.rho_fp,
+        }
+    }
+
     /// Same mesh with every length multiplied by `k` (used by the units tests).
     pub fn scaled(&self, k: f64) -> Self {
         Self {
@@ -149,6 +183,8 @@ pub(crate) mod cases {
             centre_distance: 91.5e-3,
             face_width: 14e-3,
             helix_angle: 0.0,
+            rho_fp1: 0.25,
+            rho_fp2: 0.25,
         }
     }
 
@@ -170,6 +206,8 @@ pub(crate) mod cases {
             centre_distance: m * 76.0,
             face_width: 0.1,
             helix_angle: 0.0,
+            rho_fp1: 0.25,
+            rho_fp2: 0.25,
         }
     }
 
@@ -217,6 +255,8 @@ pub(crate) mod cases {
             centre_distance: 0.5 * m * (z1 + z2) as f64 + 0.7e-3,
             face_width: 20e-3,
             helix_angle: 0.0,
+            rho_fp1: 0.25,
+            rho_fp2: 0.25,
         }
     }
 }
