@@ -152,12 +152,13 @@ fn validate_covers_bearing_seal_converter_pump_and_handbook_ranges() {
     kinds.sort_unstable();
     kinds.dedup();
     assert_eq!(kinds, ["handbook", "peer", "standard"]);
-    // Bearing: the Palmgren choice only (NJ 406 has no SKF row), one row per peer point.
+    // Bearing: the Palmgren and SKF choices (NJ 406 has an SKF row), one row per peer point each.
     let b = of("fernandes_nj406_1000n_bearing");
-    assert_eq!(b.len(), 6);
-    assert!(b
-        .iter()
-        .all(|r| r["model"] == "palmgren" && r["quantity"] == "bearing"));
+    assert_eq!(b.len(), 12);
+    assert!(b.iter().all(|r| r["quantity"] == "bearing"));
+    for m in ["palmgren", "skf"] {
+        assert_eq!(b.iter().filter(|r| r["model"] == m).count(), 6, "{m}");
+    }
     // Seal law, converter table and pump formula are reproduced (a wrong item, speed or source
     // would miss by far more).
     for c in [
