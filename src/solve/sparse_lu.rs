@@ -64,6 +64,8 @@ struct Scatter {
 }
 
 struct Factors {
+    /// The last numeric factorisation succeeded.
+    factorised: bool,
     m: FaerSparseMat<f64>,
     s_index: Vec<usize>,
     b_index: Vec<usize>,
@@ -204,6 +206,7 @@ impl LinearSolver<FaerSparseMat<f64>> for NetworkSparseLu {
             scatter: sc,
             s_index,
             b_index,
+            factorised: false,
         });
     }
 
@@ -221,7 +224,10 @@ impl LinearSolver<FaerSparseMat<f64>> for NetworkSparseLu {
                 av[q] = mv[p];
             }
         }
-        f.symbolic
+        // A singular or non-finite iteration matrix (a Newton trial off the physical range) is
+        // not a panic: the next solve reports it and diffsol cuts the step, as with its own LUs.
+        f.factorised = f
+            .symbolic
             .factorize_numeric_lu(
                 &mut f.numeric,
                 f.ass.as_ref(),
@@ -229,7 +235,11 @@ impl LinearSolver<FaerSparseMat<f64>> for NetworkSparseLu {
                 MemStack::new(&mut f.factor_scratch),
                 Default::default(),
             )
-            .expect("numeric LU of the iteration matrix");
+            .is_ok();
+        if !f.factorised {
+            f.schur = None;
+            return;
+        }
         let (ns, nb) = (f.s_index.len(), f.b_index.len());
         f.bs_vals.clear();
         f.bs_vals.extend(sc.bs.iter().map(|&(p, a, b)| (a, b, mv[p])));
@@ -265,6 +275,11 @@ impl LinearSolver<FaerSparseMat<f64>> for NetworkSparseLu {
             .f
             .as_ref()
             .ok_or_else(|| LaError::Other("sparse LU used before its factorisation".into()))?;
+        if !f.factorised {
+            return Err(LaError::Other(
+                "numeric LU of the iteration matrix failed (singular or not finite)".into(),
+            ));
+        }
         let xs = x.inner_mut().col_as_slice_mut(0);
         let ns = f.s_index.len();
         let mut guard = f.y.borrow_mut();
