@@ -531,3 +531,25 @@ fn vanishing_speeds_are_standstill_not_failures() {
         );
     }
 }
+
+/// Allocations sized by user input are refused up front: a housing meshed into 100 000 patches
+/// (the most `[thermal.wall_mesh]` allows) over a WLTC would keep 1801 rows × 100 067 values
+/// (1.4 GB of states, a CSV of several GB); the run is refused with the figures, exit 1, nothing
+/// written, in well under a second.
+#[test]
+fn a_run_too_large_to_keep_is_refused_with_its_size() {
+    let d = tempfile::tempdir().unwrap();
+    let mut text = std::fs::read_to_string("models/at6_lepelletier.toml").unwrap();
+    text.push_str(
+        "\n[thermal.wall_mesh]\nnode = \"housing\"\naround = 400\nalong = 250\ncircumference_m = 1.4\n\
+         length_m = 0.5\nthickness_mm = 15.0\nconductivity_w_per_mk = 100.0\n",
+    );
+    let model = write(d.path(), "mesh.toml", &text);
+    let out = d.path().join("o");
+    let o = run(&["run", s(&model), "--cycle", "wltc", "--out", s(&out), "--quiet"]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(e.contains("1801 rows") && e.contains("limit of 50000000"), "{e}");
+    assert!(e.contains("fewer wall patches"), "{e}");
+    assert!(!out.exists(), "nothing written");
+}

@@ -11,7 +11,9 @@ use geartherm::report::files::OutputDir;
 use geartherm::report::run::{check_finite, summary, timeseries_csv, Summary};
 use geartherm::scene::{Needs, Scene};
 use geartherm::solve::drive::{row_inputs, segments};
-use geartherm::solve::transient::{integrate, Method, Restart, Segment, Trajectory, TransientOptions};
+use geartherm::solve::transient::{
+    check_stored_values, integrate, Method, Restart, Segment, Trajectory, TransientOptions,
+};
 
 use super::{check_range, invalid, Failure, EXIT_IO, EXIT_NUMERICAL};
 
@@ -155,6 +157,8 @@ pub fn prepare(args: &RunArgs) -> Result<Prepared, Failure> {
         record_losses: !args.summary_only,
         ..TransientOptions::default()
     };
+    check_stored_values(&scene, &segs, &opts)
+        .map_err(|e| invalid(format!("{}: {e}", args.model.display())))?;
     Ok(Prepared {
         gb,
         scene,

@@ -246,6 +246,46 @@ pub struct NumericalFailure {
     pub message: String,
 }
 
+/// Values a run keeps in memory for its output rows: one row per segment end (and the start),
+/// each holding the state and, when recorded, every loss item.
+pub fn stored_values(scene: &Scene, segments: &[Segment], opts: &TransientOptions) -> usize {
+    let per_row = scene.n_states()
+        + if opts.record_losses {
+            scene.losses.items.len()
+        } else {
+            0
+        };
+    (segments.len() + 1).saturating_mul(per_row)
+}
+
+/// At most this many stored values (8 bytes each: 400 MB) per run: a larger run (a long cycle on
+/// a finely meshed housing) is refused up front with the figures, not found out by the allocator.
+pub const MAX_STORED_VALUES: usize = 50_000_000;
+
+/// Refuse a run above [`MAX_STORED_VALUES`], saying what would help.
+pub fn check_stored_values(
+    scene: &Scene,
+    segments: &[Segment],
+    opts: &TransientOptions,
+) -> Result<(), String> {
+    let stored = stored_values(scene, segments, opts);
+    if stored <= MAX_STORED_VALUES {
+        return Ok(());
+    }
+    let rows = segments.len() + 1;
+    let states_only = rows.saturating_mul(scene.n_states());
+    let help = if opts.record_losses && states_only <= MAX_STORED_VALUES {
+        "run with --summary-only (no per-row losses), shorten the cycle or use fewer wall patches"
+    } else {
+        "shorten the cycle or use fewer wall patches"
+    };
+    Err(format!(
+        "this run would keep {rows} rows × {} values = {stored} values in memory, more than the \
+         limit of {MAX_STORED_VALUES} (400 MB): {help}",
+        stored / rows
+    ))
+}
+
 /// Integrate `scene` over `segments` (contiguous, increasing). `progress(k, n)` is called after
 /// each segment.
 pub fn integrate(

@@ -14,7 +14,9 @@ use crate::scene::{Inputs, Needs, Scene};
 use crate::solve::drive::{row_inputs, segments};
 use crate::solve::equilibrium::equilibrium;
 use crate::solve::steady::SteadyOptions;
-use crate::solve::transient::{integrate, Method, Restart, TransientOptions, DEFAULT_ATOL, DEFAULT_RTOL};
+use crate::solve::transient::{
+    check_stored_values, integrate, Method, Restart, TransientOptions, DEFAULT_ATOL, DEFAULT_RTOL,
+};
 
 /// Why a job failed: bad input (exit code 1 on the CLI) or a numerical failure (exit code 2).
 #[derive(Debug, Clone, thiserror::Error, PartialEq)]
@@ -128,6 +130,7 @@ pub fn run_cycle(gb: &Gearbox, o: &RunOptions) -> Result<RunResult, JobError> {
         record_losses: !o.summary_only,
         ..TransientOptions::default()
     };
+    check_stored_values(&scene, &segs, &opts).map_err(JobError::Invalid)?;
     let traj =
         integrate(&scene, &segs, &opts, &mut |_, _| {}).map_err(|e| JobError::Numerical(e.to_string()))?;
     let rows = row_inputs(gb, &sched, &traj);
