@@ -13,7 +13,7 @@ use geartherm::cycle::DriveCycle;
 use geartherm::model;
 use geartherm::scene::{Inputs, Needs, Scene};
 use geartherm::solve::drive::segments;
-use geartherm::solve::transient::{integrate, Segment, TransientOptions};
+use geartherm::solve::transient::{integrate, Method, Segment, TransientOptions};
 
 const MODELS: [&str; 4] = [
     "models/at6_lepelletier.toml",
@@ -71,10 +71,13 @@ fn main() {
         let gb = model::load(Path::new(&m)).unwrap();
         let (_, segs) = segments(&gb, &cycle).unwrap();
         let scene = scene_for(&gb, &segs, true);
-        let o = TransientOptions {
+        let mut o = TransientOptions {
             record_losses: false,
             ..TransientOptions::default()
         };
+        if let Some(m) = std::env::var("FLOOR_METHOD").ok().and_then(|m| Method::parse(&m)) {
+            o.method = m;
+        }
         for _ in 0..200 {
             black_box(integrate(&scene, &segs, &o, &mut |_, _| {}).unwrap());
         }
@@ -91,11 +94,14 @@ fn main() {
             ("summary-only, Jacobian from products", true, false),
         ] {
             let scene = scene_for(&gb, &segs, summary);
-            let o = TransientOptions {
+            let mut o = TransientOptions {
                 record_losses: !summary,
                 assembled_jacobian: assembled,
                 ..TransientOptions::default()
             };
+            if let Some(m) = std::env::var("FLOOR_METHOD").ok().and_then(|m| Method::parse(&m)) {
+                o.method = m;
+            }
             // One cached RHS at a mid-cycle sample (the per-sample terms prepared once).
             let mid = segs[segs.len() / 2].inputs;
             let inp = Inputs { ..mid };
@@ -106,6 +112,9 @@ fn main() {
                 scene.rhs(black_box(0.0), black_box(&y), &mut work, &mut dy)
             });
             let n = scene.n_states();
+            if std::env::var_os("FLOOR_NODES").is_some() {
+                eprintln!("{name} {mode}: {} nodes, {} states", scene.nodes(), n);
+            }
             let a = nalgebra::DMatrix::<f64>::from_fn(n, n, |i, j| {
                 if i == j {
                     4.0 + i as f64

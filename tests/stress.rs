@@ -10,7 +10,7 @@ use geartherm::solve::transient::{energy_balance, integrate, Method, Segment, Tr
 mod common;
 use common::{fzg_with, jumpy, scene_of};
 
-const IMPLICIT: [Method; 3] = [Method::Bdf, Method::Esdirk34, Method::TrBdf2];
+const IMPLICIT: [Method; 4] = [Method::Bdf, Method::Esdirk34, Method::TrBdf2, Method::Ros3];
 
 /// Finishes with bounded work and a closed balance, or fails with a named failure.
 fn check(scene: &Scene, segs: &[Segment], o: &TransientOptions, what: &str) {

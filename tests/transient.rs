@@ -14,7 +14,7 @@ use nalgebra::{DMatrix, DVector};
 mod common;
 use common::{film_network, fzg_with, jumpy, steady_inputs};
 
-const IMPLICIT: [Method; 3] = [Method::Bdf, Method::Esdirk34, Method::TrBdf2];
+const IMPLICIT: [Method; 4] = [Method::Bdf, Method::Esdirk34, Method::TrBdf2, Method::Ros3];
 
 fn uniform(inputs: Inputs, n: usize, dt: f64) -> Vec<Segment> {
     (0..n)

@@ -26,7 +26,7 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 1e-10)]
     pub min_rtol: f64,
     /// Solvers (comma-separated).
-    #[arg(long, default_value = "bdf,esdirk34,tr-bdf2,tsit45")]
+    #[arg(long, default_value = "bdf,esdirk34,tr-bdf2,ros3,tsit45")]
     pub solvers: String,
     /// Step budget per run (an explicit solver on a stiff network stops there and is reported).
     #[arg(long, default_value_t = 2_000_000)]

@@ -31,8 +31,8 @@ pub struct RunArgs {
     /// Output directory (default: runs/<model>_<cycle>).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Solver: tr-bdf2 (default), esdirk34, bdf, tsit45.
-    #[arg(long, default_value = "tr-bdf2")]
+    /// Solver: ros3 (default), tr-bdf2, esdirk34, bdf, tsit45.
+    #[arg(long, default_value = geartherm::solve::transient::DEFAULT_METHOD.name())]
     pub solver: String,
     /// Relative tolerance.
     #[arg(long, default_value_t = geartherm::solve::transient::DEFAULT_RTOL)]

@@ -248,6 +248,14 @@ pub enum BoundaryTemp {
 }
 
 impl BoundaryTemp {
+    /// True when the temperature changes with time.
+    pub fn moves(&self) -> bool {
+        match self {
+            BoundaryTemp::Fixed(_) => false,
+            BoundaryTemp::Series(s) => s.windows(2).any(|w| w[0].1 != w[1].1),
+        }
+    }
+
     /// Temperature at time `t`, K.
     pub fn at(&self, t: f64) -> f64 {
         match self {

@@ -44,6 +44,14 @@ pub struct RhsFailure {
     pub what: String,
 }
 
+/// Step of the forward differences in T_oil, K.
+fn oil_step(t_oil: f64) -> f64 {
+    1e-4 * (1.0 + t_oil.abs() / 300.0)
+}
+
+/// Time step of the forward difference of [`Scene::time_derivative`], s.
+pub const TIME_STEP_FD: f64 = 1e-3;
+
 /// The compiled scene.
 #[derive(Debug, Clone)]
 pub struct Scene {
@@ -89,6 +97,11 @@ pub struct Work {
     oil_col: Vec<f64>,
     col_key: Option<(u64, u64)>,
     sample_id: u64,
+    /// The point (t, y, sample) whose heat balance `heat`, `q` and `base_to_b` hold, when they
+    /// do (the finite-difference oil column starts from it instead of evaluating it again).
+    base: Option<(u64, u64)>,
+    base_y: Vec<f64>,
+    base_to_b: f64,
     /// Right-hand-side evaluations.
     pub rhs_evals: usize,
     /// Jacobian column evaluations (finite differences in T_oil).
@@ -216,6 +229,9 @@ impl Scene {
             oil_col: vec![0.0; self.n_states()],
             col_key: None,
             sample_id: 0,
+            base: None,
+            base_y: vec![0.0; n],
+            base_to_b: 0.0,
             rhs_evals: 0,
             jac_evals: 0,
             failure: None,
@@ -259,6 +275,7 @@ impl Scene {
 
     /// Evaluate every loss item (W) at state `y` into `work.q` (also used for output).
     pub fn evaluate_losses(&self, y: &[f64], work: &mut Work) {
+        work.base = None;
         let oil = self.thermal.oil_properties(self.oil_temp(y));
         let op = self.op(&work.inputs, oil);
         self.losses.evaluate_cached(&op, &work.terms, &mut work.q);
@@ -320,6 +337,9 @@ impl Scene {
         for ((d, h), c) in dy.iter_mut().zip(&work.heat).zip(&self.thermal.capacity) {
             *d = h / c;
         }
+        work.base = Some((t.to_bits(), work.sample_id));
+        work.base_y.copy_from_slice(&y[..n]);
+        work.base_to_b = to_b;
         let e = self.energies;
         dy[n..n + e].iter_mut().for_each(|x| *x = 0.0);
         for (q, &slot) in work.q.iter().zip(&self.energy_slot) {
@@ -363,6 +383,7 @@ impl Scene {
     /// Jacobian–vector product `out = J(t, y)·v`. Allocation-free.
     pub fn jvp(&self, t: f64, y: &[f64], v: &[f64], work: &mut Work, out: &mut [f64]) {
         let n = self.nodes();
+        work.base = None;
         self.thermal.boundary_temperatures(t, &mut work.net);
         let oil_i = self.thermal.oil;
         let t_oil = self.oil_temp(y);
@@ -384,7 +405,7 @@ impl Scene {
         if self.frozen_oil_temp.is_some() || v[oil_i] == 0.0 {
             return;
         }
-        self.update_oil_column(y, t_oil, work);
+        self.update_oil_column(t, y, t_oil, work);
         let s = v[oil_i];
         for (o, c) in out.iter_mut().zip(&work.oil_col) {
             *o += c * s;
@@ -393,7 +414,7 @@ impl Scene {
 
     /// ∂f/∂T_oil through the oil properties (all rows of the state), by a forward difference,
     /// cached per (T_oil, sample) in `work.oil_col`.
-    fn update_oil_column(&self, y: &[f64], t_oil: f64, work: &mut Work) {
+    fn update_oil_column(&self, t: f64, y: &[f64], t_oil: f64, work: &mut Work) {
         let n = self.nodes();
         let e = self.energies;
         let key = (t_oil.to_bits(), work.sample_id);
@@ -401,19 +422,27 @@ impl Scene {
             return;
         }
         work.jac_evals += 1;
-        let h = 1e-4 * (1.0 + t_oil.abs() / 300.0);
+        let h = oil_step(t_oil);
         let inputs = work.inputs;
-        let b0 = self.heat_balance(
-            y,
-            t_oil,
-            &inputs,
-            &work.terms,
-            &work.net,
-            &mut work.q2,
-            &mut work.heat2,
-        );
-        work.oil_col[..n].copy_from_slice(&work.heat2);
-        work.q_base.copy_from_slice(&work.q2);
+        let b0 = if work.base == Some((t.to_bits(), work.sample_id)) && work.base_y == y[..n] {
+            // The last right-hand side was evaluated here: start from its heat balance.
+            work.oil_col[..n].copy_from_slice(&work.heat);
+            work.q_base.copy_from_slice(&work.q);
+            work.base_to_b
+        } else {
+            let b = self.heat_balance(
+                y,
+                t_oil,
+                &inputs,
+                &work.terms,
+                &work.net,
+                &mut work.q2,
+                &mut work.heat2,
+            );
+            work.oil_col[..n].copy_from_slice(&work.heat2);
+            work.q_base.copy_from_slice(&work.q2);
+            b
+        };
         // Only the oil properties move (t_oil + h); the node temperatures stay those of y, whose
         // effect is the analytic part.
         let b1 = self.heat_balance(
@@ -471,10 +500,22 @@ impl Scene {
     /// Values of the Jacobian entries of [`Self::jacobian_pattern`], in its order, at (t, y):
     /// ∂(dy_row)/∂y_col. Allocation-free; `vals` has the pattern's length.
     pub fn jacobian_values(&self, t: f64, y: &[f64], work: &mut Work, vals: &mut [f64]) {
+        let k = self.network_partial_values(t, y, work, vals);
+        let col = &mut vals[k..];
+        if self.frozen_oil_temp.is_some() {
+            col.iter_mut().for_each(|x| *x = 0.0);
+        } else {
+            self.update_oil_column(t, y, self.oil_temp(y), work);
+            col.copy_from_slice(&work.oil_col);
+        }
+    }
+
+    /// The network's analytic partials (the head of [`Self::jacobian_pattern`]) into `vals`;
+    /// returns how many were written.
+    fn network_partial_values(&self, t: f64, y: &[f64], work: &mut Work, vals: &mut [f64]) -> usize {
         let n = self.nodes();
         self.thermal.boundary_temperatures(t, &mut work.net);
-        let t_oil = self.oil_temp(y);
-        let oil = self.thermal.oil_properties(t_oil);
+        let oil = self.thermal.oil_properties(self.oil_temp(y));
         let op = Self::operating(&work.inputs);
         let mut k = 0;
         let cap = &self.thermal.capacity;
@@ -486,18 +527,127 @@ impl Scene {
                 };
                 k += 1;
             });
+        k
+    }
+
+    /// As [`Self::jacobian_values`], with the losses' share of the oil column from given slopes
+    /// `dq_dt[k]` = ∂q_k/∂T_oil (W/K) instead of a forward difference of every loss; the links
+    /// whose conductance follows ν(T_oil) are still differenced, which evaluates no loss.
+    pub fn jacobian_values_with_slopes(
+        &self,
+        t: f64,
+        y: &[f64],
+        work: &mut Work,
+        dq_dt: &[f64],
+        vals: &mut [f64],
+    ) {
+        let k = self.network_partial_values(t, y, work, vals);
         let col = &mut vals[k..];
-        if self.frozen_oil_temp.is_some() {
-            col.iter_mut().for_each(|x| *x = 0.0);
-        } else {
-            self.update_oil_column(y, t_oil, work);
-            col.copy_from_slice(&work.oil_col);
+        col.iter_mut().for_each(|x| *x = 0.0);
+        let Some(t_oil) = self.moving_oil_temp(y) else {
+            return;
+        };
+        let n = self.nodes();
+        work.base = None;
+        let h = oil_step(t_oil);
+        let op = Self::operating(&work.inputs);
+        let oil0 = self.thermal.oil_properties(t_oil);
+        let oil1 = self.thermal.oil_properties(t_oil + h);
+        let b0 = self
+            .thermal
+            .network_heat(&y[..n], &oil0, &op, &work.net, &mut work.heat);
+        let b1 = self
+            .thermal
+            .network_heat(&y[..n], &oil1, &op, &work.net, &mut work.heat2);
+        for ((c, h1), h0) in col.iter_mut().zip(&work.heat2).zip(&work.heat) {
+            *c = (h1 - h0) / h;
         }
+        for (d, dest) in dq_dt.iter().zip(&self.thermal.heat) {
+            for &(node, f) in dest {
+                col[node] += f * d;
+            }
+        }
+        for (c, cap) in col.iter_mut().zip(&self.thermal.capacity) {
+            *c /= cap;
+        }
+        for (d, &slot) in dq_dt.iter().zip(&self.energy_slot) {
+            col[n + slot] += d;
+        }
+        col[n + self.energies] = (b1 - b0) / h;
+    }
+
+    /// The oil temperature that sets the properties, when it follows the state (not frozen, not
+    /// held at a clamp bound).
+    fn moving_oil_temp(&self, y: &[f64]) -> Option<f64> {
+        if self.frozen_oil_temp.is_some() {
+            return None;
+        }
+        let t = y[self.thermal.oil];
+        match self.oil_temp_clamp {
+            Some((lo, hi)) if t <= lo || t >= hi => None,
+            _ => Some(t),
+        }
+    }
+
+    /// ∂q_k/∂T_oil of every loss item (W/K) at state `y` with the current inputs, by a forward
+    /// difference (one loss evaluation, or two when the last right-hand side was not at `y`).
+    pub fn loss_slopes(&self, t: f64, y: &[f64], work: &mut Work, out: &mut [f64]) {
+        let Some(t_oil) = self.moving_oil_temp(y) else {
+            out.iter_mut().for_each(|x| *x = 0.0);
+            return;
+        };
+        let n = self.nodes();
+        let h = oil_step(t_oil);
+        if work.base == Some((t.to_bits(), work.sample_id)) && work.base_y == y[..n] {
+            work.q_base.copy_from_slice(&work.q);
+        } else {
+            let op = self.op(&work.inputs, self.thermal.oil_properties(t_oil));
+            self.losses.evaluate_cached(&op, &work.terms, &mut work.q_base);
+        }
+        let op = self.op(&work.inputs, self.thermal.oil_properties(t_oil + h));
+        self.losses.evaluate_cached(&op, &work.terms, &mut work.q2);
+        work.jac_evals += 1;
+        for ((o, q1), q0) in out.iter_mut().zip(&work.q2).zip(&work.q_base) {
+            *o = (q1 - q0) / h;
+        }
+    }
+
+    /// ∂f/∂t at (t, y) into `out`: only boundary temperatures depend on time, so this is the
+    /// network's response to their slope, by a forward difference over [`TIME_STEP_FD`] (boundary
+    /// series are piecewise linear: exact within a piece, and a step starting at a kink sees the
+    /// piece it integrates over). The loss rows are zero. Allocation-free.
+    pub fn time_derivative(&self, t: f64, y: &[f64], work: &mut Work, out: &mut [f64]) {
+        let n = self.nodes();
+        work.base = None;
+        let oil = self.thermal.oil_properties(self.oil_temp(y));
+        let op = Self::operating(&work.inputs);
+        self.thermal.boundary_temperatures(t, &mut work.net);
+        let b0 = self
+            .thermal
+            .network_heat(&y[..n], &oil, &op, &work.net, &mut work.heat);
+        self.thermal
+            .boundary_temperatures(t + TIME_STEP_FD, &mut work.net);
+        let b1 = self
+            .thermal
+            .network_heat(&y[..n], &oil, &op, &work.net, &mut work.heat2);
+        for (((o, h1), h0), cap) in out
+            .iter_mut()
+            .zip(&work.heat2)
+            .zip(&work.heat)
+            .zip(&self.thermal.capacity)
+        {
+            *o = (h1 - h0) / TIME_STEP_FD / cap;
+        }
+        let e = self.energies;
+        out[n..n + e].iter_mut().for_each(|x| *x = 0.0);
+        out[n + e] = (b1 - b0) / TIME_STEP_FD;
+        self.thermal.boundary_temperatures(t, &mut work.net);
     }
 
     /// Heat flow into each node (W) and into boundaries at state `y` with the current inputs (for
     /// the steady-state residual). `heat` has length [`Self::nodes`].
     pub fn net_heat(&self, t: f64, y: &[f64], work: &mut Work, heat: &mut [f64]) -> f64 {
+        work.base = None;
         self.thermal.boundary_temperatures(t, &mut work.net);
         let t_oil = self.oil_temp(y);
         let inputs = work.inputs;

@@ -380,6 +380,11 @@ impl ThermalScene {
         }
     }
 
+    /// True when some boundary temperature changes with time (then f depends on t).
+    pub fn boundaries_move(&self) -> bool {
+        self.boundaries.iter().any(|b| b.moves())
+    }
+
     /// Boundary temperatures at time `t` (call at each RHS evaluation; constant ones are cheap).
     pub fn boundary_temperatures(&self, t: f64, work: &mut NetworkWork) {
         for (x, b) in work.boundary_t.iter_mut().zip(&self.boundaries) {

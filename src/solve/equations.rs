@@ -126,6 +126,24 @@ impl<'s, M: JacobianMatrix> SceneEquations<'s, M> {
         }
     }
 
+    /// The sparsity of the Jacobian and iteration matrices (None for dense matrices).
+    pub fn matrix_sparsity(&self) -> Option<M::Sparsity> {
+        self.sparsity.clone()
+    }
+
+    /// The Jacobian at (t, x) into `m`, with the losses' share of the oil column from the slopes
+    /// `dq_dt` (∂q_k/∂T_oil, W/K; [`Scene::jacobian_values_with_slopes`]).
+    pub fn jacobian_with_slopes(&self, x: &M::V, t: f64, dq_dt: &[f64], m: &mut M) {
+        let mut vals = self.vals.borrow_mut();
+        self.scene
+            .jacobian_values_with_slopes(t, x.host(), &mut self.work.borrow_mut(), dq_dt, &mut vals);
+        let mv = m.values();
+        mv.iter_mut().for_each(|v| *v = 0.0);
+        for (&s, &v) in self.slots.iter().zip(vals.iter()) {
+            mv[s] += v;
+        }
+    }
+
     /// Number of Jacobian entries written per evaluation (repeats included).
     pub fn entries(&self) -> usize {
         self.slots.len()

@@ -1,7 +1,9 @@
 //! Solvers: the transient driver (diffsol) and the steady-state equilibrium search.
+pub mod dense_lu;
 pub mod drive;
 pub mod equations;
 pub mod equilibrium;
+pub mod rosenbrock;
 pub mod sparse_lu;
 pub mod steady;
 pub mod sweep;

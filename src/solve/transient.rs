@@ -20,7 +20,9 @@ use diffsol::{
     FaerSparseMat, NalgebraLU, NalgebraMat, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason,
 };
 
+use super::dense_lu::SmallDenseLu;
 use super::equations::{HostVector, SceneEquations};
+use super::rosenbrock;
 use super::sparse_lu::NetworkSparseLu;
 use crate::scene::{Inputs, Scene, Work};
 
@@ -64,19 +66,29 @@ pub enum Method {
     TrBdf2,
     /// Tsitouras 5(4), explicit (not for stiff networks).
     Tsit45,
+    /// ROS3, three-stage Rosenbrock method of order 3, L-stable, two evaluations of f per step
+    /// ([`super::rosenbrock::ROS3`]).
+    Ros3,
 }
 
 impl Method {
     /// All methods.
-    pub const ALL: [Method; 4] = [Method::Bdf, Method::Esdirk34, Method::TrBdf2, Method::Tsit45];
+    pub const ALL: [Method; 5] = [
+        Method::Bdf,
+        Method::Esdirk34,
+        Method::TrBdf2,
+        Method::Tsit45,
+        Method::Ros3,
+    ];
 
     /// Command-line name.
-    pub fn name(self) -> &'static str {
+    pub const fn name(self) -> &'static str {
         match self {
             Method::Bdf => "bdf",
             Method::Esdirk34 => "esdirk34",
             Method::TrBdf2 => "tr-bdf2",
             Method::Tsit45 => "tsit45",
+            Method::Ros3 => "ros3",
         }
     }
 
@@ -165,7 +177,7 @@ impl Default for Guards {
 }
 
 /// Default method (chosen by the work-precision study, docs/numerics.md).
-pub const DEFAULT_METHOD: Method = Method::TrBdf2;
+pub const DEFAULT_METHOD: Method = Method::Ros3;
 /// Default relative tolerance (docs/numerics.md).
 pub const DEFAULT_RTOL: f64 = 1e-4;
 /// Default absolute tolerance on temperatures, K.
@@ -364,12 +376,21 @@ pub fn integrate(
                     let mut s = problem.tsit45().map_err(fail_build)?;
                     ctx.run(&mut s, &mut traj, progress)?;
                 }
+                Method::Ros3 => {
+                    let r = rosenbrock::run::<$m, $ls>(&ctx, &problem.eqn, &y0, &mut traj, progress)?;
+                    traj.stats.steps = r.steps;
+                    traj.stats.rejected = r.rejected;
+                    traj.stats.lu_factorisations = r.lu;
+                }
             }
         }};
     }
     let sparse = opts.method.is_implicit() && opts.linear_algebra.is_sparse(ns);
+    let rosenbrock = opts.method == Method::Ros3;
     if sparse {
         solve_with!(FaerSparseMat<f64>, NetworkSparseLu);
+    } else if rosenbrock {
+        solve_with!(NalgebraMat<f64>, SmallDenseLu);
     } else {
         solve_with!(NalgebraMat<f64>, NalgebraLU<f64>);
     }
@@ -382,15 +403,84 @@ pub fn integrate(
     Ok(traj)
 }
 
-struct Driver<'s> {
+/// What the integrators share: the scene, its work area, the segments and the tolerances.
+pub(crate) struct Driver<'s> {
     scene: &'s Scene,
     work: &'s RefCell<Work>,
-    segments: &'s [Segment],
-    opts: &'s TransientOptions,
-    atol: &'s [f64],
+    pub(crate) segments: &'s [Segment],
+    pub(crate) opts: &'s TransientOptions,
+    pub(crate) atol: &'s [f64],
 }
 
 impl Driver<'_> {
+    /// `dy = f(t, y)` with the current inputs (the losses stay in the work area).
+    pub(crate) fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
+        self.scene.rhs(t, y, &mut self.work.borrow_mut(), dy);
+    }
+
+    /// ∂f/∂t at (t, y); false (and `out` untouched) when no boundary temperature moves.
+    pub(crate) fn time_derivative(&self, t: f64, y: &[f64], out: &mut [f64]) -> bool {
+        if !self.scene.thermal.boundaries_move() {
+            return false;
+        }
+        self.scene.time_derivative(t, y, &mut self.work.borrow_mut(), out);
+        true
+    }
+
+    /// The losses (W per item) of the last right-hand side, into `out`.
+    pub(crate) fn losses_into(&self, out: &mut [f64]) {
+        out.copy_from_slice(&self.work.borrow().q);
+    }
+
+    /// ∂q_k/∂T_oil of every item at (t, y) by a forward difference.
+    pub(crate) fn loss_slopes(&self, t: f64, y: &[f64], out: &mut [f64]) {
+        self.scene.loss_slopes(t, y, &mut self.work.borrow_mut(), out);
+    }
+
+    /// Number of loss items.
+    pub(crate) fn items(&self) -> usize {
+        self.scene.items()
+    }
+
+    /// Oil temperature that sets the oil properties at state `y`, K.
+    pub(crate) fn oil_temp(&self, y: &[f64]) -> f64 {
+        self.scene.oil_temp(y)
+    }
+
+    /// Switch to the inputs of segment `k`.
+    pub(crate) fn switch_inputs(&self, k: usize) {
+        self.scene
+            .set_inputs(self.segments[k].inputs, &mut self.work.borrow_mut());
+    }
+
+    /// Forget a non-finite trial the integrator recovered from.
+    pub(crate) fn clear_failure(&self) {
+        self.work.borrow_mut().failure = None;
+    }
+
+    /// Record the row at time `t` whose losses [`Self::rhs`] has just evaluated at `y`.
+    pub(crate) fn record_evaluated(&self, traj: &mut Trajectory, t: f64, y: &[f64], seg: usize) {
+        if self.opts.record_losses {
+            traj.losses.push(self.work.borrow().q.clone());
+        }
+        traj.times.push(t);
+        traj.states.push(y.to_vec());
+        traj.segment.push(seg);
+    }
+
+    /// The step budget is spent.
+    pub(crate) fn budget_failure(&self, t: f64, y: &[f64]) -> NumericalFailure {
+        self.failure(
+            t,
+            y,
+            format!(
+                "step budget of {} exceeded (the network is too stiff for {} at this tolerance, or oscillates)",
+                self.opts.max_steps,
+                self.opts.method.name()
+            ),
+        )
+    }
+
     /// Record the row at time `t`: the state and the losses with the current inputs (those of
     /// segment `seg`, which the caller has already switched to).
     fn record(&self, traj: &mut Trajectory, t: f64, y: &[f64], seg: usize) {
@@ -406,7 +496,7 @@ impl Driver<'_> {
 
     /// Failure at the solver's current state: names the node with the largest weighted rate and
     /// the item (non-finite, else the largest loss).
-    fn failure(&self, t: f64, y: &[f64], message: String) -> NumericalFailure {
+    pub(crate) fn failure(&self, t: f64, y: &[f64], message: String) -> NumericalFailure {
         let mut w = self.work.borrow_mut();
         if let Some(f) = w.failure.take() {
             return NumericalFailure {
@@ -444,7 +534,7 @@ impl Driver<'_> {
 
     /// Starting step after a restart (Hairer, Nørsett & Wanner I, II.4), capped by the previous
     /// step and the segment length.
-    fn restart_step(&self, y: &[f64], f: &[f64], h_prev: f64, len: f64) -> f64 {
+    pub(crate) fn restart_step(&self, y: &[f64], f: &[f64], h_prev: f64, len: f64) -> f64 {
         let (mut d0, mut d1) = (0.0, 0.0);
         for ((yi, fi), ai) in y.iter().zip(f).zip(self.atol) {
             let w = ai + self.opts.rtol * yi.abs();
@@ -515,15 +605,7 @@ impl Driver<'_> {
                     + st.number_of_nonlinear_solver_fails;
                 if steps > self.opts.max_steps {
                     let st = solver.state();
-                    return Err(self.failure(
-                        st.t,
-                        st.y.host(),
-                        format!(
-                            "step budget of {} exceeded (the network is too stiff for {} at this tolerance, or oscillates)",
-                            self.opts.max_steps,
-                            self.opts.method.name()
-                        ),
-                    ));
+                    return Err(self.budget_failure(st.t, st.y.host()));
                 }
                 // A derivative that is not finite at the start of a step gives a NaN step size
                 // (diffsol's initial-step estimate, or our restart's), and a NaN step never

@@ -15,7 +15,8 @@ use crate::solve::drive::{row_inputs, segments};
 use crate::solve::equilibrium::equilibrium;
 use crate::solve::steady::SteadyOptions;
 use crate::solve::transient::{
-    check_stored_values, integrate, Method, Restart, TransientOptions, DEFAULT_ATOL, DEFAULT_RTOL,
+    check_stored_values, integrate, Method, Restart, TransientOptions, DEFAULT_ATOL, DEFAULT_METHOD,
+    DEFAULT_RTOL,
 };
 
 /// Why a job failed: bad input (exit code 1 on the CLI) or a numerical failure (exit code 2).
@@ -45,7 +46,7 @@ fn check(name: &str, v: f64, lo: f64, hi: f64, unit: &str) -> Result<(), JobErro
 pub struct RunOptions {
     /// Bundled cycle name or a CSV file.
     pub cycle: String,
-    /// Solver name (tr-bdf2, esdirk34, bdf, tsit45).
+    /// Solver name (ros3, tr-bdf2, esdirk34, bdf, tsit45).
     pub solver: String,
     /// Relative tolerance.
     pub rtol: f64,
@@ -65,7 +66,7 @@ impl Default for RunOptions {
     fn default() -> Self {
         RunOptions {
             cycle: "wltc".into(),
-            solver: "tr-bdf2".into(),
+            solver: DEFAULT_METHOD.name().into(),
             rtol: DEFAULT_RTOL,
             atol: DEFAULT_ATOL,
             initial_temp_c: None,

@@ -1,0 +1,261 @@
+//! Dense LU with partial pivoting for the small iteration matrices of lumped networks (tens of
+//! states), written for them: one column-major buffer, row swaps recorded, no allocation after
+//! `set_sparsity`.
+//!
+//! diffsol's nalgebra LU goes through nalgebra's generic views (one `icamax`, one column swap and
+//! one rank-1 update per pivot, each through a view): measured on the 14-state FZG C scene, its
+//! three triangular solves per Rosenbrock step took 14 % of a WLTC and its factorisation 10 %
+//! (`perf`, docs/performance.md). Algorithm: Golub & Van Loan, *Matrix Computations*, 4th ed.,
+//! Alg. 3.4.1 (Gaussian elimination with partial pivoting, kji form) and §3.1 (triangular
+//! solves).
+
+use diffsol::{MatrixCommon, NalgebraMat, NalgebraVec};
+use diffsol_la::{LaError, LinearOp, LinearSolver};
+
+use super::equations::{HostVector, JacobianMatrix};
+
+/// LU of a small dense iteration matrix. Quadrature states (loss and boundary energies: nothing
+/// depends on them, so their columns of M = I − γhJ are unit vectors) are eliminated first:
+///
+/// ```text
+/// M = | M_NN  0 |    x_N = M_NN⁻¹ b_N,   x_Q = b_Q − M_QN x_N
+///     | M_QN  I |
+/// ```
+///
+/// so only the node block (3–5 nodes in the bundled examples, of 12–37 states) is factorised.
+#[derive(Default)]
+pub struct SmallDenseLu {
+    /// Size of the factorised block.
+    n: usize,
+    /// L (unit, below the diagonal) and U of M_NN, column-major.
+    lu: Vec<f64>,
+    piv: Vec<usize>,
+    /// States of the factorised block, and the quadratures.
+    nodes: Vec<usize>,
+    quads: Vec<usize>,
+    /// M_QN, row-major (one row of `n` per quadrature).
+    m_qn: Vec<f64>,
+    /// The matrix as the operator writes it.
+    a: Option<NalgebraMat<f64>>,
+    /// Scratch for x_N.
+    x_n: std::cell::RefCell<Vec<f64>>,
+    factorised: bool,
+}
+
+impl SmallDenseLu {
+    /// Split the states of the column-major `n_all`² matrix `m` into quadratures (unit columns)
+    /// and the rest, keeping the last split while its quadrature columns are still unit vectors,
+    /// and gather M_NN and M_QN.
+    fn gather(&mut self, m: &[f64], n_all: usize) {
+        let unit = |j: usize| {
+            let c = &m[j * n_all..(j + 1) * n_all];
+            c[j] == 1.0 && c[..j].iter().chain(&c[j + 1..]).all(|v| *v == 0.0)
+        };
+        let split_holds = self.nodes.len() + self.quads.len() == n_all && self.quads.iter().all(|&j| unit(j));
+        if !split_holds {
+            self.nodes.clear();
+            self.quads.clear();
+            for j in 0..n_all {
+                if unit(j) {
+                    self.quads.push(j);
+                } else {
+                    self.nodes.push(j);
+                }
+            }
+        }
+        let n = self.nodes.len();
+        self.n = n;
+        self.lu.resize(n * n, 0.0);
+        self.piv.resize(n, 0);
+        self.m_qn.resize(self.quads.len() * n, 0.0);
+        for (b, &j) in self.nodes.iter().enumerate() {
+            let c = &m[j * n_all..(j + 1) * n_all];
+            for (a, &i) in self.nodes.iter().enumerate() {
+                self.lu[b * n + a] = c[i];
+            }
+            for (r, &i) in self.quads.iter().enumerate() {
+                self.m_qn[r * n + b] = c[i];
+            }
+        }
+    }
+
+    fn factor(&mut self) -> bool {
+        let n = self.n;
+        let a = &mut self.lu;
+        for k in 0..n {
+            let col = k * n;
+            let (mut p, mut big) = (k, 0.0);
+            for (i, v) in a[col + k..col + n].iter().enumerate() {
+                if v.abs() > big {
+                    (p, big) = (k + i, v.abs());
+                }
+            }
+            self.piv[k] = p;
+            if !(big > 0.0 && big.is_finite()) {
+                return false;
+            }
+            if p != k {
+                for j in 0..n {
+                    a.swap(j * n + k, j * n + p);
+                }
+            }
+            let d = 1.0 / a[col + k];
+            a[col + k + 1..col + n].iter_mut().for_each(|v| *v *= d);
+            // Columns right of k: a_j[k+1..] −= l_k[k+1..] · u_kj.
+            let (left, right) = a.split_at_mut((k + 1) * n);
+            let l = &left[col + k + 1..col + n];
+            for cj in right.chunks_exact_mut(n) {
+                let ukj = cj[k];
+                if ukj != 0.0 {
+                    for (x, li) in cj[k + 1..].iter_mut().zip(l) {
+                        *x -= li * ukj;
+                    }
+                }
+            }
+        }
+        true
+    }
+
+    fn solve(&self, x: &mut [f64]) {
+        let n = self.n;
+        for (k, &p) in self.piv.iter().enumerate() {
+            x.swap(k, p);
+        }
+        for (j, cj) in self.lu.chunks_exact(n).enumerate() {
+            let xj = x[j];
+            if xj != 0.0 {
+                for (xi, l) in x[j + 1..].iter_mut().zip(&cj[j + 1..]) {
+                    *xi -= l * xj;
+                }
+            }
+        }
+        for (j, cj) in self.lu.chunks_exact(n).enumerate().rev() {
+            x[j] /= cj[j];
+            let xj = x[j];
+            for (xi, u) in x[..j].iter_mut().zip(&cj[..j]) {
+                *xi -= u * xj;
+            }
+        }
+    }
+}
+
+type Mat = NalgebraMat<f64>;
+
+impl LinearSolver<Mat> for SmallDenseLu {
+    fn set_sparsity<C: LinearOp<T = f64, V = NalgebraVec<f64>, M = Mat, C = diffsol::NalgebraContext>>(
+        &mut self,
+        op: &C,
+    ) {
+        let n = op.nrows();
+        self.n = n;
+        self.lu = vec![0.0; n * n];
+        self.piv = vec![0; n];
+        self.nodes = Vec::with_capacity(n);
+        self.quads = Vec::with_capacity(n);
+        self.m_qn = Vec::with_capacity(n * n);
+        self.x_n = std::cell::RefCell::new(vec![0.0; n]);
+        self.a = Some(<Mat as diffsol::Matrix>::zeros(n, n, *op.context()));
+        self.factorised = false;
+    }
+
+    fn set_linearisation<
+        C: LinearOp<T = f64, V = NalgebraVec<f64>, M = Mat, C = diffsol::NalgebraContext>,
+    >(
+        &mut self,
+        op: &C,
+    ) {
+        let Some(a) = self.a.as_mut() else {
+            self.factorised = false;
+            return;
+        };
+        op.matrix_inplace(a);
+        let n_all = a.nrows();
+        let mut a = self.a.take();
+        if let Some(m) = a.as_mut() {
+            self.gather(<Mat as JacobianMatrix>::values(m), n_all);
+        }
+        self.a = a;
+        self.factorised = self.factor();
+    }
+
+    fn solve_in_place(&self, x: &mut NalgebraVec<f64>) -> Result<(), LaError> {
+        if !self.factorised {
+            return Err(LaError::Other(
+                "LU of the iteration matrix failed (singular or not finite)".into(),
+            ));
+        }
+        let x = x.host_mut();
+        let mut x_n = self.x_n.borrow_mut();
+        let n = self.n;
+        x_n.resize(n, 0.0);
+        for (v, &i) in x_n.iter_mut().zip(&self.nodes) {
+            *v = x[i];
+        }
+        self.solve(&mut x_n);
+        for (v, &i) in x_n.iter().zip(&self.nodes) {
+            x[i] = *v;
+        }
+        for (row, &q) in self.m_qn.chunks_exact(n.max(1)).zip(&self.quads) {
+            x[q] -= row.iter().zip(x_n.iter()).map(|(m, v)| m * v).sum::<f64>();
+        }
+        Ok(())
+    }
+
+    fn solve_transpose_in_place(&self, _x: &mut NalgebraVec<f64>) -> Result<(), LaError> {
+        Err(LaError::Other(
+            "transpose solves are not supported by the small dense LU".into(),
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solves_a_pivoting_system_to_rounding() {
+        let n = 7;
+        let mut lu = SmallDenseLu {
+            n,
+            lu: vec![0.0; n * n],
+            piv: vec![0; n],
+            ..SmallDenseLu::default()
+        };
+        // A zero leading entry forces a row swap; off-diagonals make it non-trivial.
+        let a = |i: usize, j: usize| {
+            if i == 0 && j == 0 {
+                0.0
+            } else if i == j {
+                3.0 + i as f64
+            } else {
+                1.0 / (1.0 + (i + 2 * j) as f64)
+            }
+        };
+        for j in 0..n {
+            for i in 0..n {
+                lu.lu[j * n + i] = a(i, j);
+            }
+        }
+        assert!(lu.factor());
+        let x_true: Vec<f64> = (0..n).map(|i| 1.0 + i as f64 * 0.5).collect();
+        let mut b: Vec<f64> = (0..n)
+            .map(|i| (0..n).map(|j| a(i, j) * x_true[j]).sum())
+            .collect();
+        lu.solve(&mut b);
+        for (x, t) in b.iter().zip(&x_true) {
+            assert!((x - t).abs() < 1e-13, "{x} vs {t}");
+        }
+    }
+
+    #[test]
+    fn a_singular_matrix_is_reported_not_solved() {
+        let n = 3;
+        let mut lu = SmallDenseLu {
+            n,
+            lu: vec![1.0, 2.0, 3.0, 2.0, 4.0, 6.0, 0.0, 0.0, 0.0],
+            piv: vec![0; n],
+            ..SmallDenseLu::default()
+        };
+        assert!(!lu.factor());
+    }
+}
