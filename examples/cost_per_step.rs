@@ -15,7 +15,7 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use geartherm::report::plots::style;
-use geartherm::solve::transient::{integrate, LinearAlgebra, TransientOptions};
+use geartherm::solve::transient::{integrate, LinearAlgebra, Method, TransientOptions};
 
 const SIZES: [usize; 9] = [0, 10, 20, 30, 50, 100, 200, 500, 1000];
 
@@ -66,11 +66,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let gb = wall::at6_with(&extra);
         let (scene, segs) = wall::wltc_scene(&gb);
         let run = |la: LinearAlgebra| {
-            let o = TransientOptions {
+            let mut o = TransientOptions {
                 record_losses: false,
                 linear_algebra: la,
                 ..TransientOptions::default()
             };
+            // TR-BDF2 throughout (what `auto` uses above 24 nodes), so that the curve shows how the
+            // linear algebra scales; COST_METHOD=ros3 for the other method.
+            o.method = std::env::var("COST_METHOD")
+                .ok()
+                .and_then(|m| Method::parse(&m))
+                .unwrap_or(Method::TrBdf2);
             let c0 = cpu_time();
             let t = integrate(&scene, &segs, &o, &mut |_, _| {});
             (t, cpu_time() - c0)

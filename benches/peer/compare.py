@@ -143,7 +143,7 @@ def _main(root, exe, reps, quick, tmp):
     results = []
     # ---- 3. geartherm sweep ----------------------------------------------------------------
     g_rtols = (1e-4, 1e-6, 1e-8) if quick else (1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
-    for solver in ("tr-bdf2", "esdirk34", "bdf"):
+    for solver in ("ros3", "tr-bdf2", "esdirk34", "bdf"):
         for rt in g_rtols:
             runs = []
             for k in range(reps):

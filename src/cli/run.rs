@@ -31,7 +31,8 @@ pub struct RunArgs {
     /// Output directory (default: runs/<model>_<cycle>).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Solver: ros3 (default), tr-bdf2, esdirk34, bdf, tsit45.
+    /// Solver: auto (default: ros3 up to 24 nodes, tr-bdf2 above), ros3, tr-bdf2, esdirk34, bdf,
+    /// tsit45.
     #[arg(long, default_value = geartherm::solve::transient::DEFAULT_METHOD.name())]
     pub solver: String,
     /// Relative tolerance.

@@ -258,4 +258,44 @@ mod tests {
         };
         assert!(!lu.factor());
     }
+
+    #[test]
+    fn quadrature_columns_are_eliminated_exactly() {
+        use diffsol::Vector;
+        let n = 5;
+        // Columns 1 and 3 are unit vectors (quadratures); rows 1 and 3 read the other states.
+        let a = |i: usize, j: usize| -> f64 {
+            if j == 1 || j == 3 {
+                f64::from(u8::from(i == j))
+            } else if i == j {
+                4.0 + i as f64
+            } else {
+                0.3 / (1.0 + (i + 2 * j) as f64)
+            }
+        };
+        let mut m = vec![0.0; n * n];
+        for j in 0..n {
+            for i in 0..n {
+                m[j * n + i] = a(i, j);
+            }
+        }
+        let mut lu = SmallDenseLu::default();
+        lu.gather(&m, n);
+        assert_eq!(lu.quads, vec![1, 3]);
+        assert_eq!(lu.nodes, vec![0, 2, 4]);
+        lu.factorised = lu.factor();
+        let x_true: Vec<f64> = (0..n).map(|i| 2.0 - 0.7 * i as f64).collect();
+        let mut v = NalgebraVec::<f64>::zeros(n, Default::default());
+        for (i, b) in v.host_mut().iter_mut().enumerate() {
+            *b = (0..n).map(|j| a(i, j) * x_true[j]).sum();
+        }
+        lu.solve_in_place(&mut v).unwrap();
+        for (x, t) in v.host().iter().zip(&x_true) {
+            assert!((x - t).abs() < 1e-13, "{x} vs {t}");
+        }
+        // A quadrature column that stops being a unit vector is caught at the next gather.
+        m[n + 2] = 0.5;
+        lu.gather(&m, n);
+        assert_eq!(lu.quads, vec![3]);
+    }
 }

@@ -16,9 +16,7 @@
 use std::cell::RefCell;
 use std::time::Instant;
 
-use diffsol::{
-    FaerSparseMat, NalgebraLU, NalgebraMat, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason,
-};
+use diffsol::{FaerSparseMat, NalgebraMat, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason};
 
 use super::dense_lu::SmallDenseLu;
 use super::equations::{HostVector, SceneEquations};
@@ -69,16 +67,25 @@ pub enum Method {
     /// ROS3, three-stage Rosenbrock method of order 3, L-stable, two evaluations of f per step
     /// ([`super::rosenbrock::ROS3`]).
     Ros3,
+    /// ROS3 for networks of up to [`ROS3_MAX_NODES`] nodes, TR-BDF2 above (the default).
+    Auto,
 }
+
+/// Largest network (capacity nodes) [`Method::Auto`] integrates with ROS3. ROS3 factorises the
+/// node block at every step, TR-BDF2 keeps its LU over ≈ 7 steps: measured on the AT6 with a
+/// meshed housing over the WLTC (docs/numerics.md, "ROS3"), ROS3 is 1.2–1.3× faster up to 15
+/// nodes, the two tie at 20–25 nodes, and TR-BDF2 wins above (1.15× at 30–35 nodes, 4× at 1005).
+pub const ROS3_MAX_NODES: usize = 24;
 
 impl Method {
     /// All methods.
-    pub const ALL: [Method; 5] = [
+    pub const ALL: [Method; 6] = [
         Method::Bdf,
         Method::Esdirk34,
         Method::TrBdf2,
         Method::Tsit45,
         Method::Ros3,
+        Method::Auto,
     ];
 
     /// Command-line name.
@@ -89,6 +96,7 @@ impl Method {
             Method::TrBdf2 => "tr-bdf2",
             Method::Tsit45 => "tsit45",
             Method::Ros3 => "ros3",
+            Method::Auto => "auto",
         }
     }
 
@@ -102,6 +110,15 @@ impl Method {
     /// True for implicit methods.
     pub fn is_implicit(self) -> bool {
         self != Method::Tsit45
+    }
+
+    /// The method used for a network of `nodes` capacity nodes ([`Method::Auto`] resolved).
+    pub fn resolve(self, nodes: usize) -> Method {
+        match self {
+            Method::Auto if nodes <= ROS3_MAX_NODES => Method::Ros3,
+            Method::Auto => Method::TrBdf2,
+            m => m,
+        }
     }
 }
 
@@ -177,7 +194,7 @@ impl Default for Guards {
 }
 
 /// Default method (chosen by the work-precision study, docs/numerics.md).
-pub const DEFAULT_METHOD: Method = Method::Ros3;
+pub const DEFAULT_METHOD: Method = Method::Auto;
 /// Default relative tolerance (docs/numerics.md).
 pub const DEFAULT_RTOL: f64 = 1e-4;
 /// Default absolute tolerance on temperatures, K.
@@ -223,6 +240,8 @@ pub struct Stats {
     pub samples_prepared: usize,
     /// True when the Newton iterations used the sparse LU.
     pub sparse: bool,
+    /// The method that integrated (`auto` resolved).
+    pub method: &'static str,
 }
 
 /// The result: the state at every segment boundary, and the losses there.
@@ -314,6 +333,7 @@ pub fn integrate(
         message: "empty input: no segment to integrate".into(),
     })?;
     let n = scene.nodes();
+    let method = opts.method.resolve(n);
     let ns = scene.n_states();
     let y0 = scene.initial_state(opts.initial_temp);
     let mean_c = scene.thermal.capacity.iter().sum::<f64>() / n as f64;
@@ -359,7 +379,7 @@ pub fn integrate(
                 // no single step can retry beyond it (a NaN step size never gets "too small").
                 problem.ode_options.max_nonlinear_solver_failures = opts.max_steps;
             }
-            match opts.method {
+            match method {
                 Method::Bdf => {
                     let mut s = problem.bdf::<$ls>().map_err(fail_build)?;
                     ctx.run(&mut s, &mut traj, progress)?;
@@ -376,7 +396,8 @@ pub fn integrate(
                     let mut s = problem.tsit45().map_err(fail_build)?;
                     ctx.run(&mut s, &mut traj, progress)?;
                 }
-                Method::Ros3 => {
+                // `method` is resolved: Auto is never seen here.
+                Method::Ros3 | Method::Auto => {
                     let r = rosenbrock::run::<$m, $ls>(&ctx, &problem.eqn, &y0, &mut traj, progress)?;
                     traj.stats.steps = r.steps;
                     traj.stats.rejected = r.rejected;
@@ -385,16 +406,14 @@ pub fn integrate(
             }
         }};
     }
-    let sparse = opts.method.is_implicit() && opts.linear_algebra.is_sparse(ns);
-    let rosenbrock = opts.method == Method::Ros3;
+    let sparse = method.is_implicit() && opts.linear_algebra.is_sparse(ns);
     if sparse {
         solve_with!(FaerSparseMat<f64>, NetworkSparseLu);
-    } else if rosenbrock {
-        solve_with!(NalgebraMat<f64>, SmallDenseLu);
     } else {
-        solve_with!(NalgebraMat<f64>, NalgebraLU<f64>);
+        solve_with!(NalgebraMat<f64>, SmallDenseLu);
     }
     traj.stats.sparse = sparse;
+    traj.stats.method = method.name();
     let w = work.borrow();
     traj.stats.rhs_evals = w.rhs_evals;
     traj.stats.jac_evals = w.jac_evals;
@@ -476,7 +495,7 @@ impl Driver<'_> {
             format!(
                 "step budget of {} exceeded (the network is too stiff for {} at this tolerance, or oscillates)",
                 self.opts.max_steps,
-                self.opts.method.name()
+                self.opts.method.resolve(self.scene.nodes()).name()
             ),
         )
     }

@@ -189,7 +189,9 @@ pub fn sweep(
                 max_steps,
                 ..TransientOptions::default()
             };
-            let is_default = m == DEFAULT_METHOD && (rt / DEFAULT_RTOL - 1.0).abs() < 1e-9;
+            let n = scene.nodes();
+            let is_default =
+                m.resolve(n) == DEFAULT_METHOD.resolve(n) && (rt / DEFAULT_RTOL - 1.0).abs() < 1e-9;
             let row = point(scene, segs, reference, &o, repeats, is_default);
             on_row(&row);
             rows.push(row);

@@ -46,7 +46,7 @@ fn check(name: &str, v: f64, lo: f64, hi: f64, unit: &str) -> Result<(), JobErro
 pub struct RunOptions {
     /// Bundled cycle name or a CSV file.
     pub cycle: String,
-    /// Solver name (ros3, tr-bdf2, esdirk34, bdf, tsit45).
+    /// Solver name (auto, ros3, tr-bdf2, esdirk34, bdf, tsit45).
     pub solver: String,
     /// Relative tolerance.
     pub rtol: f64,

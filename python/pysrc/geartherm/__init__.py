@@ -180,7 +180,7 @@ class Model:
         self,
         cycle: str = "wltc",
         *,
-        solver: str = "ros3",
+        solver: str = "auto",
         rtol: Optional[float] = None,
         atol: Optional[float] = None,
         initial_temp_c: Optional[float] = None,
