@@ -2,6 +2,10 @@
 //! the iteration matrix's size), against the WLTC integration as `geartherm run` does it
 //! (per-item energies, losses recorded per row) and as `run --summary-only` does it.
 //!
+//! Also the per-sample preparation (`prepare_us`) and `two_rhs_bound` = (2 RHS + preparation) /
+//! (RHS + LU): the ratio a method with two RHS calls per step, one step per sample and no other
+//! cost would reach (ROS3, the default on these examples, makes two RHS calls per step).
+//!
 //! `cargo run --release --example floor` — CPU time of this thread (the 2-core machine is shared:
 //! wall time includes waiting for a core), medians of repeats. `FLOOR_REPEATS` (default 7) and
 //! `FLOOR_PROFILE=model.toml` (integrate that model 200 times, for `perf record`).
@@ -83,7 +87,9 @@ fn main() {
         }
         return;
     }
-    println!("model,mode,states,samples,steps,rhs_evals,lu,rhs_us,lu_us,floor_ms,wltc_ms,ratio");
+    println!(
+        "model,mode,states,samples,steps,rhs_evals,lu,rhs_us,lu_us,prepare_us,floor_ms,wltc_ms,ratio,two_rhs_bound"
+    );
     for m in MODELS {
         let gb = model::load(Path::new(m)).unwrap();
         let name = Path::new(m).file_stem().unwrap().to_string_lossy().into_owned();
@@ -125,6 +131,14 @@ fn main() {
             let lu = per_call(2_000, repeats, || {
                 black_box(black_box(a.clone()).lu());
             });
+            // The per-sample preparation (speed- and load-dependent loss terms, conductances),
+            // alternating between two samples so that nothing is reused.
+            let other = segs[segs.len() / 2 + 1].inputs;
+            let mut flip = false;
+            let prepare = per_call(20_000, repeats, || {
+                flip = !flip;
+                scene.set_inputs(if flip { other } else { mid }, &mut work);
+            });
             let mut times = Vec::new();
             let mut last = None;
             for _ in 0..repeats {
@@ -137,13 +151,17 @@ fn main() {
             let wltc = median(times);
             let samples = segs.len();
             let floor = samples as f64 * (rhs + lu);
+            // What a method with two RHS calls per step and one preparation per sample would
+            // cost at one step per sample and nothing else, against the floor.
+            let bound = (2.0 * rhs + prepare) / (rhs + lu);
             println!(
-                "{name},{mode},{n},{samples},{},{},{},{:.3},{:.3},{:.3},{:.3},{:.2}",
+                "{name},{mode},{n},{samples},{},{},{},{:.3},{:.3},{:.3},{:.3},{:.3},{:.2},{bound:.2}",
                 t.stats.steps,
                 t.stats.rhs_evals,
                 t.stats.lu_factorisations,
                 rhs * 1e6,
                 lu * 1e6,
+                prepare * 1e6,
                 floor * 1e3,
                 wltc * 1e3,
                 wltc / floor

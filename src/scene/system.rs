@@ -548,19 +548,15 @@ impl Scene {
             return;
         };
         let n = self.nodes();
-        work.base = None;
-        let h = oil_step(t_oil);
-        let op = Self::operating(&work.inputs);
-        let oil0 = self.thermal.oil_properties(t_oil);
-        let oil1 = self.thermal.oil_properties(t_oil + h);
-        let b0 = self
-            .thermal
-            .network_heat(&y[..n], &oil0, &op, &work.net, &mut work.heat);
-        let b1 = self
-            .thermal
-            .network_heat(&y[..n], &oil1, &op, &work.net, &mut work.heat2);
-        for ((c, h1), h0) in col.iter_mut().zip(&work.heat2).zip(&work.heat) {
-            *c = (h1 - h0) / h;
+        let mut to_b = 0.0;
+        if self.thermal.has_oil_links() {
+            let h = oil_step(t_oil);
+            let op = Self::operating(&work.inputs);
+            let oil0 = self.thermal.oil_properties(t_oil);
+            let oil1 = self.thermal.oil_properties(t_oil + h);
+            to_b =
+                self.thermal
+                    .oil_property_derivative(&y[..n], &oil0, &oil1, h, &op, &work.net, &mut col[..n]);
         }
         for (d, dest) in dq_dt.iter().zip(&self.thermal.heat) {
             for &(node, f) in dest {
@@ -573,7 +569,7 @@ impl Scene {
         for (d, &slot) in dq_dt.iter().zip(&self.energy_slot) {
             col[n + slot] += d;
         }
-        col[n + self.energies] = (b1 - b0) / h;
+        col[n + self.energies] = to_b;
     }
 
     /// The oil temperature that sets the properties, when it follows the state (not frozen, not

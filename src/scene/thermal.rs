@@ -464,6 +464,30 @@ impl ThermalScene {
         l.area * rotating_disc_h(w, l.radius, &fluid)
     }
 
+    /// ∂(network heat)/∂T_oil through the oil properties alone (the rotating-in-oil links), by a
+    /// forward difference between the properties `oil0` at T_oil and `oil1` at T_oil + `dt`:
+    /// adds W/K per node into `col`, returns the boundary share. The other terms do not depend on
+    /// the oil properties.
+    pub fn oil_property_derivative(
+        &self,
+        temps: &[f64],
+        oil0: &OilProperties,
+        oil1: &OilProperties,
+        dt: f64,
+        op: &Operating,
+        work: &NetworkWork,
+        col: &mut [f64],
+    ) -> f64 {
+        let bt = &work.boundary_t;
+        let mut to_b = 0.0;
+        for l in &self.oil_links {
+            let dg = (self.oil_link_conductance(l, oil1, op) - self.oil_link_conductance(l, oil0, op)) / dt;
+            let dq = dg * (Self::temp(l.a, temps, bt) - Self::temp(l.b, temps, bt));
+            Self::flow(l.a, l.b, dq, col, &mut to_b);
+        }
+        to_b
+    }
+
     /// True when some network term depends on the oil properties (rotating parts in oil).
     pub fn has_oil_links(&self) -> bool {
         !self.oil_links.is_empty()

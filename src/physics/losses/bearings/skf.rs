@@ -105,8 +105,25 @@ pub struct Skf {
     drag1: f64,
     drag2: f64,
     dm2_ft: f64,
+    /// (d_m² f_t)^−1.379 of the drag term (0 without drag).
+    dm2_ft_pow: f64,
+    /// The d_m powers of G_rr and G_sl ([`dm_powers`]).
+    dm_pow: [f64; 4],
     /// K_rs·(d + D)·√(K_z/(2(D − d))): φ_rs = exp(−this·ν·n).
     rs: f64,
+}
+
+/// The powers of d_m in G_rr and G_sl, fixed per bearing (computed once, not per cycle sample):
+/// [G_rr, G_sl, G_sl of a deep-groove bearing under axial load, d_m^1.5 of that form].
+fn dm_powers(kind: SkfKind, dm: f64) -> [f64; 4] {
+    match kind {
+        SkfKind::DeepGrooveBall => [dm.powf(1.96), dm.powf(-0.26), dm.powf(-0.145), dm.powf(1.5)],
+        SkfKind::AngularContactBall | SkfKind::FourPointContactBall => {
+            [dm.powf(1.97), dm.powf(0.26), 0.0, 0.0]
+        }
+        SkfKind::CylindricalRoller => [dm.powf(2.41), dm.powf(0.9), 0.0, 0.0],
+        SkfKind::TaperedRoller => [dm.powf(2.38), dm.powf(0.82), 0.0, 0.0],
+    }
 }
 
 /// Lubrication method (sets K_rs).
@@ -223,6 +240,8 @@ impl Skf {
             drag1,
             drag2,
             dm2_ft,
+            dm2_ft_pow: if dm2_ft > 0.0 { dm2_ft.powf(-1.379) } else { 0.0 },
+            dm_pow: dm_powers(i.kind, dm),
             rs: match i.lubrication {
                 Lubrication::OilBath => 3e-8,
                 Lubrication::Grease => 6e-8,
@@ -234,40 +253,34 @@ impl Skf {
     /// G_rr and G_sl at speed `n` (r/min) and `load`.
     pub fn load_terms(&self, n: f64, load: BearingLoad) -> LoadTerms {
         let (fr, fa) = (load.radial.abs(), load.axial.abs());
-        let (c, dm) = (&self.c, self.dm);
+        let (c, dm, p) = (&self.c, self.dm, &self.dm_pow);
         let (g_rr, g_sl) = match self.kind {
             SkfKind::DeepGrooveBall if fa > 0.0 && self.c0 > 0.0 => {
                 let sin_af = (24.6 * (fa / self.c0).powf(0.24)).min(90.0).to_radians().sin();
                 (
-                    c.r1 * dm.powf(1.96) * (fr + c.r2 / sin_af * fa).powf(0.54),
-                    c.s1 * dm.powf(-0.145) * (fr.powi(5) + c.s2 * dm.powf(1.5) / sin_af * fa.powi(4)).cbrt(),
+                    c.r1 * p[0] * (fr + c.r2 / sin_af * fa).powf(0.54),
+                    c.s1 * p[2] * (fr.powi(5) + c.s2 * p[3] / sin_af * fa.powi(4)).cbrt(),
                 )
             }
-            SkfKind::DeepGrooveBall => (
-                c.r1 * dm.powf(1.96) * fr.powf(0.54),
-                c.s1 * dm.powf(-0.26) * fr.powf(5.0 / 3.0),
-            ),
+            SkfKind::DeepGrooveBall => (c.r1 * p[0] * fr.powf(0.54), c.s1 * p[1] * fr.powf(5.0 / 3.0)),
             SkfKind::AngularContactBall | SkfKind::FourPointContactBall => {
                 let dm4n2 = dm.powi(4) * n * n;
                 (
-                    c.r1 * dm.powf(1.97) * (fr + c.r3 * dm4n2 + c.r2 * fa).powf(0.54),
-                    c.s1 * dm.powf(0.26) * ((fr + c.s3 * dm4n2).powf(4.0 / 3.0) + c.s2 * fa.powf(4.0 / 3.0)),
+                    c.r1 * p[0] * (fr + c.r3 * dm4n2 + c.r2 * fa).powf(0.54),
+                    c.s1 * p[1] * ((fr + c.s3 * dm4n2).powf(4.0 / 3.0) + c.s2 * fa.powf(4.0 / 3.0)),
                 )
             }
-            SkfKind::CylindricalRoller => (
-                c.r1 * dm.powf(2.41) * fr.powf(0.31),
-                c.s1 * dm.powf(0.9) * fa + c.s2 * dm * fr,
-            ),
+            SkfKind::CylindricalRoller => (c.r1 * p[0] * fr.powf(0.31), c.s1 * p[1] * fa + c.s2 * dm * fr),
             // r2 and s2 carry Y (folded in by `new`).
             SkfKind::TaperedRoller => (
-                c.r1 * dm.powf(2.38) * (fr + c.r2 * fa).powf(0.31),
-                c.s1 * dm.powf(0.82) * (fr + c.s2 * fa),
+                c.r1 * p[0] * (fr + c.r2 * fa).powf(0.31),
+                c.s1 * p[1] * (fr + c.s2 * fa),
             ),
         };
         let drag = if self.drag2 > 0.0 && n > 0.0 {
             // n²·(n·f_t dm²)^-1.379 written as one power of n: at vanishing speed n² underflows
             // to 0 while (n·f_t dm²)^-1.379 overflows, and 0·∞ is NaN.
-            n.powf(2.0 - 1.379) * self.dm2_ft.powf(-1.379)
+            n.powf(2.0 - 1.379) * self.dm2_ft_pow
         } else {
             0.0
         };
