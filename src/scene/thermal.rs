@@ -465,19 +465,23 @@ impl ThermalScene {
     }
 
     /// ∂(network heat)/∂T_oil through the oil properties alone (the rotating-in-oil links), by a
-    /// forward difference between the properties `oil0` at T_oil and `oil1` at T_oil + `dt`:
-    /// adds W/K per node into `col`, returns the boundary share. The other terms do not depend on
-    /// the oil properties.
+    /// forward difference between the oil properties at `t_oil` and at `t_oil + dt`: adds W/K per
+    /// node into `col`, returns the boundary share. The other terms do not depend on the oil
+    /// properties.
     pub fn oil_property_derivative(
         &self,
         temps: &[f64],
-        oil0: &OilProperties,
-        oil1: &OilProperties,
+        t_oil: f64,
         dt: f64,
         op: &Operating,
         work: &NetworkWork,
         col: &mut [f64],
     ) -> f64 {
+        if self.oil_links.is_empty() {
+            return 0.0;
+        }
+        let (oil0, oil1) = (self.oil_properties(t_oil), self.oil_properties(t_oil + dt));
+        let (oil0, oil1) = (&oil0, &oil1);
         let bt = &work.boundary_t;
         let mut to_b = 0.0;
         for l in &self.oil_links {
