@@ -548,16 +548,15 @@ impl Scene {
             return;
         };
         let n = self.nodes();
-        let mut to_b = 0.0;
-        if self.thermal.has_oil_links() {
-            let h = oil_step(t_oil);
-            let op = Self::operating(&work.inputs);
-            let oil0 = self.thermal.oil_properties(t_oil);
-            let oil1 = self.thermal.oil_properties(t_oil + h);
-            to_b =
-                self.thermal
-                    .oil_property_derivative(&y[..n], &oil0, &oil1, h, &op, &work.net, &mut col[..n]);
-        }
+        let op = Self::operating(&work.inputs);
+        let to_b = self.thermal.oil_property_derivative(
+            &y[..n],
+            t_oil,
+            oil_step(t_oil),
+            &op,
+            &work.net,
+            &mut col[..n],
+        );
         for (d, dest) in dq_dt.iter().zip(&self.thermal.heat) {
             for &(node, f) in dest {
                 col[node] += f * d;
