@@ -13,7 +13,7 @@ use geartherm::scene::{Inputs, Needs, Scene};
 use geartherm::solve::drive::segments;
 use geartherm::solve::equilibrium::equilibrium;
 use geartherm::solve::steady::SteadyOptions;
-use geartherm::solve::transient::{integrate, LinearAlgebra, TransientOptions};
+use geartherm::solve::transient::{integrate, LinearAlgebra, Method, TransientOptions};
 
 #[path = "../tests/common/wall.rs"]
 mod wall;
@@ -114,7 +114,10 @@ fn networks(c: &mut Criterion) {
             if la == LinearAlgebra::Dense && n > 200 {
                 continue; // 1.5 s and more per run
             }
+            // TR-BDF2 at every size (what `auto` uses above 24 nodes), so that the curve shows
+            // how the linear algebra scales.
             let o = TransientOptions {
+                method: Method::TrBdf2,
                 record_losses: false,
                 linear_algebra: la,
                 ..TransientOptions::default()

@@ -32,7 +32,8 @@ use std::cell::RefCell;
 use diffsol::{FaerContext, FaerSparseMat, FaerVec, Matrix, MatrixCommon, Vector};
 use diffsol_la::{LaError, LinearOp, LinearSolver};
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, SymbolicLu};
+use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, LuSymbolicParams, NumericLu, SymbolicLu};
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par};
 
@@ -184,7 +185,7 @@ impl LinearSolver<FaerSparseMat<f64>> for NetworkSparseLu {
         let ns = s_index.len();
         let ss_sym = SymbolicSparseColMat::new_checked(ns, ns, ss_cp, None, ss_ri);
         let nnz = ss_sym.row_idx().len();
-        let symbolic = factorize_symbolic_lu(ss_sym.as_ref(), Default::default()).expect("symbolic LU");
+        let symbolic = factorize_symbolic_lu(ss_sym.as_ref(), lu_params(ns)).expect("symbolic LU");
         let factor_scratch =
             MemBuffer::new(symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()));
         let solve_scratch = RefCell::new(MemBuffer::new(
@@ -326,5 +327,24 @@ impl LinearSolver<FaerSparseMat<f64>> for NetworkSparseLu {
         Err(LaError::Other(
             "transpose solves (adjoint sensitivities) are not supported by the network LU".into(),
         ))
+    }
+}
+
+/// Rest-block size from which faer's supernodal numeric LU is used instead of its simplicial one.
+/// faer's own flop-ratio choice picked simplicial for the 1000-patch AT6 wall; measured over the
+/// WLTC (TR-BDF2, CPU time of two runs each, docs/performance.md "Sparse networks"): 513 states
+/// simplicial 0.39–0.41 s vs supernodal 0.43–0.47 s; 1013 states simplicial 0.94–0.99 s vs
+/// supernodal 0.77–0.81 s.
+pub const SUPERNODAL_FROM: usize = 750;
+
+/// Symbolic LU parameters for a rest block of `n` states.
+fn lu_params(n: usize) -> LuSymbolicParams<'static> {
+    LuSymbolicParams {
+        supernodal_flop_ratio_threshold: if n >= SUPERNODAL_FROM {
+            SupernodalThreshold::FORCE_SUPERNODAL
+        } else {
+            SupernodalThreshold::FORCE_SIMPLICIAL
+        },
+        ..LuSymbolicParams::default()
     }
 }
