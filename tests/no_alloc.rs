@@ -73,6 +73,8 @@ fn sample_switch_right_hand_side_and_jacobian_product_allocate_nothing() {
         let mut v = vec![0.0; y.len()];
         let mut jv = vec![0.0; y.len()];
         let mut jac = vec![0.0; scene.jacobian_pattern().len()];
+        let mut slopes = vec![0.0; scene.items()];
+        let mut ft = vec![0.0; y.len()];
         let before = allocs();
         for k in 0..20 {
             y[scene.thermal.oil] += 0.5 * k as f64; // new T_oil: the Jacobian column is recomputed
@@ -91,11 +93,54 @@ fn sample_switch_right_hand_side_and_jacobian_product_allocate_nothing() {
             }
             // The assembled Jacobian (issue 15) too.
             scene.jacobian_values(k as f64, &y, &mut work, &mut jac);
+            // And what ROS3 evaluates per step: loss slopes, the Jacobian from them, ∂f/∂t.
+            scene.loss_slopes(k as f64, &y, &mut work, &mut slopes);
+            scene.jacobian_values_with_slopes(k as f64, &y, &mut work, &slopes, &mut jac);
+            scene.time_derivative(k as f64, &y, &mut work, &mut ft);
         }
         let after = allocs();
         assert_eq!(after - before, 0, "{m}: rhs/jvp allocated");
-        assert!(dy.iter().chain(&jv).all(|x| x.is_finite()), "{m}");
+        assert!(
+            dy.iter()
+                .chain(&jv)
+                .chain(&slopes)
+                .chain(&ft)
+                .all(|x| x.is_finite()),
+            "{m}"
+        );
         assert!(work.jac_evals >= 20, "{m}: Jacobian column recomputed per T_oil");
         assert!(work.terms.prepared >= 20, "{m}: loss terms prepared per sample");
     }
+}
+
+#[test]
+fn ros3_steps_allocate_nothing_beyond_the_output_rows() {
+    // Two cycles of different lengths: the allocations may grow with the rows the trajectory
+    // keeps (a state vector and a loss vector per row, and the row vectors' growth), never with
+    // the steps.
+    use geartherm::cycle::DriveCycle;
+    use geartherm::scene::Scene;
+    use geartherm::solve::drive::segments;
+    use geartherm::solve::transient::{integrate, Method, TransientOptions};
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let gb = model::load(&root.join("models/fzg_c.toml")).unwrap();
+    let scene = Scene::compile(&gb).unwrap();
+    let (_, segs) = segments(&gb, &DriveCycle::resolve("wltc").unwrap()).unwrap();
+    let o = TransientOptions {
+        method: Method::Ros3,
+        ..TransientOptions::default()
+    };
+    let count = |segs: &[geartherm::solve::transient::Segment]| {
+        let before = allocs();
+        let t = integrate(&scene, segs, &o, &mut |_, _| {}).unwrap();
+        (allocs() - before, t.stats.steps, t.times.len())
+    };
+    let (short, short_steps, short_rows) = count(&segs[..300]);
+    let (long, long_steps, long_rows) = count(&segs);
+    let per_row = (long - short) as f64 / (long_rows - short_rows) as f64;
+    println!(
+        "{short} allocations for {short_steps} steps / {short_rows} rows, {long} for {long_steps} / {long_rows}: {per_row:.2} per extra row"
+    );
+    assert!(long_steps > 5 * short_steps);
+    assert!(per_row <= 2.1, "{per_row} allocations per row");
 }
