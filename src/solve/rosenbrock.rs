@@ -7,9 +7,15 @@
 //! y⁺ = y + Σ m_i K_i,   error estimate Σ e_i K_i.
 //! ```
 //!
-//! Sandu, Verwer, Blom, Spee, Carmichael & Potra, "Benchmarking stiff ODE solvers for atmospheric
-//! chemistry problems II: Rosenbrock solvers", Atmospheric Environment 31(20), 3459–3472 (1997);
-//! the transformed form is Hairer & Wanner, *Solving ODEs II*, §IV.7. No Newton iteration: per
+//! Source of the coefficients: the Rosenbrock integrator of KPP as FATODE ships it
+//! (ComputationalScienceLaboratory/FATODE, `FWD/ROS/ROS_f90_Integrator.F90`, subroutine `Ros3`,
+//! commit 0ccbac09; read there: "an L-stable method, 3 stages, order 3, 2 function
+//! evaluations", its A, C, M, E, α and γ_i). The method belongs to the Rosenbrock family of
+//! Sandu et al.'s atmospheric-chemistry benchmarks (Atmos. Environ. 31(20), 1997); that paper was
+//! not read. The transformed form (G = 1/(γh) − J, stages K_i) is Hairer & Wanner's, as KPP
+//! documents it. The order-3 and L-stability claims are KPP's, not re-derived here; what is
+//! checked is convergence against analytic solutions (`tests/transient.rs`,
+//! `tests/rosenbrock.rs`). No Newton iteration: per
 //! step two right-hand sides, one Jacobian, one LU of the (small) node block and three
 //! triangular solves.
 //!
@@ -38,7 +44,7 @@ use diffsol_la::{LinearOp, LinearSolver};
 use super::equations::{HostVector, JacobianMatrix, SceneEquations};
 use super::transient::{Driver, NumericalFailure, Trajectory};
 
-/// A Rosenbrock tableau in the transformed form (coefficients as Sandu et al. 1997 give them).
+/// A Rosenbrock tableau in the transformed form (coefficients as KPP/FATODE give them).
 pub struct Tableau {
     /// Stages.
     pub stages: usize,
@@ -62,7 +68,7 @@ pub struct Tableau {
     pub elo: f64,
 }
 
-/// ROS3 (Sandu et al. 1997, Table 2 "ROS3"): L-stable, order 3(2), 3 stages, 2 evaluations of f.
+/// ROS3 (FATODE `Ros3`): L-stable, order 3(2), 3 stages, 2 evaluations of f.
 pub const ROS3: Tableau = Tableau {
     stages: 3,
     gamma: 0.435_866_521_508_459,
