@@ -74,7 +74,13 @@ def test_run_returns_a_dataframe_with_units_and_a_summary_dict(at6):
     assert ts["temp_sump_c"].max() == pytest.approx(r.summary["temperatures_c"]["sump"]["max"], abs=1e-9)
     s = at6.run(cycle="hwfet", summary_only=True)
     assert s.timeseries is None
-    assert s.summary["energy_lost_j"]["total"] == pytest.approx(r.summary["energy_lost_j"]["total"], rel=1e-6)
+    # Summary-only integrates the same equations with energies per source instead of per item:
+    # at the default tolerance the two differ by their integration error (ROS3: 2.8e-6 relative
+    # on this cycle, against 0.4e-6 from the 1e-10 reference for the full run), at a tight one
+    # they agree to 2e-8.
+    assert s.summary["energy_lost_j"]["total"] == pytest.approx(r.summary["energy_lost_j"]["total"], rel=1e-5)
+    tight = [at6.run(cycle="hwfet", rtol=1e-7, summary_only=so).summary["energy_lost_j"]["total"] for so in (False, True)]
+    assert tight[1] == pytest.approx(tight[0], rel=1e-7)
 
 
 def test_steady_and_map(at6):
