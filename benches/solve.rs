@@ -101,27 +101,15 @@ fn networks(c: &mut Criterion) {
     let mut g = c.benchmark_group("wltc_network");
     g.sample_size(10);
     // Small sizes first: where the sparse LU starts to win.
-    for n in [0usize, 10, 20, 30, 50, 100, 200, 500, 1000] {
-        let (around, along) = wall::grid(n);
-        let extra = if n == 0 {
-            String::new()
-        } else {
-            wall::mesh_toml(around, along, Some(0.3), 100.0)
-        };
-        let gb = wall::at6_with(&extra);
-        let (scene, segs) = wall::wltc_scene(&gb);
+    for n in wall::STUDY_SIZES {
+        let (scene, segs) = wall::meshed_at6_wltc(n);
         for (label, la) in [("sparse", LinearAlgebra::Sparse), ("dense", LinearAlgebra::Dense)] {
             if la == LinearAlgebra::Dense && n > 200 {
                 continue; // 1.5 s and more per run
             }
             // TR-BDF2 at every size (what `auto` uses above 24 nodes), so that the curve shows
             // how the linear algebra scales.
-            let o = TransientOptions {
-                method: Method::TrBdf2,
-                record_losses: false,
-                linear_algebra: la,
-                ..TransientOptions::default()
-            };
+            let o = wall::study_options(Method::TrBdf2, la);
             g.bench_function(format!("{label}/{n}"), |b| {
                 b.iter(|| integrate(&scene, &segs, &o, &mut |_, _| {}).unwrap())
             });

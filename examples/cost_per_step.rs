@@ -9,26 +9,17 @@
 #[path = "../tests/common/wall.rs"]
 mod wall;
 
+#[path = "common/cpu.rs"]
+mod cpu;
+use cpu::cpu_time;
+
 use std::fs;
 use std::path::Path;
 
 use plotters::prelude::*;
 
 use geartherm::report::plots::style;
-use geartherm::solve::transient::{integrate, LinearAlgebra, Method, TransientOptions};
-
-const SIZES: [usize; 9] = [0, 10, 20, 30, 50, 100, 200, 500, 1000];
-
-/// CPU time of this thread, s (the machine is shared: wall times include waiting for a core).
-fn cpu_time() -> f64 {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: clock_gettime writes into the timespec we own.
-    unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
-    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
-}
+use geartherm::solve::transient::{integrate, LinearAlgebra, Method};
 
 /// Criterion's median (s) of `wltc_network/<label>/<n>` (stored as `<label>_<n>`), if measured.
 fn median(label: &str, n: usize) -> Option<f64> {
@@ -54,29 +45,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // COST_SIZES=500,1000 limits the sizes (for profiling one of them).
     let sizes: Vec<usize> = match std::env::var("COST_SIZES") {
         Ok(v) => v.split(',').filter_map(|x| x.trim().parse().ok()).collect(),
-        Err(_) => SIZES.to_vec(),
+        Err(_) => wall::STUDY_SIZES.to_vec(),
     };
+    // TR-BDF2 throughout (what `auto` uses above 24 nodes), so that the curve shows how the
+    // linear algebra scales; COST_METHOD=ros3 for the other method.
+    let method = std::env::var("COST_METHOD")
+        .ok()
+        .and_then(|m| Method::parse(&m))
+        .unwrap_or(Method::TrBdf2);
     for n in sizes {
-        let (around, along) = wall::grid(n);
-        let extra = if n == 0 {
-            String::new()
-        } else {
-            wall::mesh_toml(around, along, Some(0.3), 100.0)
-        };
-        let gb = wall::at6_with(&extra);
-        let (scene, segs) = wall::wltc_scene(&gb);
+        let (scene, segs) = wall::meshed_at6_wltc(n);
         let run = |la: LinearAlgebra| {
-            let mut o = TransientOptions {
-                record_losses: false,
-                linear_algebra: la,
-                ..TransientOptions::default()
-            };
-            // TR-BDF2 throughout (what `auto` uses above 24 nodes), so that the curve shows how the
-            // linear algebra scales; COST_METHOD=ros3 for the other method.
-            o.method = std::env::var("COST_METHOD")
-                .ok()
-                .and_then(|m| Method::parse(&m))
-                .unwrap_or(Method::TrBdf2);
+            let o = wall::study_options(method, la);
             let c0 = cpu_time();
             let t = integrate(&scene, &segs, &o, &mut |_, _| {});
             (t, cpu_time() - c0)

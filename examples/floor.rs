@@ -10,6 +10,10 @@
 //! wall time includes waiting for a core), medians of repeats. `FLOOR_REPEATS` (default 7) and
 //! `FLOOR_PROFILE=model.toml` (integrate that model 200 times, for `perf record`).
 
+#[path = "common/cpu.rs"]
+mod cpu;
+use cpu::cpu_time;
+
 use std::hint::black_box;
 use std::path::Path;
 
@@ -25,16 +29,6 @@ const MODELS: [&str; 4] = [
     "models/helical_stage.toml",
     "models/pt6_spur_pair.toml",
 ];
-
-fn cpu_time() -> f64 {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: clock_gettime writes into the timespec we own.
-    unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
-    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
-}
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);

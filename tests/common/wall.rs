@@ -8,7 +8,7 @@ use geartherm::cycle::DriveCycle;
 use geartherm::model::{self, Gearbox};
 use geartherm::scene::{Needs, Scene};
 use geartherm::solve::drive::segments;
-use geartherm::solve::transient::Segment;
+use geartherm::solve::transient::{LinearAlgebra, Method, Segment, TransientOptions};
 
 /// Patches (around, along) for a wall of about `n` patches.
 pub fn grid(n: usize) -> (usize, usize) {
@@ -53,4 +53,30 @@ pub fn wltc_scene(gb: &Gearbox) -> (Scene, Vec<Segment>) {
         ..Needs::default()
     };
     (Scene::compile_for(gb, &needs).unwrap(), segs)
+}
+
+/// Wall sizes (patches) of the cost-per-step study (`benches/solve.rs` `wltc_network`,
+/// `examples/cost_per_step.rs`).
+pub const STUDY_SIZES: [usize; 9] = [0, 10, 20, 30, 50, 100, 200, 500, 1000];
+
+/// The AT6 with a wall of about `n` patches (0: the lumped housing), 30 % of the circumference
+/// wetted, k = 100 W/(m·K): scene and WLTC segments.
+pub fn meshed_at6_wltc(n: usize) -> (Scene, Vec<Segment>) {
+    let (around, along) = grid(n);
+    let extra = if n == 0 {
+        String::new()
+    } else {
+        mesh_toml(around, along, Some(0.3), 100.0)
+    };
+    wltc_scene(&at6_with(&extra))
+}
+
+/// Options of the cost-per-step study: `method` at the default tolerance, no per-row losses.
+pub fn study_options(method: Method, la: LinearAlgebra) -> TransientOptions {
+    TransientOptions {
+        method,
+        record_losses: false,
+        linear_algebra: la,
+        ..TransientOptions::default()
+    }
 }
