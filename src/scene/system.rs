@@ -110,6 +110,14 @@ pub struct Work {
     pub failure: Option<RhsFailure>,
 }
 
+impl Work {
+    /// True when `heat`, `q` and `base_to_b` hold the heat balance of the last right-hand side
+    /// and it was evaluated at time `t`, node temperatures `temps` and the current sample.
+    fn holds_rhs_at(&self, t: f64, temps: &[f64]) -> bool {
+        self.base == Some((t.to_bits(), self.sample_id)) && self.base_y == temps
+    }
+}
+
 impl Scene {
     /// Compile the scene of a gearbox with a thermal network, for every gear state.
     pub fn compile(gb: &Gearbox) -> Result<Scene, SceneError> {
@@ -424,7 +432,7 @@ impl Scene {
         work.jac_evals += 1;
         let h = oil_step(t_oil);
         let inputs = work.inputs;
-        let b0 = if work.base == Some((t.to_bits(), work.sample_id)) && work.base_y == y[..n] {
+        let b0 = if work.holds_rhs_at(t, &y[..n]) {
             // The last right-hand side was evaluated here: start from its heat balance.
             work.oil_col[..n].copy_from_slice(&work.heat);
             work.q_base.copy_from_slice(&work.q);
@@ -593,7 +601,7 @@ impl Scene {
         };
         let n = self.nodes();
         let h = oil_step(t_oil);
-        if work.base == Some((t.to_bits(), work.sample_id)) && work.base_y == y[..n] {
+        if work.holds_rhs_at(t, &y[..n]) {
             work.q_base.copy_from_slice(&work.q);
         } else {
             let op = self.op(&work.inputs, self.thermal.oil_properties(t_oil));

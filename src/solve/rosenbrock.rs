@@ -200,8 +200,9 @@ impl<'a, 'd, M: JacobianMatrix, LS: LinearSolver<M>> Ros<'a, 'd, M, LS> {
         let diag: Vec<usize> = (0..n).map(|i| M::slot(&jac, i, i)).collect();
         let mut y = vector();
         y.host_mut().copy_from_slice(y0);
-        let mut tmp = vector();
-        let ft = d.time_derivative(0.0, y0, tmp.host_mut()).then(vector);
+        let tmp = vector();
+        // Decided once: whether ∂f/∂t is needed at all.
+        let ft = d.boundaries_move().then(vector);
         let mut ls = LS::default();
         ls.set_sparsity(&IterationOp {
             jac: &jac,
@@ -235,11 +236,17 @@ impl<'a, 'd, M: JacobianMatrix, LS: LinearSolver<M>> Ros<'a, 'd, M, LS> {
         }
     }
 
-    /// f at (t, y) with the current inputs, and the losses of stage 1.
-    fn eval_f(&mut self, t: f64) {
+    /// f at (t, y) with the current inputs, and the losses of stage 1 (they are also the output
+    /// row's); a non-finite f fails the run, naming the item the RHS diagnosed.
+    fn eval_f(&mut self, t: f64) -> Result<(), NumericalFailure> {
         self.d.rhs(t, self.y.host(), self.f.host_mut());
         self.d.losses_into(&mut self.slopes.q1);
         self.slopes.t_oil[0] = self.d.oil_temp(self.y.host());
+        if self.f.host().iter().all(|v| v.is_finite()) {
+            return Ok(());
+        }
+        let why = "the right-hand side is not finite at an accepted state".to_string();
+        Err(self.d.failure(t, self.y.host(), why))
     }
 
     /// The slopes for a Jacobian at (t, y) in `state`: carried over, else differenced.
@@ -383,7 +390,7 @@ where
     let mut r = Ros::<M, LS>::new(d, eqn, y0);
     let segs = d.segments;
     let mut t = segs[0].t0;
-    r.eval_f(t);
+    r.eval_f(t)?;
     d.record_evaluated(traj, t, r.y.host(), 0);
     let len0 = segs[0].t1 - segs[0].t0;
     let mut h = d.restart_step(r.y.host(), r.f.host(), len0, len0);
@@ -398,7 +405,7 @@ where
             d.switch_inputs(row_seg);
         }
         // The next step's first stage is f at the new inputs; its losses are the row's.
-        r.eval_f(seg.t1);
+        r.eval_f(seg.t1)?;
         d.record_evaluated(traj, seg.t1, r.y.host(), row_seg);
         progress(k + 1, segs.len());
     }
@@ -419,10 +426,6 @@ fn integrate_segment<M: JacobianMatrix, LS: LinearSolver<M>>(
         if r.stats.steps + r.stats.rejected >= d.opts.max_steps {
             return Err(d.budget_failure(*t, r.y.host()));
         }
-        if !r.f.host().iter().all(|v| v.is_finite()) {
-            let why = "the right-hand side is not finite at an accepted state".to_string();
-            return Err(d.failure(*t, r.y.host(), why));
-        }
         let rest = t1 - *t;
         // Land exactly on the segment end, leaving no sliver.
         let h_try = if h >= rest * (1.0 - 1e-9) { rest } else { h };
@@ -439,7 +442,7 @@ fn integrate_segment<M: JacobianMatrix, LS: LinearSolver<M>>(
             h = h_try * (SAFETY * err.max(1e-10).powf(expo)).min(GROW_MAX);
             retry = false;
             if *t < t1 {
-                r.eval_f(*t);
+                r.eval_f(*t)?;
             }
         } else {
             r.stats.rejected += 1;

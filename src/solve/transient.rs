@@ -1,7 +1,9 @@
 //! Transient driver: integrates a [`Scene`] over piecewise-constant input segments (drive-cycle
-//! intervals) with a diffsol solver.
+//! intervals) with ROS3 ([`super::rosenbrock`], the default for lumped networks through
+//! [`Method::Auto`]) or a diffsol solver (TR-BDF2 above 24 nodes, BDF, ESDIRK34, Tsit45). Both
+//! share [`Driver`]: the rows, the step budget and the failure diagnosis.
 //!
-//! How the pitfalls of docs/numerics.md are handled (each has a test in `tests/transient.rs`):
+//! How the diffsol pitfalls of docs/numerics.md are handled (each has a test in `tests/transient.rs`):
 //! 1. `max_nonlinear_solver_failures` counts over the solver's life: raised to the step budget;
 //!    runaway runs are stopped by our own step budget instead.
 //! 2. `TstopReached` may leave `t` one ulp short of the stop time: the segment index is kept here,
@@ -193,7 +195,7 @@ impl Default for Guards {
     }
 }
 
-/// Default method (chosen by the work-precision study, docs/numerics.md).
+/// Default method (ROS3 on lumped networks, TR-BDF2 on large ones: docs/numerics.md "ROS3").
 pub const DEFAULT_METHOD: Method = Method::Auto;
 /// Default relative tolerance (docs/numerics.md).
 pub const DEFAULT_RTOL: f64 = 1e-4;
@@ -437,13 +439,14 @@ impl Driver<'_> {
         self.scene.rhs(t, y, &mut self.work.borrow_mut(), dy);
     }
 
-    /// ∂f/∂t at (t, y); false (and `out` untouched) when no boundary temperature moves.
-    pub(crate) fn time_derivative(&self, t: f64, y: &[f64], out: &mut [f64]) -> bool {
-        if !self.scene.thermal.boundaries_move() {
-            return false;
-        }
+    /// True when some boundary temperature moves (then f depends on t).
+    pub(crate) fn boundaries_move(&self) -> bool {
+        self.scene.thermal.boundaries_move()
+    }
+
+    /// ∂f/∂t at (t, y).
+    pub(crate) fn time_derivative(&self, t: f64, y: &[f64], out: &mut [f64]) {
         self.scene.time_derivative(t, y, &mut self.work.borrow_mut(), out);
-        true
     }
 
     /// The losses (W per item) of the last right-hand side, into `out`.
