@@ -2,7 +2,7 @@
 //! docs/validation.md): a peer case and a trend case, every applicable model choice.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Output};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -25,16 +25,7 @@ fn validate_runs_every_model_choice_and_writes_table_and_plots() {
     copy_case("gearpie_c14_sliding", &cases);
     copy_case("seed000_table2_trend", &cases);
     let out = d.path().join("out");
-    let r = Command::new(env!("CARGO_BIN_EXE_geartherm"))
-        .args([
-            "validate",
-            cases.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--json",
-        ])
-        .output()
-        .unwrap();
+    let r = validate(&cases, &out, &["--json"]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let v: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
     let rows = v["rows"].as_array().unwrap();
@@ -84,30 +75,27 @@ fn validate_runs_every_model_choice_and_writes_table_and_plots() {
 fn validate_on_a_directory_without_cases_fails_and_writes_nothing() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("out");
-    let r = Command::new(env!("CARGO_BIN_EXE_geartherm"))
-        .args([
-            "validate",
-            d.path().to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let r = validate(d.path(), &out, &[]);
     assert_eq!(r.status.code(), Some(1));
     assert!(!out.exists());
 }
 
-fn run_validate(cases: &Path, out: &Path) -> serde_json::Value {
-    let r = Command::new(env!("CARGO_BIN_EXE_geartherm"))
+/// `geartherm validate CASES --out OUT [extra...]`.
+fn validate(cases: &Path, out: &Path, extra: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_geartherm"))
         .args([
             "validate",
             cases.to_str().unwrap(),
             "--out",
             out.to_str().unwrap(),
-            "--json",
         ])
+        .args(extra)
         .output()
-        .unwrap();
+        .unwrap()
+}
+
+fn run_validate(cases: &Path, out: &Path) -> serde_json::Value {
+    let r = validate(cases, out, &["--json"]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     serde_json::from_slice(&r.stdout).unwrap()
 }
@@ -201,15 +189,7 @@ fn a_range_with_low_above_high_is_rejected_naming_the_point() {
     let cases = d.path().join("cases");
     write_handbook_case(&cases, 0.998, 0.990);
     let out = d.path().join("out");
-    let r = Command::new(env!("CARGO_BIN_EXE_geartherm"))
-        .args([
-            "validate",
-            cases.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let r = validate(&cases, &out, &[]);
     assert_eq!(r.status.code(), Some(1));
     let err = String::from_utf8_lossy(&r.stderr);
     assert!(err.contains("range K9") && err.contains("case.toml"), "{err}");
