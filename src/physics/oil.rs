@@ -159,6 +159,12 @@ impl Walther {
 
     /// d ν / d T (m²/s/K), analytic (used by the steady-state Newton).
     pub fn dnu_dt(&self, t_k: f64) -> f64 {
+        self.nu_and_slope(t_k).1
+    }
+
+    /// ν (m²/s) and d ν / d T (m²/s/K) at `t_k` (K) from the same powers: ν is bitwise that of
+    /// [`Self::nu`].
+    pub fn nu_and_slope(&self, t_k: f64) -> (f64, f64) {
         // y = A − B log10 T; Z = 10^(10^y); dZ/dT = Z ln10 · 10^y ln10 · (−B/(T ln10)).
         let y = self.a - self.b * t_k.log10();
         let p = 10f64.powf(y);
@@ -172,8 +178,17 @@ impl Walther {
             }
             _ => 1.0,
         };
-        dz_dt * dnu_dz * CST
+        (nu * CST, dz_dt * dnu_dz * CST)
     }
+}
+
+/// Logarithmic temperature slopes of the oil properties, 1/K.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct OilLogSlopes {
+    /// d ln ν / d T.
+    pub nu: f64,
+    /// d ln ρ / d T.
+    pub rho: f64,
 }
 
 /// A lubricant: Walther viscosity law plus linear density law.
@@ -254,6 +269,23 @@ impl Oil {
         }
     }
 
+    /// [`Self::properties`] (bitwise the same) and their logarithmic temperature slopes, from the
+    /// same powers (the analytic derivative of the Walther and density laws).
+    pub fn properties_and_slopes(&self, t_k: f64) -> (OilProperties, OilLogSlopes) {
+        let (nu, dnu) = self.walther.nu_and_slope(t_k);
+        let rho = self.density(t_k);
+        let props = OilProperties {
+            nu,
+            rho,
+            mu: rho * nu,
+        };
+        let slopes = OilLogSlopes {
+            nu: dnu / nu,
+            rho: self.rho15 * self.alpha_t / rho,
+        };
+        (props, slopes)
+    }
+
     /// Viscosity index is not computed (needs ASTM D2270 tables); this returns the
     /// viscosity–temperature slope B of the Walther law instead (a VI-like measure).
     pub fn walther_slope(&self) -> f64 {
@@ -267,6 +299,33 @@ mod tests {
 
     fn fva3a(v: WaltherVariant) -> Oil {
         Oil::new("FVA 3A", v, 90.02 * CST, 10.41 * CST, 884.1, ALPHA_T_MINERAL).unwrap()
+    }
+
+    /// `properties_and_slopes`: the properties bitwise those of `properties`, the slopes against
+    /// central differences (every Walther variant; D341 also below 2 cSt, its inverted branch).
+    #[test]
+    fn log_slopes_match_central_differences() {
+        for v in [WaltherVariant::AstmD341, WaltherVariant::C06, WaltherVariant::C08] {
+            let oil = fva3a(v);
+            for t in [280.0, 330.0, 380.0, 430.0, 520.0] {
+                let (p, s) = oil.properties_and_slopes(t);
+                assert_eq!(p, oil.properties(t));
+                let d = 1e-3;
+                let ln = |f: &dyn Fn(f64) -> f64| (f(t + d).ln() - f(t - d).ln()) / (2.0 * d);
+                let fd_nu = ln(&|x| oil.nu(x));
+                let fd_rho = ln(&|x| oil.density(x));
+                assert!(
+                    (s.nu - fd_nu).abs() <= 1e-6 * fd_nu.abs(),
+                    "{v:?} {t}: {} vs {fd_nu}",
+                    s.nu
+                );
+                assert!(
+                    (s.rho - fd_rho).abs() <= 1e-6 * fd_rho.abs(),
+                    "{v:?} {t}: {} vs {fd_rho}",
+                    s.rho
+                );
+            }
+        }
     }
 
     #[test]

@@ -95,11 +95,40 @@ pub const OIL_SPECIFIC_HEAT: f64 = 2000.0;
 /// in speed (no step at the transition; a discontinuous h would stall the stiff solver). At rest
 /// the correlation gives 0: natural convection is left to a fixed conductance in parallel.
 pub fn rotating_disc_h(omega: f64, radius: f64, fluid: &FluidProperties) -> f64 {
+    disc_h_and_re_exponent(omega, radius, fluid).0
+}
+
+/// [`rotating_disc_h`] and its temperature derivative dh/dT (W/m²K/K), given the fluid's
+/// logarithmic slopes d ln ν/dT (`dln_nu`) and d ln Pr/dT (`dln_pr`); h is bitwise that of
+/// [`rotating_disc_h`].
+///
+/// [derived] from the correlation above at fixed ω, r and k: Re ∝ 1/ν, so
+/// d ln h/dT = −ε·d ln ν/dT + (1/3)·d ln Pr/dT with the local Reynolds exponent of the blend
+/// ε = d ln Nu/d ln Re = (0.5·Nu_l⁴ + 0.8·Nu_t⁴)/(Nu_l⁴ + Nu_t⁴).
+pub fn rotating_disc_h_slope(
+    omega: f64,
+    radius: f64,
+    fluid: &FluidProperties,
+    dln_nu: f64,
+    dln_pr: f64,
+) -> (f64, f64) {
+    let (h, eps) = disc_h_and_re_exponent(omega, radius, fluid);
+    (h, h * (-eps * dln_nu + dln_pr / 3.0))
+}
+
+/// h of [`rotating_disc_h`] and the blend's Reynolds exponent ε (0 at rest).
+fn disc_h_and_re_exponent(omega: f64, radius: f64, fluid: &FluidProperties) -> (f64, f64) {
     let re = omega.abs() * radius * radius / fluid.kinematic_viscosity;
     let nu_l = 0.36 * re.sqrt();
     let nu_t = 0.015 * re.powf(0.8);
-    let nu = (nu_l.powi(4) + nu_t.powi(4)).powf(0.25) * fluid.prandtl.cbrt();
-    nu * fluid.conductivity / radius
+    let (l4, t4) = (nu_l.powi(4), nu_t.powi(4));
+    let nu = (l4 + t4).powf(0.25) * fluid.prandtl.cbrt();
+    let eps = if l4 + t4 > 0.0 {
+        (0.5 * l4 + 0.8 * t4) / (l4 + t4)
+    } else {
+        0.0
+    };
+    (nu * fluid.conductivity / radius, eps)
 }
 
 /// Opening of a thermostat valve at temperature `t` (K): 0 below `t_open`, 1 above `t_full`,
@@ -135,6 +164,45 @@ mod tests {
         let one = HTable::new(vec![3.0], vec![7.0]);
         assert_eq!(one.at(0.0), 7.0);
         assert_eq!(one.at(9.0), 7.0);
+    }
+
+    /// The analytic dh/dT of the rotating disc in oil against a central difference of h through
+    /// the oil's properties, across the laminar–turbulent blend (1 to 1e4 rad/s), and h bitwise
+    /// that of `rotating_disc_h`.
+    #[test]
+    fn rotating_disc_slope_matches_a_central_difference() {
+        use crate::physics::oil::{Oil, WaltherVariant, CST};
+        let oil = Oil::new(
+            "FVA 3A",
+            WaltherVariant::C06,
+            90.02 * CST,
+            10.41 * CST,
+            884.1,
+            crate::physics::oil::ALPHA_T_MINERAL,
+        )
+        .unwrap();
+        let fluid = |t: f64| {
+            let p = oil.properties(t);
+            FluidProperties {
+                conductivity: OIL_CONDUCTIVITY,
+                kinematic_viscosity: p.nu,
+                prandtl: p.mu * OIL_SPECIFIC_HEAT / OIL_CONDUCTIVITY,
+            }
+        };
+        for t in [300.0, 340.0, 390.0] {
+            let (_, s) = oil.properties_and_slopes(t);
+            for w in [0.0, 1.0, 30.0, 300.0, 3000.0, 1e4] {
+                let (h, dh) = rotating_disc_h_slope(w, 0.08, &fluid(t), s.nu, s.nu + s.rho);
+                assert_eq!(h.to_bits(), rotating_disc_h(w, 0.08, &fluid(t)).to_bits());
+                let d = 1e-3;
+                let fd = (rotating_disc_h(w, 0.08, &fluid(t + d)) - rotating_disc_h(w, 0.08, &fluid(t - d)))
+                    / (2.0 * d);
+                assert!(
+                    (dh - fd).abs() <= 1e-6 * fd.abs().max(1e-12),
+                    "T {t} ω {w}: {dh} vs {fd}"
+                );
+            }
+        }
     }
 
     #[test]

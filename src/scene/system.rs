@@ -93,6 +93,13 @@ pub struct Work {
     q2: Vec<f64>,
     q_base: Vec<f64>,
     heat2: Vec<f64>,
+    /// Conductances of the rotating-in-oil links at the last heat balance (part of what `base`
+    /// holds), W/K, and scratch for them at other points.
+    oil_g: Vec<f64>,
+    oil_g2: Vec<f64>,
+    /// Their temperature derivatives, W/K² (as `oil_g` and `oil_g2`).
+    oil_dg: Vec<f64>,
+    oil_dg2: Vec<f64>,
     /// ∂f/∂T_oil for the whole state (column of the Jacobian), cached.
     oil_col: Vec<f64>,
     col_key: Option<(u64, u64)>,
@@ -234,6 +241,10 @@ impl Scene {
             q2: vec![0.0; m],
             q_base: vec![0.0; m],
             heat2: vec![0.0; n],
+            oil_g: vec![0.0; self.thermal.oil_link_count()],
+            oil_g2: vec![0.0; self.thermal.oil_link_count()],
+            oil_dg: vec![0.0; self.thermal.oil_link_count()],
+            oil_dg2: vec![0.0; self.thermal.oil_link_count()],
             oil_col: vec![0.0; self.n_states()],
             col_key: None,
             sample_id: 0,
@@ -310,14 +321,16 @@ impl Scene {
         terms: &SampleTerms,
         net: &NetworkWork,
         q: &mut [f64],
+        oil_g: (&mut [f64], &mut [f64]),
         heat: &mut [f64],
     ) -> f64 {
         let n = self.nodes();
-        let oil = self.thermal.oil_properties(t_oil);
+        let (oil, slopes) = self.thermal.oil_properties_and_slopes(t_oil);
         self.losses.evaluate_cached(&self.op(inputs, oil), terms, q);
-        let to_b = self
-            .thermal
-            .network_heat(&y[..n], &oil, &Self::operating(inputs), net, heat);
+        let (g, dg) = oil_g;
+        self.thermal
+            .oil_link_conductances(&oil, &slopes, &Self::operating(inputs), g, dg);
+        let to_b = self.thermal.network_heat(&y[..n], g, net, heat);
         for (qk, dest) in q.iter().zip(&self.thermal.heat) {
             for &(node, f) in dest {
                 heat[node] += f * qk;
@@ -340,6 +353,7 @@ impl Scene {
             &work.terms,
             &work.net,
             &mut work.q,
+            (&mut work.oil_g, &mut work.oil_dg),
             &mut work.heat,
         );
         for ((d, h), c) in dy.iter_mut().zip(&work.heat).zip(&self.thermal.capacity) {
@@ -395,15 +409,13 @@ impl Scene {
         self.thermal.boundary_temperatures(t, &mut work.net);
         let oil_i = self.thermal.oil;
         let t_oil = self.oil_temp(y);
-        let oil = self.thermal.oil_properties(t_oil);
-        let to_b = self.thermal.network_heat_jvp(
-            &y[..n],
-            &oil,
-            &Self::operating(&work.inputs),
-            &work.net,
-            &v[..n],
-            &mut work.heat,
-        );
+        let (oil, slopes) = self.thermal.oil_properties_and_slopes(t_oil);
+        let op = Self::operating(&work.inputs);
+        self.thermal
+            .oil_link_conductances(&oil, &slopes, &op, &mut work.oil_g, &mut work.oil_dg);
+        let to_b = self
+            .thermal
+            .network_heat_jvp(&y[..n], &work.oil_g, &work.net, &v[..n], &mut work.heat);
         for ((o, h), c) in out.iter_mut().zip(&work.heat).zip(&self.thermal.capacity) {
             *o = h / c;
         }
@@ -445,6 +457,7 @@ impl Scene {
                 &work.terms,
                 &work.net,
                 &mut work.q2,
+                (&mut work.oil_g2, &mut work.oil_dg2),
                 &mut work.heat2,
             );
             work.oil_col[..n].copy_from_slice(&work.heat2);
@@ -460,6 +473,7 @@ impl Scene {
             &work.terms,
             &work.net,
             &mut work.q2,
+            (&mut work.oil_g2, &mut work.oil_dg2),
             &mut work.heat2,
         );
         for i in 0..n {
@@ -494,15 +508,28 @@ impl Scene {
             vehicle_speed: 0.0,
         });
         let y = self.initial_state(None);
-        let oil = self.thermal.oil_properties(self.oil_temp(&y));
-        let op = Self::operating(&work.inputs);
         let mut out = Vec::new();
         self.thermal
-            .network_heat_partials(&y[..n], &oil, &op, &work.net, &mut |r, c, _| {
+            .network_heat_partials(&y[..n], &work.oil_g, &work.net, &mut |r, c, _| {
                 out.push((self.row_of(r), c))
             });
         out.extend((0..self.n_states()).map(|r| (r, self.thermal.oil)));
         out
+    }
+
+    /// Set the boundary temperatures to time `t` and make the oil links' conductances at (t, y)
+    /// available: true when `work.oil_g` holds them (the last right-hand side was evaluated at
+    /// this point), false when they were computed into `work.oil_g2`.
+    fn oil_conductances_at(&self, t: f64, y: &[f64], work: &mut Work) -> bool {
+        self.thermal.boundary_temperatures(t, &mut work.net);
+        if work.holds_rhs_at(t, &y[..self.nodes()]) {
+            return true;
+        }
+        let (oil, slopes) = self.thermal.oil_properties_and_slopes(self.oil_temp(y));
+        let op = Self::operating(&work.inputs);
+        self.thermal
+            .oil_link_conductances(&oil, &slopes, &op, &mut work.oil_g2, &mut work.oil_dg2);
+        false
     }
 
     /// Values of the Jacobian entries of [`Self::jacobian_pattern`], in its order, at (t, y):
@@ -520,15 +547,17 @@ impl Scene {
 
     /// The network's analytic partials (the head of [`Self::jacobian_pattern`]) into `vals`;
     /// returns how many were written.
+    /// The oil links' conductances at (t, y) are those of the last right-hand side when it was
+    /// evaluated there (ROS3's Jacobian follows its first stage), else computed into scratch.
     fn network_partial_values(&self, t: f64, y: &[f64], work: &mut Work, vals: &mut [f64]) -> usize {
         let n = self.nodes();
-        self.thermal.boundary_temperatures(t, &mut work.net);
-        let oil = self.thermal.oil_properties(self.oil_temp(y));
-        let op = Self::operating(&work.inputs);
+        let oil_g = self.oil_conductances_at(t, y, work);
         let mut k = 0;
         let cap = &self.thermal.capacity;
+        let work = &*work;
+        let oil_g = if oil_g { &work.oil_g } else { &work.oil_g2 };
         self.thermal
-            .network_heat_partials(&y[..n], &oil, &op, &work.net, &mut |r, _, d| {
+            .network_heat_partials(&y[..n], oil_g, &work.net, &mut |r, _, d| {
                 vals[k] = match r {
                     End::Node(i) => d / cap[i],
                     End::Boundary(_) => d,
@@ -552,19 +581,19 @@ impl Scene {
         let k = self.network_partial_values(t, y, work, vals);
         let col = &mut vals[k..];
         col.iter_mut().for_each(|x| *x = 0.0);
-        let Some(t_oil) = self.moving_oil_temp(y) else {
+        if self.moving_oil_temp(y).is_none() {
             return;
-        };
+        }
         let n = self.nodes();
-        let op = Self::operating(&work.inputs);
-        let to_b = self.thermal.oil_property_derivative(
-            &y[..n],
-            t_oil,
-            oil_step(t_oil),
-            &op,
-            &work.net,
-            &mut col[..n],
-        );
+        // network_partial_values left the conductances at t_oil in one of the two buffers.
+        let dg = if work.holds_rhs_at(t, &y[..n]) {
+            &work.oil_dg
+        } else {
+            &work.oil_dg2
+        };
+        let to_b = self
+            .thermal
+            .oil_property_derivative(&y[..n], dg, &work.net, &mut col[..n]);
         for (d, dest) in dq_dt.iter().zip(&self.thermal.heat) {
             for &(node, f) in dest {
                 col[node] += f * d;
@@ -622,17 +651,19 @@ impl Scene {
     pub fn time_derivative(&self, t: f64, y: &[f64], work: &mut Work, out: &mut [f64]) {
         let n = self.nodes();
         work.base = None;
-        let oil = self.thermal.oil_properties(self.oil_temp(y));
+        let (oil, slopes) = self.thermal.oil_properties_and_slopes(self.oil_temp(y));
         let op = Self::operating(&work.inputs);
+        self.thermal
+            .oil_link_conductances(&oil, &slopes, &op, &mut work.oil_g, &mut work.oil_dg);
         self.thermal.boundary_temperatures(t, &mut work.net);
         let b0 = self
             .thermal
-            .network_heat(&y[..n], &oil, &op, &work.net, &mut work.heat);
+            .network_heat(&y[..n], &work.oil_g, &work.net, &mut work.heat);
         self.thermal
             .boundary_temperatures(t + TIME_STEP_FD, &mut work.net);
         let b1 = self
             .thermal
-            .network_heat(&y[..n], &oil, &op, &work.net, &mut work.heat2);
+            .network_heat(&y[..n], &work.oil_g, &work.net, &mut work.heat2);
         for (((o, h1), h0), cap) in out
             .iter_mut()
             .zip(&work.heat2)
@@ -654,6 +685,15 @@ impl Scene {
         self.thermal.boundary_temperatures(t, &mut work.net);
         let t_oil = self.oil_temp(y);
         let inputs = work.inputs;
-        self.heat_balance(y, t_oil, &inputs, &work.terms, &work.net, &mut work.q, heat)
+        self.heat_balance(
+            y,
+            t_oil,
+            &inputs,
+            &work.terms,
+            &work.net,
+            &mut work.q,
+            (&mut work.oil_g, &mut work.oil_dg),
+            heat,
+        )
     }
 }

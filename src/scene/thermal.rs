@@ -9,10 +9,10 @@
 
 use crate::model::gearbox::{GearMount, Gearbox};
 use crate::model::thermal::{BoundaryTemp, Fluid, HeatTarget, LinkLaw, NodeRef, ThermalNetwork};
-use crate::physics::oil::{Oil, OilProperties};
+use crate::physics::oil::{Oil, OilLogSlopes, OilProperties};
 use crate::physics::thermal::{
-    h_power_law, radiation_derivative, radiation_power, rotating_disc_h, thermostat_opening, FluidProperties,
-    HTable, AIR_50C, OIL_CONDUCTIVITY, OIL_SPECIFIC_HEAT,
+    h_power_law, radiation_derivative, radiation_power, rotating_disc_h, rotating_disc_h_slope,
+    thermostat_opening, FluidProperties, HTable, AIR_50C, OIL_CONDUCTIVITY, OIL_SPECIFIC_HEAT,
 };
 
 use super::losses::{DefaultHeat, LossItem};
@@ -152,6 +152,15 @@ pub struct NetworkWork {
     pub sample_g: Vec<f64>,
     /// Boundary temperatures at the current time, K.
     pub boundary_t: Vec<f64>,
+}
+
+/// The oil as the fluid of the rotating-disc correlation (Pr = μ·c_p/k).
+fn oil_fluid(oil: &OilProperties) -> FluidProperties {
+    FluidProperties {
+        conductivity: OIL_CONDUCTIVITY,
+        kinematic_viscosity: oil.nu,
+        prandtl: oil.mu * OIL_SPECIFIC_HEAT / OIL_CONDUCTIVITY,
+    }
 }
 
 impl ThermalScene {
@@ -346,6 +355,11 @@ impl ThermalScene {
         self.oil_model.properties(t)
     }
 
+    /// Oil properties at `t` (K) and their logarithmic temperature slopes.
+    pub fn oil_properties_and_slopes(&self, t: f64) -> (OilProperties, OilLogSlopes) {
+        self.oil_model.properties_and_slopes(t)
+    }
+
     /// Fresh work buffers.
     pub fn work(&self) -> NetworkWork {
         NetworkWork {
@@ -414,16 +428,10 @@ impl ThermalScene {
     }
 
     /// Net heat flow (W) into each node from the network (not the losses), at node temperatures
-    /// `temps` (K), oil properties `oil`, the operating point `op` and the sample conductances in
-    /// `work`. Returns the heat flowing into boundaries (W). `heat` is overwritten.
-    pub fn network_heat(
-        &self,
-        temps: &[f64],
-        oil: &OilProperties,
-        op: &Operating,
-        work: &NetworkWork,
-        heat: &mut [f64],
-    ) -> f64 {
+    /// `temps` (K), the rotating-in-oil links' conductances `oil_g` (W/K,
+    /// [`Self::oil_link_conductances`]) and the sample conductances in `work`. Returns the heat
+    /// flowing into boundaries (W). `heat` is overwritten.
+    pub fn network_heat(&self, temps: &[f64], oil_g: &[f64], work: &NetworkWork, heat: &mut [f64]) -> f64 {
         heat.iter_mut().for_each(|x| *x = 0.0);
         let bt = &work.boundary_t;
         let mut to_b = 0.0;
@@ -435,8 +443,7 @@ impl ThermalScene {
             let q = g * (Self::temp(l.a, temps, bt) - Self::temp(l.b, temps, bt));
             Self::flow(l.a, l.b, q, heat, &mut to_b);
         }
-        for l in &self.oil_links {
-            let g = self.oil_link_conductance(l, oil, op);
+        for (l, g) in self.oil_links.iter().zip(oil_g) {
             let q = g * (Self::temp(l.a, temps, bt) - Self::temp(l.b, temps, bt));
             Self::flow(l.a, l.b, q, heat, &mut to_b);
         }
@@ -454,38 +461,45 @@ impl ThermalScene {
         to_b
     }
 
-    fn oil_link_conductance(&self, l: &OilLink, oil: &OilProperties, op: &Operating) -> f64 {
-        let w = l.speed_per_input[op.state] * op.input_speed;
-        let fluid = FluidProperties {
-            conductivity: OIL_CONDUCTIVITY,
-            kinematic_viscosity: oil.nu,
-            prandtl: oil.mu * OIL_SPECIFIC_HEAT / OIL_CONDUCTIVITY,
-        };
-        l.area * rotating_disc_h(w, l.radius, &fluid)
+    /// Conductances of the rotating-in-oil links (W/K) at the oil state `oil` into `g`, and their
+    /// temperature derivatives (W/K², analytic, from the oil's logarithmic slopes) into `dg`: one
+    /// per link, in the order [`Self::network_heat`] and its derivatives take them.
+    pub fn oil_link_conductances(
+        &self,
+        oil: &OilProperties,
+        slopes: &OilLogSlopes,
+        op: &Operating,
+        g: &mut [f64],
+        dg: &mut [f64],
+    ) {
+        let fluid = oil_fluid(oil);
+        let dln_pr = slopes.nu + slopes.rho;
+        for ((g, dg), l) in g.iter_mut().zip(dg.iter_mut()).zip(&self.oil_links) {
+            let w = l.speed_per_input[op.state] * op.input_speed;
+            let (h, dh) = rotating_disc_h_slope(w, l.radius, &fluid, slopes.nu, dln_pr);
+            (*g, *dg) = (l.area * h, l.area * dh);
+        }
     }
 
-    /// ∂(network heat)/∂T_oil through the oil properties alone (the rotating-in-oil links), by a
-    /// forward difference between the oil properties at `t_oil` and at `t_oil + dt`: adds W/K per
-    /// node into `col`, returns the boundary share. The other terms do not depend on the oil
+    /// Number of rotating-in-oil links.
+    pub fn oil_link_count(&self) -> usize {
+        self.oil_links.len()
+    }
+
+    /// ∂(network heat)/∂T_oil through the oil properties alone (the rotating-in-oil links), from
+    /// their conductances' derivatives `dg` ([`Self::oil_link_conductances`]): adds W/K per node
+    /// into `col`, returns the boundary share. The other terms do not depend on the oil
     /// properties.
     pub fn oil_property_derivative(
         &self,
         temps: &[f64],
-        t_oil: f64,
-        dt: f64,
-        op: &Operating,
+        dg: &[f64],
         work: &NetworkWork,
         col: &mut [f64],
     ) -> f64 {
-        if self.oil_links.is_empty() {
-            return 0.0;
-        }
-        let (oil0, oil1) = (self.oil_properties(t_oil), self.oil_properties(t_oil + dt));
-        let (oil0, oil1) = (&oil0, &oil1);
         let bt = &work.boundary_t;
         let mut to_b = 0.0;
-        for l in &self.oil_links {
-            let dg = (self.oil_link_conductance(l, oil1, op) - self.oil_link_conductance(l, oil0, op)) / dt;
+        for (l, dg) in self.oil_links.iter().zip(dg) {
             let dq = dg * (Self::temp(l.a, temps, bt) - Self::temp(l.b, temps, bt));
             Self::flow(l.a, l.b, dq, col, &mut to_b);
         }
@@ -505,8 +519,7 @@ impl ThermalScene {
     pub fn network_heat_partials(
         &self,
         temps: &[f64],
-        oil: &OilProperties,
-        op: &Operating,
+        oil_g: &[f64],
         work: &NetworkWork,
         add: &mut impl FnMut(End, usize, f64),
     ) {
@@ -526,9 +539,8 @@ impl ThermalScene {
         for (l, g) in self.sample.iter().zip(&work.sample_g) {
             pair(l.a, l.b, *g, -g);
         }
-        for l in &self.oil_links {
-            let g = self.oil_link_conductance(l, oil, op);
-            pair(l.a, l.b, g, -g);
+        for (l, g) in self.oil_links.iter().zip(oil_g) {
+            pair(l.a, l.b, *g, -g);
         }
         for r in &self.radiation {
             let (ta, tb) = (Self::temp(r.a, temps, bt), Self::temp(r.b, temps, bt));
@@ -553,8 +565,7 @@ impl ThermalScene {
     pub fn network_heat_jvp(
         &self,
         temps: &[f64],
-        oil: &OilProperties,
-        op: &Operating,
+        oil_g: &[f64],
         work: &NetworkWork,
         v: &[f64],
         out: &mut [f64],
@@ -572,8 +583,7 @@ impl ThermalScene {
         for (l, g) in self.sample.iter().zip(&work.sample_g) {
             Self::flow(l.a, l.b, g * (dv(l.a) - dv(l.b)), out, &mut to_b);
         }
-        for l in &self.oil_links {
-            let g = self.oil_link_conductance(l, oil, op);
+        for (l, g) in self.oil_links.iter().zip(oil_g) {
             Self::flow(l.a, l.b, g * (dv(l.a) - dv(l.b)), out, &mut to_b);
         }
         for r in &self.radiation {

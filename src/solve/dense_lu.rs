@@ -30,16 +30,33 @@ pub struct SmallDenseLu {
     /// L (unit, below the diagonal) and U of M_NN, column-major.
     lu: Vec<f64>,
     piv: Vec<usize>,
+    /// 1/U_kk (the back substitution multiplies).
+    inv_diag: Vec<f64>,
     /// States of the factorised block, and the quadratures.
     nodes: Vec<usize>,
     quads: Vec<usize>,
-    /// M_QN, row-major (one row of `n` per quadrature).
-    m_qn: Vec<f64>,
+    /// True when the factorised block is the leading states `0..n` (solved in place).
+    nodes_leading: bool,
+    /// Non-zero entries of M_QN: (quadrature state, column in the node block, value).
+    m_qn: Vec<(usize, usize, f64)>,
+    /// Where each Jacobian entry of [`Self::factorise_entries`] goes, for the slots it was
+    /// built for.
+    entry_dest: Vec<EntryDest>,
+    entry_slots: Vec<usize>,
     /// The matrix as the operator writes it.
     a: Option<NalgebraMat<f64>>,
     /// Scratch for x_N.
     x_n: std::cell::RefCell<Vec<f64>>,
     factorised: bool,
+}
+
+/// Destination of a Jacobian entry in the blocks of M = I − γhJ.
+#[derive(Debug, Clone, Copy)]
+enum EntryDest {
+    /// Position in the column-major node block.
+    Node(usize),
+    /// Quadrature state and column in the node block.
+    Quad(usize, usize),
 }
 
 impl SmallDenseLu {
@@ -63,20 +80,84 @@ impl SmallDenseLu {
                 }
             }
         }
-        let n = self.nodes.len();
-        self.n = n;
-        self.lu.resize(n * n, 0.0);
-        self.piv.resize(n, 0);
-        self.m_qn.resize(self.quads.len() * n, 0.0);
+        self.set_block_sizes();
+        let n = self.n;
+        self.m_qn.clear();
         for (b, &j) in self.nodes.iter().enumerate() {
             let c = &m[j * n_all..(j + 1) * n_all];
             for (a, &i) in self.nodes.iter().enumerate() {
                 self.lu[b * n + a] = c[i];
             }
-            for (r, &i) in self.quads.iter().enumerate() {
-                self.m_qn[r * n + b] = c[i];
+            for &i in &self.quads {
+                if c[i] != 0.0 {
+                    self.m_qn.push((i, b, c[i]));
+                }
             }
         }
+    }
+
+    /// Sizes of the buffers for the current split.
+    fn set_block_sizes(&mut self) {
+        let n = self.nodes.len();
+        self.n = n;
+        self.lu.resize(n * n, 0.0);
+        self.piv.resize(n, 0);
+        self.inv_diag.resize(n, 0.0);
+        self.nodes_leading = self.nodes.iter().enumerate().all(|(i, &j)| i == j);
+    }
+
+    /// The split of the states for Jacobian entries at column-major positions `slots` of an
+    /// `n_all`² matrix: the columns with entries form the node block, the other states are
+    /// quadratures (their columns of M are unit vectors). Built once per pattern.
+    fn split_for_entries(&mut self, n_all: usize, slots: &[usize]) {
+        let mut in_block = vec![false; n_all];
+        for &s in slots {
+            in_block[s / n_all] = true;
+        }
+        self.nodes = (0..n_all).filter(|&j| in_block[j]).collect();
+        self.quads = (0..n_all).filter(|&j| !in_block[j]).collect();
+        let mut local = vec![usize::MAX; n_all];
+        for (b, &j) in self.nodes.iter().enumerate() {
+            local[j] = b;
+        }
+        self.set_block_sizes();
+        let n = self.n;
+        self.entry_dest = slots
+            .iter()
+            .map(|&s| {
+                let (r, c) = (s % n_all, local[s / n_all]);
+                match local[r] {
+                    usize::MAX => EntryDest::Quad(r, c),
+                    a => EntryDest::Node(c * n + a),
+                }
+            })
+            .collect();
+        self.m_qn = Vec::with_capacity(slots.len());
+        self.entry_slots = slots.to_vec();
+    }
+
+    /// Factorise M = I − γh·J straight from J's entries `vals` at the column-major positions
+    /// `slots` of an `n_all`² matrix (repeated positions add up), without forming M: only the
+    /// node block and the non-zero entries of M_QN are written. Returns false when the node block
+    /// is singular or not finite (the solves then fail).
+    pub fn factorise_entries(&mut self, n_all: usize, slots: &[usize], vals: &[f64], gamma_h: f64) -> bool {
+        if self.entry_slots != slots {
+            self.split_for_entries(n_all, slots);
+        }
+        let n = self.n;
+        self.lu.iter_mut().for_each(|v| *v = 0.0);
+        for k in 0..n {
+            self.lu[k * n + k] = 1.0;
+        }
+        self.m_qn.clear();
+        for (d, v) in self.entry_dest.iter().zip(vals) {
+            match *d {
+                EntryDest::Node(p) => self.lu[p] -= gamma_h * v,
+                EntryDest::Quad(q, c) => self.m_qn.push((q, c, -gamma_h * v)),
+            }
+        }
+        self.factorised = self.factor();
+        self.factorised
     }
 
     fn factor(&mut self) -> bool {
@@ -100,6 +181,7 @@ impl SmallDenseLu {
                 }
             }
             let d = 1.0 / a[col + k];
+            self.inv_diag[k] = d;
             a[col + k + 1..col + n].iter_mut().for_each(|v| *v *= d);
             // Columns right of k: a_j[k+1..] −= l_k[k+1..] · u_kj.
             let (left, right) = a.split_at_mut((k + 1) * n);
@@ -129,8 +211,8 @@ impl SmallDenseLu {
                 }
             }
         }
-        for (j, cj) in self.lu.chunks_exact(n).enumerate().rev() {
-            x[j] /= cj[j];
+        for ((j, cj), d) in self.lu.chunks_exact(n).enumerate().zip(&self.inv_diag).rev() {
+            x[j] *= d;
             let xj = x[j];
             for (xi, u) in x[..j].iter_mut().zip(&cj[..j]) {
                 *xi -= u * xj;
@@ -150,9 +232,11 @@ impl LinearSolver<Mat> for SmallDenseLu {
         self.n = n;
         self.lu = vec![0.0; n * n];
         self.piv = vec![0; n];
+        self.inv_diag = vec![0.0; n];
         self.nodes = Vec::with_capacity(n);
         self.quads = Vec::with_capacity(n);
         self.m_qn = Vec::with_capacity(n * n);
+        self.entry_slots.clear();
         self.x_n = std::cell::RefCell::new(vec![0.0; n]);
         self.a = Some(<Mat as diffsol::Matrix>::zeros(n, n, *op.context()));
         self.factorised = false;
@@ -185,8 +269,15 @@ impl LinearSolver<Mat> for SmallDenseLu {
             ));
         }
         let x = x.host_mut();
-        let mut x_n = self.x_n.borrow_mut();
         let n = self.n;
+        if self.nodes_leading {
+            self.solve(&mut x[..n]);
+            for &(q, b, m) in &self.m_qn {
+                x[q] -= m * x[b];
+            }
+            return Ok(());
+        }
+        let mut x_n = self.x_n.borrow_mut();
         x_n.resize(n, 0.0);
         for (v, &i) in x_n.iter_mut().zip(&self.nodes) {
             *v = x[i];
@@ -195,8 +286,8 @@ impl LinearSolver<Mat> for SmallDenseLu {
         for (v, &i) in x_n.iter().zip(&self.nodes) {
             x[i] = *v;
         }
-        for (row, &q) in self.m_qn.chunks_exact(n.max(1)).zip(&self.quads) {
-            x[q] -= row.iter().zip(x_n.iter()).map(|(m, v)| m * v).sum::<f64>();
+        for &(q, b, m) in &self.m_qn {
+            x[q] -= m * x_n[b];
         }
         Ok(())
     }
@@ -219,6 +310,7 @@ mod tests {
             n,
             lu: vec![0.0; n * n],
             piv: vec![0; n],
+            inv_diag: vec![0.0; n],
             ..SmallDenseLu::default()
         };
         // A zero leading entry forces a row swap; off-diagonals make it non-trivial.
@@ -254,6 +346,7 @@ mod tests {
             n,
             lu: vec![1.0, 2.0, 3.0, 2.0, 4.0, 6.0, 0.0, 0.0, 0.0],
             piv: vec![0; n],
+            inv_diag: vec![0.0; n],
             ..SmallDenseLu::default()
         };
         assert!(!lu.factor());

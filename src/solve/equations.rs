@@ -144,6 +144,22 @@ impl<'s, M: JacobianMatrix> SceneEquations<'s, M> {
         }
     }
 
+    /// The Jacobian at (t, x) as entries, with the losses' share of the oil column from the slopes
+    /// `dq_dt`: calls `f(slots, values)` with each entry's position in the matrix (repeated
+    /// positions add up) and its value, for solvers that read J without a matrix.
+    pub fn with_jacobian_entries<R>(
+        &self,
+        x: &M::V,
+        t: f64,
+        dq_dt: &[f64],
+        f: impl FnOnce(&[usize], &[f64]) -> R,
+    ) -> R {
+        let mut vals = self.vals.borrow_mut();
+        self.scene
+            .jacobian_values_with_slopes(t, x.host(), &mut self.work.borrow_mut(), dq_dt, &mut vals);
+        f(&self.slots, &vals)
+    }
+
     /// Number of Jacobian entries written per evaluation (repeats included).
     pub fn entries(&self) -> usize {
         self.slots.len()

@@ -41,7 +41,11 @@
 use diffsol::{Op, Vector};
 use diffsol_la::{LinearOp, LinearSolver};
 
+use diffsol::{FaerSparseMat, NalgebraMat, NalgebraVec};
+
+use super::dense_lu::SmallDenseLu;
 use super::equations::{HostVector, JacobianMatrix, SceneEquations};
+use super::sparse_lu::NetworkSparseLu;
 use super::transient::{Driver, NumericalFailure, Trajectory};
 
 /// A Rosenbrock tableau in the transformed form (coefficients as KPP/FATODE give them).
@@ -141,6 +145,52 @@ impl<M: JacobianMatrix> LinearOp for IterationOp<'_, M> {
     }
 }
 
+/// How a linear solver gets the Jacobian at (t, y) and factorises W = I − γhJ for a step.
+pub(crate) trait IterationLu<M: JacobianMatrix>: LinearSolver<M> {
+    /// Evaluate J (losses' share of the oil column from `dq_dt`) and factorise W = I − γhJ.
+    /// The default writes J into `jac` and W into the solver's matrix.
+    #[allow(clippy::too_many_arguments)]
+    fn factorise_w(
+        &mut self,
+        eqn: &SceneEquations<'_, M>,
+        y: &M::V,
+        t: f64,
+        dq_dt: &[f64],
+        jac: &mut M,
+        gamma_h: f64,
+        diag: &[usize],
+    ) {
+        eqn.jacobian_with_slopes(y, t, dq_dt, jac);
+        self.set_linearisation(&IterationOp {
+            jac,
+            gamma_h,
+            diag,
+            sparsity: None,
+        });
+    }
+}
+
+impl IterationLu<FaerSparseMat<f64>> for NetworkSparseLu {}
+
+/// The small dense LU reads J's entries straight into its node block (no n × n matrix).
+impl IterationLu<NalgebraMat<f64>> for SmallDenseLu {
+    fn factorise_w(
+        &mut self,
+        eqn: &SceneEquations<'_, NalgebraMat<f64>>,
+        y: &NalgebraVec<f64>,
+        t: f64,
+        dq_dt: &[f64],
+        _jac: &mut NalgebraMat<f64>,
+        gamma_h: f64,
+        _diag: &[usize],
+    ) {
+        let n_all = y.len();
+        eqn.with_jacobian_entries(y, t, dq_dt, |slots, vals| {
+            self.factorise_entries(n_all, slots, vals, gamma_h)
+        });
+    }
+}
+
 /// What the integrator knows of ∂q_k/∂T_oil.
 struct Slopes {
     /// Slopes the next Jacobian uses, W/K.
@@ -165,7 +215,7 @@ pub(crate) struct RosStats {
 }
 
 /// The integrator's state over a run.
-struct Ros<'a, 'd, M: JacobianMatrix, LS: LinearSolver<M>> {
+struct Ros<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> {
     tab: &'static Tableau,
     d: &'a Driver<'d>,
     eqn: &'a SceneEquations<'d, M>,
@@ -185,7 +235,7 @@ struct Ros<'a, 'd, M: JacobianMatrix, LS: LinearSolver<M>> {
     stats: RosStats,
 }
 
-impl<'a, 'd, M: JacobianMatrix, LS: LinearSolver<M>> Ros<'a, 'd, M, LS> {
+impl<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> Ros<'a, 'd, M, LS> {
     fn new(d: &'a Driver<'d>, eqn: &'a SceneEquations<'d, M>, y0: &[f64]) -> Self {
         let n = y0.len();
         let ctx = eqn.context().clone();
@@ -284,14 +334,15 @@ impl<'a, 'd, M: JacobianMatrix, LS: LinearSolver<M>> Ros<'a, 'd, M, LS> {
 
     /// Evaluate J at (t, y) and factorise W = I − γhJ (= γh·G).
     fn factorise(&mut self, t: f64, h: f64) {
-        self.eqn
-            .jacobian_with_slopes(&self.y, t, &self.slopes.dq_dt, &mut self.jac);
-        self.ls.set_linearisation(&IterationOp {
-            jac: &self.jac,
-            gamma_h: self.tab.gamma * h,
-            diag: &self.diag,
-            sparsity: None,
-        });
+        self.ls.factorise_w(
+            self.eqn,
+            &self.y,
+            t,
+            &self.slopes.dq_dt,
+            &mut self.jac,
+            self.tab.gamma * h,
+            &self.diag,
+        );
         self.stats.lu += 1;
     }
 
@@ -385,7 +436,7 @@ pub(crate) fn run<M, LS>(
 ) -> Result<RosStats, NumericalFailure>
 where
     M: JacobianMatrix,
-    LS: LinearSolver<M>,
+    LS: IterationLu<M>,
 {
     let mut r = Ros::<M, LS>::new(d, eqn, y0);
     let segs = d.segments;
@@ -413,7 +464,7 @@ where
 }
 
 /// Steps from t to `t1` (f at (t, y) already evaluated); returns the next step-size proposal.
-fn integrate_segment<M: JacobianMatrix, LS: LinearSolver<M>>(
+fn integrate_segment<M: JacobianMatrix, LS: IterationLu<M>>(
     r: &mut Ros<'_, '_, M, LS>,
     t: &mut f64,
     mut h: f64,
