@@ -181,7 +181,7 @@ pub fn summary(
     atol: f64,
 ) -> Summary {
     let n = scene.nodes();
-    let last = traj.states.last().cloned().unwrap_or_default();
+    let last = traj.states.last().map(<[f64]>::to_vec).unwrap_or_default();
     let by = if last.is_empty() {
         [0.0; N_SOURCES]
     } else {

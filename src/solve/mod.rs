@@ -4,6 +4,7 @@ pub mod drive;
 pub mod equations;
 pub mod equilibrium;
 pub mod rosenbrock;
+pub mod rows;
 pub mod sparse_lu;
 pub mod steady;
 pub mod sweep;

@@ -23,6 +23,7 @@ use diffsol::{FaerSparseMat, NalgebraMat, OdeBuilder, OdeEquations, OdeSolverMet
 use super::dense_lu::SmallDenseLu;
 use super::equations::{HostVector, SceneEquations};
 use super::rosenbrock;
+use super::rows::Rows;
 use super::sparse_lu::NetworkSparseLu;
 use crate::scene::{Inputs, Scene, Work};
 
@@ -252,10 +253,10 @@ pub struct Trajectory {
     /// Output times, s (segment boundaries).
     pub times: Vec<f64>,
     /// State at each time (temperatures K, energies J).
-    pub states: Vec<Vec<f64>>,
+    pub states: Rows,
     /// Loss of each item at each time (W), with the inputs of the segment that starts there (the
     /// last row: of the last segment). Empty when `TransientOptions::record_losses` is off.
-    pub losses: Vec<Vec<f64>>,
+    pub losses: Rows,
     /// Segment index whose inputs each row shows.
     pub segment: Vec<usize>,
     /// Counters.
@@ -359,8 +360,11 @@ pub fn integrate(
     };
     let mut traj = Trajectory {
         times: Vec::with_capacity(segments.len() + 1),
-        states: Vec::with_capacity(segments.len() + 1),
-        losses: Vec::with_capacity(segments.len() + 1),
+        states: Rows::with_capacity(scene.n_states(), segments.len() + 1),
+        losses: Rows::with_capacity(
+            scene.items(),
+            if opts.record_losses { segments.len() + 1 } else { 0 },
+        ),
         segment: Vec::with_capacity(segments.len() + 1),
         stats: Stats::default(),
         wall_time_s: 0.0,
@@ -483,10 +487,10 @@ impl Driver<'_> {
     /// Record the row at time `t` whose losses [`Self::rhs`] has just evaluated at `y`.
     pub(crate) fn record_evaluated(&self, traj: &mut Trajectory, t: f64, y: &[f64], seg: usize) {
         if self.opts.record_losses {
-            traj.losses.push(self.work.borrow().q.clone());
+            traj.losses.push(&self.work.borrow().q);
         }
         traj.times.push(t);
-        traj.states.push(y.to_vec());
+        traj.states.push(y);
         traj.segment.push(seg);
     }
 
@@ -509,10 +513,10 @@ impl Driver<'_> {
         if self.opts.record_losses {
             let mut w = self.work.borrow_mut();
             self.scene.evaluate_losses(y, &mut w);
-            traj.losses.push(w.q.clone());
+            traj.losses.push(&w.q);
         }
         traj.times.push(t);
-        traj.states.push(y.to_vec());
+        traj.states.push(y);
         traj.segment.push(seg);
     }
 
