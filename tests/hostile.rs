@@ -446,10 +446,13 @@ fn a_second_writer_is_refused_while_the_first_writes() {
         "1e-9",
     ];
     let mut first = bin().args(args).spawn().unwrap();
-    // Wait for the first to take the lock.
+    // Wait for the first to take the lock: the file exists from its open, but the first holds
+    // the lock only once it has written its PID there (a second writer started between the two
+    // could take the lock first, and then the first is the one refused).
     let lock = d.path().join(".o.geartherm-lock");
+    let held = || std::fs::read_to_string(&lock).is_ok_and(|s| !s.trim().is_empty());
     let t = Instant::now();
-    while !lock.exists() && t.elapsed() < Duration::from_secs(10) {
+    while !held() && t.elapsed() < Duration::from_secs(10) {
         std::thread::sleep(Duration::from_millis(5));
     }
     let second = run(&args);

@@ -120,9 +120,11 @@ pub fn rotating_disc_h_slope(
 fn disc_h_and_re_exponent(omega: f64, radius: f64, fluid: &FluidProperties) -> (f64, f64) {
     let re = omega.abs() * radius * radius / fluid.kinematic_viscosity;
     let nu_l = 0.36 * re.sqrt();
-    let nu_t = 0.015 * re.powf(0.8);
+    // Re^0.8 as exp(0.8 ln Re) (Re = 0: ln = −∞, the power 0) and x^(1/4) as √√x: the same
+    // values to rounding, at a fraction of powf's cost (this runs per link and RHS).
+    let nu_t = 0.015 * (0.8 * re.ln()).exp();
     let (l4, t4) = (nu_l.powi(4), nu_t.powi(4));
-    let nu = (l4 + t4).powf(0.25) * fluid.prandtl.cbrt();
+    let nu = (l4 + t4).sqrt().sqrt() * fluid.prandtl.cbrt();
     let eps = if l4 + t4 > 0.0 {
         (0.5 * l4 + 0.8 * t4) / (l4 + t4)
     } else {

@@ -164,9 +164,13 @@ impl ElementLosses {
 
     /// Load terms of every bearing for `state`, input speed `w_in` (rad/s) and torque `t_in`
     /// (N·m) into `terms`. No allocation.
+    /// A bearing after one with the same speed powers (same ring speed and size) takes them
+    /// from it.
     pub fn prepare(&self, state: usize, w_in: f64, t_in: f64, terms: &mut [LoadTerms]) {
-        for (e, t) in self.bearings.iter().zip(terms.iter_mut()) {
-            *t = load_terms(e, state, w_in, t_in);
+        for k in 0..self.bearings.len().min(terms.len()) {
+            let (done, rest) = terms.split_at_mut(k);
+            let prev = k.checked_sub(1).map(|p| (&self.bearings[p].model, &done[p]));
+            rest[0] = load_terms_after(&self.bearings[k], state, w_in, t_in, prev);
         }
     }
 
@@ -215,13 +219,25 @@ impl ElementLosses {
 }
 
 fn load_terms(e: &BearingEntry, state: usize, w_in: f64, t_in: f64) -> LoadTerms {
+    load_terms_after(e, state, w_in, t_in, None)
+}
+
+/// Load terms of `e`, with the speed powers of `prev` when they are the same
+/// ([`BearingFriction::load_terms_after`]).
+fn load_terms_after(
+    e: &BearingEntry,
+    state: usize,
+    w_in: f64,
+    t_in: f64,
+    prev: Option<(&BearingFriction, &LoadTerms)>,
+) -> LoadTerms {
     let [r, a] = e.load[state];
     let t = t_in.abs();
     let load = BearingLoad {
         radial: r * t + e.preload[0],
         axial: a * t + e.preload[1],
     };
-    e.model.load_terms(e.speed[state] * w_in, load)
+    e.model.load_terms_after(e.speed[state] * w_in, load, prev)
 }
 
 fn default_heat(heat_to: &Option<Vec<(String, f64)>>, gear: Option<usize>) -> DefaultHeat {

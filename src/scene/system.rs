@@ -553,13 +553,13 @@ impl Scene {
         let n = self.nodes();
         let oil_g = self.oil_conductances_at(t, y, work);
         let mut k = 0;
-        let cap = &self.thermal.capacity;
+        let inv_cap = &self.thermal.inv_capacity;
         let work = &*work;
         let oil_g = if oil_g { &work.oil_g } else { &work.oil_g2 };
         self.thermal
             .network_heat_partials(&y[..n], oil_g, &work.net, &mut |r, _, d| {
                 vals[k] = match r {
-                    End::Node(i) => d / cap[i],
+                    End::Node(i) => d * inv_cap[i],
                     End::Boundary(_) => d,
                 };
                 k += 1;
@@ -599,8 +599,8 @@ impl Scene {
                 col[node] += f * d;
             }
         }
-        for (c, cap) in col.iter_mut().zip(&self.thermal.capacity) {
-            *c /= cap;
+        for (c, inv_cap) in col.iter_mut().zip(&self.thermal.inv_capacity) {
+            *c *= inv_cap;
         }
         for (d, &slot) in dq_dt.iter().zip(&self.energy_slot) {
             col[n + slot] += d;

@@ -128,6 +128,8 @@ pub struct ThermalScene {
     pub boundary_names: Vec<String>,
     /// Heat capacities, J/K.
     pub capacity: Vec<f64>,
+    /// Their reciprocals, 1/(J/K) (the Jacobian multiplies).
+    pub inv_capacity: Vec<f64>,
     /// Initial temperatures, K.
     pub initial: Vec<f64>,
     /// Oil node.
@@ -168,7 +170,7 @@ impl ThermalScene {
     pub fn compile(gb: &Gearbox, net: &ThermalNetwork, items: &[LossItem]) -> ThermalScene {
         let n = net.nodes.len();
         let names = net.nodes.iter().map(|x| x.name.clone()).collect();
-        let capacity = net.nodes.iter().map(|x| x.capacity).collect();
+        let capacity: Vec<f64> = net.nodes.iter().map(|x| x.capacity).collect();
         let initial = net
             .nodes
             .iter()
@@ -320,6 +322,7 @@ impl ThermalScene {
         ThermalScene {
             names,
             boundary_names: net.boundaries.iter().map(|b| b.name.clone()).collect(),
+            inv_capacity: capacity.iter().map(|c| 1.0 / c).collect(),
             capacity,
             initial,
             oil: net.oil_node,

@@ -353,14 +353,26 @@ impl<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> Ros<'a, 'd, M, LS> {
         let (done, rest) = self.k.split_at_mut(i);
         let ki = rest[0].host_mut();
         let f = if i == 0 { self.f.host() } else { self.fs.host() };
-        ki.iter_mut().zip(f).for_each(|(x, fi)| *x = gh * fi);
+        // One pass over the state (ROS3 has at most two earlier stages).
+        let c = |j: usize| tab.c[i][j] * tab.gamma;
+        match done {
+            [] => ki.iter_mut().zip(f).for_each(|(x, fi)| *x = gh * fi),
+            [k0] => {
+                let c0 = c(0);
+                for ((x, fi), a) in ki.iter_mut().zip(f).zip(k0.host()) {
+                    *x = gh * fi + c0 * a;
+                }
+            }
+            [k0, k1, ..] => {
+                let (c0, c1) = (c(0), c(1));
+                for (((x, fi), a), b) in ki.iter_mut().zip(f).zip(k0.host()).zip(k1.host()) {
+                    *x = gh * fi + c0 * a + c1 * b;
+                }
+            }
+        }
         if let Some(ft) = &self.ft {
             let g = gh * tab.gamma_sum[i] * h;
             ki.iter_mut().zip(ft.host()).for_each(|(x, v)| *x += g * v);
-        }
-        for (j, kj) in done.iter().enumerate() {
-            let c = tab.c[i][j] * tab.gamma;
-            ki.iter_mut().zip(kj.host()).for_each(|(x, v)| *x += c * v);
         }
     }
 
@@ -403,18 +415,16 @@ impl<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> Ros<'a, 'd, M, LS> {
     /// y⁺ = y + Σ m_i K_i into `tmp` and the weighted RMS norm of Σ e_i K_i.
     fn update_and_error(&mut self) -> f64 {
         let (rtol, atol) = (self.d.opts.rtol, self.d.atol);
-        let tab = self.tab;
+        let (m, e) = (self.tab.m, self.tab.e);
         let (tmp, y) = (self.tmp.host_mut(), self.y.host());
+        let [k0, k1, k2] = [self.k[0].host(), self.k[1].host(), self.k[2].host()];
         let mut sum = 0.0;
         for i in 0..y.len() {
-            let (mut y1, mut e) = (y[i], 0.0);
-            for (j, kj) in self.k.iter().enumerate() {
-                let v = kj.host()[i];
-                y1 += tab.m[j] * v;
-                e += tab.e[j] * v;
-            }
+            let (a, b, c) = (k0[i], k1[i], k2[i]);
+            let y1 = y[i] + m[0] * a + m[1] * b + m[2] * c;
+            let err = e[0] * a + e[1] * b + e[2] * c;
             tmp[i] = y1;
-            let r = e / (atol[i] + rtol * y[i].abs().max(y1.abs()));
+            let r = err / (atol[i] + rtol * y[i].abs().max(y1.abs()));
             sum += r * r;
         }
         let err = (sum / y.len() as f64).sqrt();

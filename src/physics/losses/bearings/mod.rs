@@ -128,6 +128,28 @@ impl BearingFriction {
         }
     }
 
+    /// As [`Self::load_terms`], taking the speed powers from `prev` (another bearing's terms at
+    /// the same cycle sample) when they are the same: equal ring speed and speed law (two SKF
+    /// bearings of one size on one shaft). The result equals [`Self::load_terms`]'s.
+    pub fn load_terms_after(
+        &self,
+        omega: f64,
+        load: BearingLoad,
+        prev: Option<(&Self, &LoadTerms)>,
+    ) -> LoadTerms {
+        let n = omega.abs() * RPM_PER_RAD_S;
+        match self {
+            BearingFriction::Skf(m) => {
+                let speed = prev.and_then(|(p, t)| match p {
+                    BearingFriction::Skf(o) if t.n_rpm == n && m.same_speed_law(o) => Some(t.speed),
+                    _ => None,
+                });
+                m.load_terms_with(n, load, speed)
+            }
+            BearingFriction::Palmgren(m) => m.load_terms(n, load),
+        }
+    }
+
     /// Frictional moment with terms `t` and oil `oil`.
     pub fn moment(&self, t: &LoadTerms, oil: BearingOil) -> BearingMoment {
         match self {

@@ -255,6 +255,20 @@ impl Skf {
 
     /// G_rr and G_sl at speed `n` (r/min) and `load`.
     pub fn load_terms(&self, n: f64, load: BearingLoad) -> LoadTerms {
+        self.load_terms_with(n, load, None)
+    }
+
+    /// True when `other`'s speed powers ([`LoadTerms::speed`]) equal this bearing's at every
+    /// speed: the same d_m and drag law.
+    pub fn same_speed_law(&self, other: &Skf) -> bool {
+        self.ln_dm == other.ln_dm
+            && (self.drag2 > 0.0) == (other.drag2 > 0.0)
+            && self.dm2_ft_pow == other.dm2_ft_pow
+    }
+
+    /// As [`Self::load_terms`], with the speed powers `speed` when already known (from a bearing
+    /// of the [`Self::same_speed_law`] at the same speed).
+    pub fn load_terms_with(&self, n: f64, load: BearingLoad, speed: Option<[f64; 4]>) -> LoadTerms {
         let (fr, fa) = (load.radial.abs(), load.axial.abs());
         let (c, dm, p) = (&self.c, self.dm, &self.dm_pow);
         let (g_rr, g_sl) = match self.kind {
@@ -265,7 +279,14 @@ impl Skf {
                     c.s1 * p[2] * (fr.powi(5) + c.s2 * p[3] / sin_af * fa.powi(4)).cbrt(),
                 )
             }
-            SkfKind::DeepGrooveBall => (c.r1 * p[0] * fr.powf(0.54), c.s1 * p[1] * fr.powf(5.0 / 3.0)),
+            SkfKind::DeepGrooveBall => {
+                // Both powers of F_r from one logarithm (F_r = 0: ln = −∞, both powers 0).
+                let ln_fr = fr.ln();
+                (
+                    c.r1 * p[0] * (0.54 * ln_fr).exp(),
+                    c.s1 * p[1] * (5.0 / 3.0 * ln_fr).exp(),
+                )
+            }
             SkfKind::AngularContactBall | SkfKind::FourPointContactBall => {
                 let dm4n2 = dm.powi(4) * n * n;
                 (
@@ -280,6 +301,16 @@ impl Skf {
                 c.s1 * p[1] * (fr + c.s2 * fa),
             ),
         };
+        LoadTerms {
+            n_rpm: n,
+            g_rr,
+            g_sl,
+            speed: speed.unwrap_or_else(|| self.speed_powers(n)),
+        }
+    }
+
+    /// `[(n d_m)^1.28, n^0.6, n^1.4, n²·(n d_m² f_t)^−1.379]` at `n` (r/min).
+    fn speed_powers(&self, n: f64) -> [f64; 4] {
         // The powers of n from one logarithm (exp is about half the cost of powf; the values
         // agree to rounding). n = 0 gives ln n = −∞ and every positive power 0, as powf does.
         let ln_n = n.ln();
@@ -290,17 +321,12 @@ impl Skf {
         } else {
             0.0
         };
-        LoadTerms {
-            n_rpm: n,
-            g_rr,
-            g_sl,
-            speed: [
-                (1.28 * (ln_n + self.ln_dm)).exp(),
-                (0.6 * ln_n).exp(),
-                (1.4 * ln_n).exp(),
-                drag,
-            ],
-        }
+        [
+            (1.28 * (ln_n + self.ln_dm)).exp(),
+            (0.6 * ln_n).exp(),
+            (1.4 * ln_n).exp(),
+            drag,
+        ]
     }
 
     /// Frictional moment at the oil state `oil` with the load terms `t`: two exponentials and

@@ -421,3 +421,60 @@ fn vanishing_speeds_give_finite_power() {
         assert!((0.0..1e-6).contains(&p), "{w}: {p} W");
     }
 }
+
+/// Speed powers taken from a bearing of the same size at the same speed give bitwise the terms
+/// computed from scratch; a different size or speed is not shared.
+#[test]
+fn shared_speed_powers_equal_computed_ones() {
+    let c = dgbb(3.3e-7, 3.3e-3, 0.0);
+    let a = BearingFriction::Skf(
+        Skf::new(&input(
+            SkfKind::DeepGrooveBall,
+            c,
+            40.0,
+            80.0,
+            19000.0,
+            (0.12, 0.1),
+        ))
+        .unwrap(),
+    );
+    let b = BearingFriction::Skf(
+        Skf::new(&input(
+            SkfKind::DeepGrooveBall,
+            c,
+            40.0,
+            80.0,
+            19000.0,
+            (0.12, 0.1),
+        ))
+        .unwrap(),
+    );
+    let other = BearingFriction::Skf(
+        Skf::new(&input(
+            SkfKind::DeepGrooveBall,
+            c,
+            50.0,
+            90.0,
+            23000.0,
+            (0.12, 0.1),
+        ))
+        .unwrap(),
+    );
+    let load = |fr, fa| BearingLoad {
+        radial: fr,
+        axial: fa,
+    };
+    let w = 1500.0 * RPM;
+    let ta = a.load_terms(w, load(2000.0, 0.0));
+    // b carries an axial load (the other branch of G_rr, G_sl); its speed powers are a's.
+    let shared = b.load_terms_after(w, load(1200.0, 400.0), Some((&a, &ta)));
+    assert_eq!(shared, b.load_terms(w, load(1200.0, 400.0)));
+    let t_other = other.load_terms(w, load(2000.0, 0.0));
+    assert_ne!(t_other.speed, ta.speed);
+    assert_eq!(
+        other.load_terms_after(w, load(2000.0, 0.0), Some((&a, &ta))),
+        t_other
+    );
+    let slower = b.load_terms_after(0.5 * w, load(2000.0, 0.0), Some((&a, &ta)));
+    assert_eq!(slower, b.load_terms(0.5 * w, load(2000.0, 0.0)));
+}
