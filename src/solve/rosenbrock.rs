@@ -28,8 +28,9 @@
 //! each slope is carried over as a logarithmic derivative (∂ ln q_k/∂T_oil, which the viscosity
 //! sets and the speed barely moves) times the new loss. An explicit forward difference is taken
 //! when there is nothing to carry over: the first step, a gear change, an item whose loss was
-//! zero, a rejected step. The links whose conductance follows ν(T_oil) are differenced directly
-//! (no loss evaluation).
+//! zero, a rejected step. The links whose conductance follows ν(T_oil) enter with their analytic
+//! derivative, which every RHS computes beside the conductance (the Jacobian at the step's start
+//! takes both from the first stage).
 //!
 //! ∂f/∂t: only moving boundary temperatures (e.g. an engine coolant warm-up curve) make f depend
 //! on t, and [`crate::scene::Scene::time_derivative`] gives it from the network alone.
