@@ -39,24 +39,17 @@ pub struct SmallDenseLu {
     nodes_leading: bool,
     /// Non-zero entries of M_QN: (quadrature state, column in the node block, value).
     m_qn: Vec<(usize, usize, f64)>,
-    /// Where each Jacobian entry of [`Self::factorise_entries`] goes, for the slots it was
-    /// built for.
-    entry_dest: Vec<EntryDest>,
-    entry_slots: Vec<usize>,
+    /// Where the Jacobian entries of [`Self::factorise_entries`] go, for the slots they were
+    /// built for: (entry, position in the node block), and the entry of each M_QN value.
+    node_entries: Vec<(usize, usize)>,
+    quad_entries: Vec<usize>,
+    /// Address and length of those slots (the solver serves one equations object per run).
+    entry_slots: (usize, usize),
     /// The matrix as the operator writes it.
     a: Option<NalgebraMat<f64>>,
     /// Scratch for x_N.
     x_n: std::cell::RefCell<Vec<f64>>,
     factorised: bool,
-}
-
-/// Destination of a Jacobian entry in the blocks of M = I − γhJ.
-#[derive(Debug, Clone, Copy)]
-enum EntryDest {
-    /// Position in the column-major node block.
-    Node(usize),
-    /// Quadrature state and column in the node block.
-    Quad(usize, usize),
 }
 
 impl SmallDenseLu {
@@ -82,6 +75,8 @@ impl SmallDenseLu {
         }
         self.set_block_sizes();
         let n = self.n;
+        // The entries' destinations (factorise_entries) no longer describe m_qn.
+        self.entry_slots = (0, 0);
         self.m_qn.clear();
         for (b, &j) in self.nodes.iter().enumerate() {
             let c = &m[j * n_all..(j + 1) * n_all];
@@ -122,18 +117,18 @@ impl SmallDenseLu {
         }
         self.set_block_sizes();
         let n = self.n;
-        self.entry_dest = slots
-            .iter()
-            .map(|&s| {
-                let (r, c) = (s % n_all, local[s / n_all]);
-                match local[r] {
-                    usize::MAX => EntryDest::Quad(r, c),
-                    a => EntryDest::Node(c * n + a),
+        (self.node_entries, self.quad_entries, self.m_qn) = (Vec::new(), Vec::new(), Vec::new());
+        for (k, &s) in slots.iter().enumerate() {
+            let (r, c) = (s % n_all, local[s / n_all]);
+            match local[r] {
+                usize::MAX => {
+                    self.quad_entries.push(k);
+                    self.m_qn.push((r, c, 0.0));
                 }
-            })
-            .collect();
-        self.m_qn = Vec::with_capacity(slots.len());
-        self.entry_slots = slots.to_vec();
+                a => self.node_entries.push((k, c * n + a)),
+            }
+        }
+        self.entry_slots = (slots.as_ptr() as usize, slots.len());
     }
 
     /// Factorise M = I − γh·J straight from J's entries `vals` at the column-major positions
@@ -141,7 +136,7 @@ impl SmallDenseLu {
     /// node block and the non-zero entries of M_QN are written. Returns false when the node block
     /// is singular or not finite (the solves then fail).
     pub fn factorise_entries(&mut self, n_all: usize, slots: &[usize], vals: &[f64], gamma_h: f64) -> bool {
-        if self.entry_slots != slots {
+        if self.entry_slots != (slots.as_ptr() as usize, slots.len()) {
             self.split_for_entries(n_all, slots);
         }
         let n = self.n;
@@ -149,12 +144,11 @@ impl SmallDenseLu {
         for k in 0..n {
             self.lu[k * n + k] = 1.0;
         }
-        self.m_qn.clear();
-        for (d, v) in self.entry_dest.iter().zip(vals) {
-            match *d {
-                EntryDest::Node(p) => self.lu[p] -= gamma_h * v,
-                EntryDest::Quad(q, c) => self.m_qn.push((q, c, -gamma_h * v)),
-            }
+        for &(k, p) in &self.node_entries {
+            self.lu[p] -= gamma_h * vals[k];
+        }
+        for (m, &k) in self.m_qn.iter_mut().zip(&self.quad_entries) {
+            m.2 = -gamma_h * vals[k];
         }
         self.factorised = self.factor();
         self.factorised
@@ -236,7 +230,7 @@ impl LinearSolver<Mat> for SmallDenseLu {
         self.nodes = Vec::with_capacity(n);
         self.quads = Vec::with_capacity(n);
         self.m_qn = Vec::with_capacity(n * n);
-        self.entry_slots.clear();
+        self.entry_slots = (0, 0);
         self.x_n = std::cell::RefCell::new(vec![0.0; n]);
         self.a = Some(<Mat as diffsol::Matrix>::zeros(n, n, *op.context()));
         self.factorised = false;
