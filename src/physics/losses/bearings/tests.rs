@@ -427,39 +427,12 @@ fn vanishing_speeds_give_finite_power() {
 #[test]
 fn shared_speed_powers_equal_computed_ones() {
     let c = dgbb(3.3e-7, 3.3e-3, 0.0);
-    let a = BearingFriction::Skf(
-        Skf::new(&input(
-            SkfKind::DeepGrooveBall,
-            c,
-            40.0,
-            80.0,
-            19000.0,
-            (0.12, 0.1),
-        ))
-        .unwrap(),
-    );
-    let b = BearingFriction::Skf(
-        Skf::new(&input(
-            SkfKind::DeepGrooveBall,
-            c,
-            40.0,
-            80.0,
-            19000.0,
-            (0.12, 0.1),
-        ))
-        .unwrap(),
-    );
-    let other = BearingFriction::Skf(
-        Skf::new(&input(
-            SkfKind::DeepGrooveBall,
-            c,
-            50.0,
-            90.0,
-            23000.0,
-            (0.12, 0.1),
-        ))
-        .unwrap(),
-    );
+    let deep_groove = |d: f64, big_d: f64, c0: f64| {
+        let i = input(SkfKind::DeepGrooveBall, c, d, big_d, c0, (0.12, 0.1));
+        BearingFriction::Skf(Skf::new(&i).unwrap())
+    };
+    let (a, b) = (deep_groove(40.0, 80.0, 19000.0), deep_groove(40.0, 80.0, 19000.0));
+    let other = deep_groove(50.0, 90.0, 23000.0);
     let load = |fr, fa| BearingLoad {
         radial: fr,
         axial: fa,
