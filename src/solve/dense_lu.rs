@@ -385,4 +385,49 @@ mod tests {
         lu.gather(&m, n);
         assert_eq!(lu.quads, vec![3]);
     }
+
+    /// W = I − γhJ factorised straight from J's entries (repeated positions, node columns
+    /// 0, 1, 3 of 6 states, quadrature rows reading them) solves W x = b to rounding, and a new
+    /// γh on the same pattern too.
+    #[test]
+    fn factorising_from_entries_solves_the_iteration_matrix() {
+        use diffsol::Vector;
+        let n = 6;
+        let cols = [0usize, 1, 3];
+        // (row, column, value); (1, 1) appears twice and adds up.
+        let mut entries = Vec::new();
+        for &c in &cols {
+            for r in 0..n {
+                entries.push((
+                    r,
+                    c,
+                    0.2 + 0.05 * (r + 3 * c) as f64 - if r == c { 1.5 } else { 0.0 },
+                ));
+            }
+        }
+        entries.push((1, 1, -0.4));
+        let slots: Vec<usize> = entries.iter().map(|&(r, c, _)| c * n + r).collect();
+        let vals: Vec<f64> = entries.iter().map(|e| e.2).collect();
+        let mut lu = SmallDenseLu::default();
+        for gamma_h in [0.3, 2.0] {
+            let mut w = vec![0.0; n * n];
+            for k in 0..n {
+                w[k * n + k] = 1.0;
+            }
+            for &(r, c, v) in &entries {
+                w[c * n + r] -= gamma_h * v;
+            }
+            assert!(lu.factorise_entries(n, &slots, &vals, gamma_h));
+            assert_eq!(lu.nodes, cols);
+            let x_true: Vec<f64> = (0..n).map(|i| 1.0 - 0.3 * i as f64).collect();
+            let mut v = NalgebraVec::<f64>::zeros(n, Default::default());
+            for (i, b) in v.host_mut().iter_mut().enumerate() {
+                *b = (0..n).map(|j| w[j * n + i] * x_true[j]).sum();
+            }
+            lu.solve_in_place(&mut v).unwrap();
+            for (x, t) in v.host().iter().zip(&x_true) {
+                assert!((x - t).abs() < 1e-13, "γh {gamma_h}: {x} vs {t}");
+            }
+        }
+    }
 }
