@@ -150,22 +150,49 @@ impl Converter {
     }
 
     /// SR in (0, 1) where the turbine torque at turbine speed `wt` > 0 equals `tt` > 0.
+    ///
+    /// Bracketed root finding: bisection until both ends of the bracket have finite values
+    /// (f(0+) = +∞), then the Illinois variant of regula falsi ([recalled] Dowell & Jarratt,
+    /// BIT 11, 1971: a regula falsi step, and the retained end's value halved when the same end
+    /// is kept twice), which keeps the bracket and converges superlinearly: fewer evaluations of
+    /// f than bisection's ≈ 47 to the same 1e-14 bracket. f is continuous and piecewise smooth
+    /// (linear interpolation of the converter tables); checked against bisection in the tests.
     pub fn solve_speed_ratio(&self, wt: f64, tt: f64) -> f64 {
         let f = |sr: f64| self.torque_ratio(sr) * self.impeller_torque(wt / sr, sr) - tt;
-        let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
         // f(0+) = +∞, f(1) = −tt < 0.
+        let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+        let (mut f_lo, mut f_hi) = (f64::INFINITY, -tt);
+        // Which end the last two steps moved (for the Illinois halving).
+        let mut side = 0i8;
         for _ in 0..200 {
-            let mid = 0.5 * (lo + hi);
-            if mid <= lo || mid >= hi {
-                break;
-            }
-            if f(mid) > 0.0 {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
             if hi - lo < 1e-14 {
                 break;
+            }
+            let secant = lo - f_lo * (hi - lo) / (f_hi - f_lo);
+            let x = if f_lo.is_finite() && secant > lo && secant < hi {
+                secant
+            } else {
+                0.5 * (lo + hi)
+            };
+            if x <= lo || x >= hi {
+                break;
+            }
+            let fx = f(x);
+            if fx == 0.0 {
+                return x;
+            }
+            if fx > 0.0 {
+                (lo, f_lo) = (x, fx);
+                if side == 1 {
+                    f_hi *= 0.5;
+                }
+                side = 1;
+            } else {
+                (hi, f_hi) = (x, fx);
+                if side == -1 && f_lo.is_finite() {
+                    f_lo *= 0.5;
+                }
+                side = -1;
             }
         }
         0.5 * (lo + hi)
@@ -245,6 +272,34 @@ pub(crate) mod tests {
         assert_relative_eq!(p.impeller_torque, 100.0, max_relative = 1e-12);
         assert_relative_eq!(p.turbine_torque, 200.0, max_relative = 1e-12);
         assert_relative_eq!(p.loss, 100.0 * 1444.0 * RPM, max_relative = 1e-12);
+    }
+
+    /// The Illinois root agrees with plain bisection to 1e-12 over turbine speeds and demands
+    /// from creep to the end of the table, and makes the turbine torque match the demand.
+    #[test]
+    fn speed_ratio_root_matches_bisection() {
+        let c = jdm();
+        let bisect = |wt: f64, tt: f64| {
+            let f = |sr: f64| c.torque_ratio(sr) * c.impeller_torque(wt / sr, sr) - tt;
+            let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+            while hi - lo > 1e-15 {
+                let mid = 0.5 * (lo + hi);
+                if f(mid) > 0.0 {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            0.5 * (lo + hi)
+        };
+        for wt in [0.5, 5.0, 50.0, 150.0, 300.0, 600.0] {
+            for tt in [0.1, 1.0, 10.0, 50.0, 200.0, 600.0] {
+                let (sr, sr_ref) = (c.solve_speed_ratio(wt, tt), bisect(wt, tt));
+                assert!((sr - sr_ref).abs() < 1e-12, "wt {wt} tt {tt}: {sr} vs {sr_ref}");
+                let t_out = c.torque_ratio(sr) * c.impeller_torque(wt / sr, sr);
+                assert_relative_eq!(t_out, tt, max_relative = 1e-9);
+            }
+        }
     }
 
     #[test]
