@@ -144,3 +144,39 @@ fn sparse_and_dense_linear_algebra_give_the_same_trajectory() {
     }
     assert!(worst < 1e-9, "{worst}");
 }
+
+#[test]
+fn the_analytic_time_derivative_matches_a_central_difference_of_the_rhs() {
+    // The AT6's coolant series is piecewise linear with knots at 300, 600 and 900 s: inside a
+    // piece the central difference of f over ±1 ms is exact up to rounding, and at a knot the
+    // derivative is the next piece's (the one a step from t integrates over).
+    let (scene, segs) = wltc("models/at6_lepelletier.toml");
+    let mut work = scene.work(segs[400].inputs);
+    let mut y = scene.initial_state(None);
+    y[scene.thermal.oil] += 30.0; // the coolant exchanger between the oil and a warmer coolant
+    let n_s = scene.n_states();
+    let (mut ft, mut f1, mut f0) = (vec![0.0; n_s], vec![0.0; n_s], vec![0.0; n_s]);
+    let d = 1e-3;
+    for t in [17.3, 450.6, 777.7, 1500.0] {
+        scene.time_derivative(t, &y, &mut work, &mut ft);
+        scene.rhs(t + d, &y, &mut work, &mut f1);
+        scene.rhs(t - d, &y, &mut work, &mut f0);
+        let scale = ft.iter().fold(1e-12_f64, |m, v| m.max(v.abs()));
+        for (i, ((a, b0), b1)) in ft.iter().zip(&f0).zip(&f1).enumerate() {
+            let fd = (b1 - b0) / (2.0 * d);
+            assert!((a - fd).abs() <= 1e-6 * scale, "t {t}, state {i}: {a} vs {fd}");
+        }
+    }
+    // At a knot: the slope of the piece after it.
+    scene.time_derivative(300.0, &y, &mut work, &mut ft);
+    scene.rhs(300.0 + d, &y, &mut work, &mut f1);
+    scene.rhs(300.0, &y, &mut work, &mut f0);
+    let oil = scene.thermal.oil;
+    let fd = (f1[oil] - f0[oil]) / d;
+    assert!(
+        (ft[oil] - fd).abs() <= 1e-6 * fd.abs().max(1e-12),
+        "{} vs {fd}",
+        ft[oil]
+    );
+    assert!(ft[oil] != 0.0);
+}

@@ -256,6 +256,23 @@ impl BoundaryTemp {
         }
     }
 
+    /// dT/dt (K/s) on the piece the series follows just after `t` (a kink at `t` gives the
+    /// slope of the piece that starts there); 0 before the first and after the last point.
+    pub fn slope_at(&self, t: f64) -> f64 {
+        match self {
+            BoundaryTemp::Fixed(_) => 0.0,
+            BoundaryTemp::Series(s) => {
+                let k = s.partition_point(|p| p.0 <= t);
+                if k == 0 || k == s.len() {
+                    0.0
+                } else {
+                    let (a, b) = (s[k - 1], s[k]);
+                    (b.1 - a.1) / (b.0 - a.0)
+                }
+            }
+        }
+    }
+
     /// Temperature at time `t`, K.
     pub fn at(&self, t: f64) -> f64 {
         match self {

@@ -49,9 +49,6 @@ fn oil_step(t_oil: f64) -> f64 {
     1e-4 * (1.0 + t_oil.abs() / 300.0)
 }
 
-/// Time step of the forward difference of [`Scene::time_derivative`], s.
-pub const TIME_STEP_FD: f64 = 1e-3;
-
 /// The compiled scene.
 #[derive(Debug, Clone)]
 pub struct Scene {
@@ -645,9 +642,9 @@ impl Scene {
     }
 
     /// ∂f/∂t at (t, y) into `out`: only boundary temperatures depend on time, so this is the
-    /// network's response to their slope, by a forward difference over [`TIME_STEP_FD`] (boundary
-    /// series are piecewise linear: exact within a piece, and a step starting at a kink sees the
-    /// piece it integrates over). The loss rows are zero. Allocation-free.
+    /// network's response to their rates of change, analytic (boundary series are piecewise
+    /// linear: the rate of the piece the series follows just after t, the one a step from t
+    /// integrates over). The loss rows are zero. Allocation-free.
     pub fn time_derivative(&self, t: f64, y: &[f64], work: &mut Work, out: &mut [f64]) {
         let n = self.nodes();
         work.base = None;
@@ -656,26 +653,16 @@ impl Scene {
         self.thermal
             .oil_link_conductances(&oil, &slopes, &op, &mut work.oil_g, &mut work.oil_dg);
         self.thermal.boundary_temperatures(t, &mut work.net);
-        let b0 = self
+        self.thermal.boundary_slopes(t, &mut work.net);
+        let to_b = self
             .thermal
-            .network_heat(&y[..n], &work.oil_g, &work.net, &mut work.heat);
-        self.thermal
-            .boundary_temperatures(t + TIME_STEP_FD, &mut work.net);
-        let b1 = self
-            .thermal
-            .network_heat(&y[..n], &work.oil_g, &work.net, &mut work.heat2);
-        for (((o, h1), h0), cap) in out
-            .iter_mut()
-            .zip(&work.heat2)
-            .zip(&work.heat)
-            .zip(&self.thermal.capacity)
-        {
-            *o = (h1 - h0) / TIME_STEP_FD / cap;
+            .network_heat_time_rate(&y[..n], &work.oil_g, &work.net, &mut work.heat);
+        for ((o, h), c) in out.iter_mut().zip(&work.heat).zip(&self.thermal.capacity) {
+            *o = h / c;
         }
         let e = self.energies;
         out[n..n + e].iter_mut().for_each(|x| *x = 0.0);
-        out[n + e] = (b1 - b0) / TIME_STEP_FD;
-        self.thermal.boundary_temperatures(t, &mut work.net);
+        out[n + e] = to_b;
     }
 
     /// Heat flow into each node (W) and into boundaries at state `y` with the current inputs (for

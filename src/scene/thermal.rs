@@ -154,6 +154,8 @@ pub struct NetworkWork {
     pub sample_g: Vec<f64>,
     /// Boundary temperatures at the current time, K.
     pub boundary_t: Vec<f64>,
+    /// Their rates of change, K/s ([`ThermalScene::boundary_slopes`]).
+    pub boundary_slope: Vec<f64>,
 }
 
 /// The oil as the fluid of the rotating-disc correlation (Pr = μ·c_p/k).
@@ -368,6 +370,7 @@ impl ThermalScene {
         NetworkWork {
             sample_g: vec![0.0; self.sample.len()],
             boundary_t: self.boundaries.iter().map(|b| b.at(0.0)).collect(),
+            boundary_slope: vec![0.0; self.boundaries.len()],
         }
     }
 
@@ -406,6 +409,13 @@ impl ThermalScene {
     pub fn boundary_temperatures(&self, t: f64, work: &mut NetworkWork) {
         for (x, b) in work.boundary_t.iter_mut().zip(&self.boundaries) {
             *x = b.at(t);
+        }
+    }
+
+    /// The boundary temperatures' rates of change at time `t` into `work.boundary_slope`.
+    pub fn boundary_slopes(&self, t: f64, work: &mut NetworkWork) {
+        for (x, b) in work.boundary_slope.iter_mut().zip(&self.boundaries) {
+            *x = b.slope_at(t);
         }
     }
 
@@ -563,8 +573,8 @@ impl ThermalScene {
     }
 
     /// Directional derivative of [`Self::network_heat`] along `v` (K), holding the oil properties
-    /// fixed (their dependence on T_oil is added by the caller through a finite difference).
-    /// Writes W per node into `out`; returns the derivative of the boundary heat.
+    /// (the caller adds their T_oil dependence) and the boundary temperatures fixed: W per node
+    /// into `out`; returns the derivative of the boundary heat. Allocation-free.
     pub fn network_heat_jvp(
         &self,
         temps: &[f64],
@@ -573,11 +583,41 @@ impl ThermalScene {
         v: &[f64],
         out: &mut [f64],
     ) -> f64 {
-        out.iter_mut().for_each(|x| *x = 0.0);
         let dv = |e: End| match e {
             End::Node(i) => v[i],
             End::Boundary(_) => 0.0,
         };
+        self.heat_derivative(temps, oil_g, work, dv, out)
+    }
+
+    /// ∂(network heat)/∂t: the response to the boundary temperatures' rates of change in
+    /// `work.boundary_slope` (node temperatures and oil properties fixed): heat per node into
+    /// `out` (W/s), returns the boundary share. Allocation-free.
+    pub fn network_heat_time_rate(
+        &self,
+        temps: &[f64],
+        oil_g: &[f64],
+        work: &NetworkWork,
+        out: &mut [f64],
+    ) -> f64 {
+        let dv = |e: End| match e {
+            End::Node(_) => 0.0,
+            End::Boundary(j) => work.boundary_slope[j],
+        };
+        self.heat_derivative(temps, oil_g, work, dv, out)
+    }
+
+    /// Derivative of [`Self::network_heat`] along the rates `dv` of every end (nodes and
+    /// boundaries), oil properties fixed.
+    fn heat_derivative(
+        &self,
+        temps: &[f64],
+        oil_g: &[f64],
+        work: &NetworkWork,
+        dv: impl Fn(End) -> f64,
+        out: &mut [f64],
+    ) -> f64 {
+        out.iter_mut().for_each(|x| *x = 0.0);
         let bt = &work.boundary_t;
         let mut to_b = 0.0;
         for c in &self.fixed {
@@ -598,7 +638,7 @@ impl ThermalScene {
             let th = temps[c.hot];
             let tc = Self::temp(c.cold, temps, bt);
             let (x, dx) = c.opening(th, tc);
-            let dq = c.g * ((x + dx * (th - tc)) * v[c.hot] - x * dv(c.cold));
+            let dq = c.g * ((x + dx * (th - tc)) * dv(End::Node(c.hot)) - x * dv(c.cold));
             Self::flow(End::Node(c.hot), c.cold, dq, out, &mut to_b);
         }
         to_b
