@@ -328,8 +328,9 @@ impl<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> Ros<'a, 'd, M, LS> {
         if dt.abs() < MIN_SLOPE_DT {
             return;
         }
+        let inv_dt = 1.0 / dt;
         for ((l, q1), q2) in s.log.iter_mut().zip(&s.q1).zip(&s.q2) {
-            *l = (*q1 != 0.0).then(|| (q2 - q1) / dt / q1);
+            *l = (*q1 != 0.0).then(|| (q2 - q1) * inv_dt / q1);
         }
     }
 
