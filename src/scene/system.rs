@@ -429,6 +429,22 @@ impl Scene {
         }
     }
 
+    /// [`Self::heat_balance`] at oil temperature `t_oil` into the work area's scratch buffers
+    /// (`q2`, `oil_g2`, `oil_dg2`, `heat2`), leaving the last right-hand side's intact.
+    fn scratch_heat_balance(&self, y: &[f64], t_oil: f64, work: &mut Work) -> f64 {
+        let inputs = work.inputs;
+        self.heat_balance(
+            y,
+            t_oil,
+            &inputs,
+            &work.terms,
+            &work.net,
+            &mut work.q2,
+            (&mut work.oil_g2, &mut work.oil_dg2),
+            &mut work.heat2,
+        )
+    }
+
     /// ∂f/∂T_oil through the oil properties (all rows of the state), by a forward difference,
     /// cached per (T_oil, sample) in `work.oil_col`.
     fn update_oil_column(&self, t: f64, y: &[f64], t_oil: f64, work: &mut Work) {
@@ -440,39 +456,20 @@ impl Scene {
         }
         work.jac_evals += 1;
         let h = oil_step(t_oil);
-        let inputs = work.inputs;
         let b0 = if work.holds_rhs_at(t, &y[..n]) {
             // The last right-hand side was evaluated here: start from its heat balance.
             work.oil_col[..n].copy_from_slice(&work.heat);
             work.q_base.copy_from_slice(&work.q);
             work.base_to_b
         } else {
-            let b = self.heat_balance(
-                y,
-                t_oil,
-                &inputs,
-                &work.terms,
-                &work.net,
-                &mut work.q2,
-                (&mut work.oil_g2, &mut work.oil_dg2),
-                &mut work.heat2,
-            );
+            let b = self.scratch_heat_balance(y, t_oil, work);
             work.oil_col[..n].copy_from_slice(&work.heat2);
             work.q_base.copy_from_slice(&work.q2);
             b
         };
         // Only the oil properties move (t_oil + h); the node temperatures stay those of y, whose
         // effect is the analytic part.
-        let b1 = self.heat_balance(
-            y,
-            t_oil + h,
-            &inputs,
-            &work.terms,
-            &work.net,
-            &mut work.q2,
-            (&mut work.oil_g2, &mut work.oil_dg2),
-            &mut work.heat2,
-        );
+        let b1 = self.scratch_heat_balance(y, t_oil + h, work);
         for i in 0..n {
             work.oil_col[i] = (work.heat2[i] - work.oil_col[i]) / h / self.thermal.capacity[i];
         }
@@ -532,7 +529,7 @@ impl Scene {
     /// Values of the Jacobian entries of [`Self::jacobian_pattern`], in its order, at (t, y):
     /// ∂(dy_row)/∂y_col. Allocation-free; `vals` has the pattern's length.
     pub fn jacobian_values(&self, t: f64, y: &[f64], work: &mut Work, vals: &mut [f64]) {
-        let k = self.network_partial_values(t, y, work, vals);
+        let (k, _) = self.network_partial_values(t, y, work, vals);
         let col = &mut vals[k..];
         if self.frozen_oil_temp.is_some() {
             col.iter_mut().for_each(|x| *x = 0.0);
@@ -546,13 +543,15 @@ impl Scene {
     /// returns how many were written.
     /// The oil links' conductances at (t, y) are those of the last right-hand side when it was
     /// evaluated there (ROS3's Jacobian follows its first stage), else computed into scratch.
-    fn network_partial_values(&self, t: f64, y: &[f64], work: &mut Work, vals: &mut [f64]) -> usize {
+    /// Also returns whether the oil links' conductances (and their derivatives) are those of
+    /// the last RHS (`oil_g`, `oil_dg`) or were computed into the scratch (`oil_g2`, `oil_dg2`).
+    fn network_partial_values(&self, t: f64, y: &[f64], work: &mut Work, vals: &mut [f64]) -> (usize, bool) {
         let n = self.nodes();
-        let oil_g = self.oil_conductances_at(t, y, work);
+        let held = self.oil_conductances_at(t, y, work);
         let mut k = 0;
         let inv_cap = &self.thermal.inv_capacity;
         let work = &*work;
-        let oil_g = if oil_g { &work.oil_g } else { &work.oil_g2 };
+        let oil_g = if held { &work.oil_g } else { &work.oil_g2 };
         self.thermal
             .network_heat_partials(&y[..n], oil_g, &work.net, &mut |r, _, d| {
                 vals[k] = match r {
@@ -561,12 +560,13 @@ impl Scene {
                 };
                 k += 1;
             });
-        k
+        (k, held)
     }
 
     /// As [`Self::jacobian_values`], with the losses' share of the oil column from given slopes
     /// `dq_dt[k]` = ∂q_k/∂T_oil (W/K) instead of a forward difference of every loss; the links
-    /// whose conductance follows ν(T_oil) are still differenced, which evaluates no loss.
+    /// whose conductance follows ν(T_oil) enter with their analytic derivative (no loss is
+    /// evaluated).
     pub fn jacobian_values_with_slopes(
         &self,
         t: f64,
@@ -575,19 +575,14 @@ impl Scene {
         dq_dt: &[f64],
         vals: &mut [f64],
     ) {
-        let k = self.network_partial_values(t, y, work, vals);
+        let (k, held) = self.network_partial_values(t, y, work, vals);
         let col = &mut vals[k..];
         col.iter_mut().for_each(|x| *x = 0.0);
         if self.moving_oil_temp(y).is_none() {
             return;
         }
         let n = self.nodes();
-        // network_partial_values left the conductances at t_oil in one of the two buffers.
-        let dg = if work.holds_rhs_at(t, &y[..n]) {
-            &work.oil_dg
-        } else {
-            &work.oil_dg2
-        };
+        let dg = if held { &work.oil_dg } else { &work.oil_dg2 };
         let to_b = self
             .thermal
             .oil_property_derivative(&y[..n], dg, &work.net, &mut col[..n]);
