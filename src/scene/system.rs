@@ -642,17 +642,16 @@ impl Scene {
     /// integrates over). The loss rows are zero. Allocation-free.
     pub fn time_derivative(&self, t: f64, y: &[f64], work: &mut Work, out: &mut [f64]) {
         let n = self.nodes();
-        work.base = None;
-        let (oil, slopes) = self.thermal.oil_properties_and_slopes(self.oil_temp(y));
-        let op = Self::operating(&work.inputs);
-        self.thermal
-            .oil_link_conductances(&oil, &slopes, &op, &mut work.oil_g, &mut work.oil_dg);
-        self.thermal.boundary_temperatures(t, &mut work.net);
+        // The oil links' conductances of the last RHS when it was evaluated here (ROS3 asks at
+        // the step's start, after its first stage), else computed into scratch; the last RHS's
+        // heat balance is left intact.
+        let held = self.oil_conductances_at(t, y, work);
         self.thermal.boundary_slopes(t, &mut work.net);
+        let oil_g = if held { &work.oil_g } else { &work.oil_g2 };
         let to_b = self
             .thermal
-            .network_heat_time_rate(&y[..n], &work.oil_g, &work.net, &mut work.heat);
-        for ((o, h), c) in out.iter_mut().zip(&work.heat).zip(&self.thermal.capacity) {
+            .network_heat_time_rate(&y[..n], oil_g, &work.net, &mut work.heat2);
+        for ((o, h), c) in out.iter_mut().zip(&work.heat2).zip(&self.thermal.capacity) {
             *o = h / c;
         }
         let e = self.energies;
