@@ -10,7 +10,8 @@
 //! - slip loss (heat into the ATF) `P = T_p·ω_p − T_t·ω_t = T_p·ω_p·(1 − SR·TR)`.
 //!
 //! Backward use (the drive cycle gives the turbine side = gearbox input): find SR in (0, 1) with
-//! `TR(SR)·(ω_t/(SR·K(SR)))² = T_t` by bisection (the left side falls from +∞ at SR → 0 to the
+//! `TR(SR)·(ω_t/(SR·K(SR)))² = T_t` by a bracketing root search ([`Converter::solve_speed_ratio`];
+//! the left side falls from +∞ at SR → 0 to the
 //! coupling-point value), then ω_p = ω_t/SR. Between the last tabulated speed ratio s_L (< 1) and
 //! SR = 1, where K grows without bound, the capacity is taken to fall linearly to zero:
 //! `T_p = (ω_p/K(s_L))²·(1 − SR)/(1 − s_L)` with TR = TR(s_L) \[assumption, docs/physics.md].
@@ -152,11 +153,13 @@ impl Converter {
     /// SR in (0, 1) where the turbine torque at turbine speed `wt` > 0 equals `tt` > 0.
     ///
     /// Bracketed root finding: bisection until both ends of the bracket have finite values
-    /// (f(0+) = +∞), then the Illinois variant of regula falsi ([recalled] Dowell & Jarratt,
-    /// BIT 11, 1971: a regula falsi step, and the retained end's value halved when the same end
-    /// is kept twice), which keeps the bracket and converges superlinearly: fewer evaluations of
-    /// f than bisection's ≈ 47 to the same 1e-14 bracket. f is continuous and piecewise smooth
-    /// (linear interpolation of the converter tables); checked against bisection in the tests.
+    /// (f(0+) = +∞), then the Illinois variant of regula falsi (Dowell & Jarratt, "A modified
+    /// regula falsi method for computing the root of an equation", BIT 11 (1971) 168–174, read
+    /// in the copy at studylib.net/doc/11126914: a regula falsi step, and the retained end's
+    /// value halved when the same end is kept twice), which keeps the bracket and converges
+    /// superlinearly. Measured over the 36 points of the unit test below: 7–36 evaluations of f,
+    /// 12 at the median, against bisection's 47 to the same 1e-14 bracket. f is continuous and
+    /// piecewise smooth (linear interpolation of the converter tables).
     pub fn solve_speed_ratio(&self, wt: f64, tt: f64) -> f64 {
         let f = |sr: f64| self.torque_ratio(sr) * self.impeller_torque(wt / sr, sr) - tt;
         // f(0+) = +∞, f(1) = −tt < 0.
