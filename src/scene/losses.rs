@@ -14,6 +14,9 @@ use crate::physics::losses::sliding::friction::Schlenk;
 use crate::physics::losses::sliding::{OilState as SlideOil, PowerLaw, SlidingMesh, SlidingMeshInput};
 use crate::physics::oil::OilProperties;
 
+use super::churn_sample::{self, ChurnSample};
+use crate::physics::losses::churning::ChangenetSum;
+
 /// Helical pockets: the exact infinitely-many-slices limit of the connected-slice model (one spur
 /// pocket history summed over phases; was 48 discrete slices, 0.5 % off and 0.35 s per AT6 compile).
 pub const HELIX_POCKET_SLICES: Option<usize> = None;
@@ -94,6 +97,8 @@ struct ChurnEntry {
     /// One model per immersion the gear takes, with its weight (a fixed-axis gear: one, weight 1;
     /// a planet set: the orbit-average quadrature with the planets counted, `planet_churning`).
     models: Vec<(GearChurning, f64)>,
+    /// Their sum as a law of the oil per speed (Changenet–Velex immersions of one gear).
+    law: Option<ChangenetSum>,
 }
 
 #[derive(Debug, Clone)]
@@ -148,6 +153,8 @@ pub struct SampleTerms {
     slide_unit: Vec<f64>,
     /// Per bearing: the load- and speed-dependent terms of this sample.
     bearing: Vec<crate::physics::losses::bearings::LoadTerms>,
+    /// Per churning entry: its power as a law of the oil at this sample's speed.
+    churn: Vec<ChurnSample>,
     /// Samples prepared.
     pub prepared: usize,
     /// Pump and converter values of the sample (they need the vehicle speed too).
@@ -291,6 +298,7 @@ impl LossScene {
                         })?;
                     churn.push(ChurnEntry {
                         item: items.len(),
+                        law: churn_sample::sum_law(&models),
                         models,
                     });
                     if cfg.model == crate::physics::losses::churning::ChurningModel::Stavytskyi {
@@ -557,7 +565,7 @@ impl LossScene {
     /// Evaluate every loss item (W) at `op` into `out` (length [`Self::len`]), everything in
     /// full. No allocation.
     pub fn evaluate(&self, op: &OperatingPoint, out: &mut [f64]) {
-        self.evaluate_load_independent(op, out);
+        self.evaluate_load_independent(op, None, out);
         let none = super::automatic::AutoSample::default();
         self.auto
             .evaluate(op.state, op.input_speed, op.input_torque, &op.oil, &none, out);
@@ -575,6 +583,7 @@ impl LossScene {
             key: None,
             slide_unit: vec![0.0; self.slide.len()],
             bearing: vec![Default::default(); self.elements.bearings()],
+            churn: vec![ChurnSample::Direct; self.churn.len()],
             prepared: 0,
             auto: Default::default(),
         }
@@ -617,6 +626,9 @@ impl LossScene {
             }
         }
         self.elements.prepare(state, w, t, &mut terms.bearing);
+        for ((e, k), c) in self.churn.iter().zip(&st.churn_speed).zip(&mut terms.churn) {
+            *c = ChurnSample::prepare(e.law.as_ref(), k * w);
+        }
         terms.key = Some(key);
         terms.prepared += 1;
     }
@@ -628,7 +640,7 @@ impl LossScene {
         if terms.key != Some((op.state, op.input_speed.to_bits(), op.input_torque.to_bits())) {
             return self.evaluate(op, out);
         }
-        self.evaluate_load_independent(op, out);
+        self.evaluate_load_independent(op, Some(&terms.churn), out);
         self.auto.evaluate(
             op.state,
             op.input_speed,
@@ -675,20 +687,27 @@ impl LossScene {
             .flat_map(move |(e, k)| e.models.iter().map(move |(m, _)| (e.item, m, k * input_speed)))
     }
 
-    /// Churning and pocketing at `op` into `out`.
-    fn evaluate_load_independent(&self, op: &OperatingPoint, out: &mut [f64]) {
+    /// Churning and pocketing at `op` into `out`; churning from the sample's laws `churn` when
+    /// given (prepared for `op`'s state and speed).
+    fn evaluate_load_independent(&self, op: &OperatingPoint, churn: Option<&[ChurnSample]>, out: &mut [f64]) {
         let st = &self.states[op.state];
         let w_in = op.input_speed;
         let churn_oil = ChurnOil {
             density: op.oil.rho,
             kinematic_viscosity: op.oil.nu,
         };
-        for (e, k) in self.churn.iter().zip(&st.churn_speed) {
-            out[e.item] = e
-                .models
-                .iter()
-                .map(|(m, wt)| wt * m.power(k * w_in, &churn_oil).total)
-                .sum();
+        match churn {
+            Some(laws) if !self.churn.is_empty() => {
+                let ln_nu = op.oil.nu.ln();
+                for ((e, k), law) in self.churn.iter().zip(&st.churn_speed).zip(laws) {
+                    out[e.item] = law.power(&e.models, e.law.as_ref(), k * w_in, &churn_oil, ln_nu);
+                }
+            }
+            _ => {
+                for (e, k) in self.churn.iter().zip(&st.churn_speed) {
+                    out[e.item] = ChurnSample::Direct.power(&e.models, None, k * w_in, &churn_oil, 0.0);
+                }
+            }
         }
         for (e, k) in self.pocket.iter().zip(&st.pocket_speed) {
             // The share above the oil pumps an unknown density unless the model file gives one;

@@ -2,6 +2,7 @@
 //! solvers evaluate without strings, maps or allocation.
 pub mod automatic;
 pub mod bearing_loads;
+pub mod churn_sample;
 pub mod element_losses;
 pub mod losses;
 pub mod planet_churning;

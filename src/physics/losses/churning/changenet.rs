@@ -93,6 +93,15 @@ pub struct ChangenetGear {
     g: f64,
 }
 
+/// One gear's terms of a weighted sum of its immersions ([`ChangenetGear::sum_terms`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct SumTerms {
+    pub form: [f64; 8],
+    pub low_unit: f64,
+    pub high_unit: f64,
+    pub bridge: Option<(f64, f64)>,
+}
+
 impl ChangenetGear {
     /// Precomputes the geometric factors (validates gear and parameters).
     pub fn new(gear: &ChurningGear, p: &ChangenetParams) -> Result<Self, ChurningError> {
@@ -138,16 +147,19 @@ impl ChangenetGear {
         } else {
             (0.0, 0.0)
         };
+        let k = 0.5 * sm * rp.powi(3);
+        let low_geo = p.low[0] * hd_l * vd.powf(p.low[2]);
+        let high_geo = p.high[0] * hd_h * vd.powf(p.high[2]) * (b / d).powf(p.high[4]);
         Ok(ChangenetGear {
             immersed: gear.immersion_depth > 0.0,
             rp,
             b,
-            k: 0.5 * sm * rp.powi(3),
+            k,
             shares,
-            low_geo: p.low[0] * hd_l * vd.powf(p.low[2]),
+            low_geo,
             low_fr: p.low[3],
             low_re: p.low[4],
-            high_geo: p.high[0] * hd_h * vd.powf(p.high[2]) * (b / d).powf(p.high[4]),
+            high_geo,
             high_fr: p.high[3],
             re_c_low: p.re_c_low,
             re_c_high: p.re_c_high,
@@ -155,6 +167,40 @@ impl ChangenetGear {
             inv_ln_span: 1.0 / (p.re_c_high / p.re_c_low).ln(),
             g: p.gravity,
         })
+    }
+
+    /// This gear's terms of a weighted sum of immersions (see [`super::changenet_sum`]):
+    /// - `form`: what the immersions of one gear share (r_p, b, the laws' exponents, the regime
+    ///   limits, g);
+    /// - `low_unit` = ½ S_m r_p³ · low_geo · (r_p/g)^a_Fr · r_p^(2 a_Re), so that the low law is
+    ///   `P = ρ · low_unit · ω^(3 + 2a_Fr + a_Re) · ν^(−a_Re)`;
+    /// - `high_unit` = ½ S_m r_p³ · high_geo · (r_p/g)^b_Fr, so that `P = ρ · high_unit · ω^(3 + 2b_Fr)`;
+    /// - `bridge` = (a, d) with `ln(P/ρ) = a + 3 ln ω + 2a_Fr L + t (d + 2(b_Fr − a_Fr) L)` in the
+    ///   bridge band (L = ln ν, t as in [`Self::moment_coefficient`]), `None` for a dry gear.
+    ///
+    /// [derived] from the laws in the module docs: ln C_a = ln C_low(ω_a) with
+    /// ω_a = Re_c,low ν/(r_p b) is `CA + 2a_Fr L` (the Re terms in ν cancel) and
+    /// ln C_b = `CB + 2b_Fr L`; then a = ln(½ S_m r_p³) + CA, d = CB − CA.
+    pub(super) fn sum_terms(&self) -> SumTerms {
+        let (lf, lr, hf) = (self.low_fr, self.low_re, self.high_fr);
+        let rp_g = (self.rp / self.g).ln();
+        let ln_rp_b = (self.rp * self.b).ln();
+        let ln_rp = self.rp.ln();
+        let ln_wa0 = self.ln_re_c_low - ln_rp_b;
+        let ln_wb0 = self.re_c_high.ln() - ln_rp_b;
+        let dry = !(self.immersed && self.k > 0.0 && self.low_geo > 0.0 && self.high_geo > 0.0);
+        let bridge = (!dry).then(|| {
+            let ca = self.low_geo.ln() + lf * (2.0 * ln_wa0 + rp_g) + lr * (ln_wa0 + 2.0 * ln_rp);
+            let cb = self.high_geo.ln() + hf * (2.0 * ln_wb0 + rp_g);
+            (self.k.ln() + ca, cb - ca)
+        });
+        let on = if dry { 0.0 } else { 1.0 };
+        SumTerms {
+            form: [self.rp, self.b, lf, lr, hf, self.re_c_low, self.re_c_high, self.g],
+            low_unit: on * self.k * self.low_geo * (lf * rp_g + 2.0 * lr * ln_rp).exp(),
+            high_unit: on * self.k * self.high_geo * (hf * rp_g).exp(),
+            bridge,
+        }
     }
 
     /// False when h ≤ 0.

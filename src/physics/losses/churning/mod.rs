@@ -21,6 +21,7 @@
 //! gear is far outside Changenet's test range; [`ChurningModel::Stavytskyi`] for comparison only.
 
 pub mod changenet;
+pub mod changenet_sum;
 pub mod immersion;
 pub mod ranges;
 pub mod seetharaman;
@@ -30,6 +31,7 @@ use std::f64::consts::PI;
 use std::fmt;
 
 pub use changenet::{ChangenetGear, ChangenetParams};
+pub use changenet_sum::{ChangenetAtSpeed, ChangenetSum};
 pub use immersion::Immersion;
 pub use ranges::RangeCheck;
 pub use seetharaman::{CavityTerm, SeetharamanGear, SeetharamanParams};
