@@ -412,6 +412,12 @@ impl ThermalScene {
         }
     }
 
+    /// True when no boundary temperature changes on the pieces that follow `t` (then f does not
+    /// depend on t there: ∂f/∂t = 0).
+    pub fn boundaries_still_at(&self, t: f64) -> bool {
+        self.boundaries.iter().all(|b| b.slope_at(t) == 0.0)
+    }
+
     /// The boundary temperatures' rates of change at time `t` into `work.boundary_slope`.
     pub fn boundary_slopes(&self, t: f64, work: &mut NetworkWork) {
         for (x, b) in work.boundary_slope.iter_mut().zip(&self.boundaries) {

@@ -227,6 +227,8 @@ struct Ros<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> {
     fs: M::V,
     /// ∂f/∂t at (t, y), when boundaries move.
     ft: Option<M::V>,
+    /// `ft` is non-zero at this step (a boundary moves on the piece after t).
+    ft_on: bool,
     k: Vec<M::V>,
     tmp: M::V,
     jac: M,
@@ -270,6 +272,7 @@ impl<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> Ros<'a, 'd, M, LS> {
             f: vector(),
             fs: vector(),
             ft,
+            ft_on: false,
             k: (0..ROS3.stages).map(|_| vector()).collect(),
             tmp,
             jac,
@@ -372,7 +375,7 @@ impl<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> Ros<'a, 'd, M, LS> {
                 }
             }
         }
-        if let Some(ft) = &self.ft {
+        if let Some(ft) = self.ft.as_ref().filter(|_| self.ft_on) {
             let g = gh * tab.gamma_sum[i] * h;
             ki.iter_mut().zip(ft.host()).for_each(|(x, v)| *x += g * v);
         }
@@ -399,7 +402,10 @@ impl<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> Ros<'a, 'd, M, LS> {
     /// One step of size h from (t, y): y⁺ into `tmp`; returns the weighted RMS error estimate
     /// (infinite when a solve fails or a value is not finite).
     fn step(&mut self, t: f64, h: f64) -> f64 {
-        if let Some(ft) = self.ft.as_mut() {
+        // Boundary series are piecewise linear: on a still piece (e.g. the coolant at its
+        // thermostat) ∂f/∂t is zero and neither computed nor added.
+        self.ft_on = self.ft.is_some() && !self.d.time_rate_vanishes(t);
+        if let Some(ft) = self.ft.as_mut().filter(|_| self.ft_on) {
             self.d.time_derivative(t, self.y.host(), ft.host_mut());
         }
         for i in 0..self.tab.stages {

@@ -448,6 +448,11 @@ impl Driver<'_> {
         self.scene.thermal.boundaries_move()
     }
 
+    /// True when ∂f/∂t = 0 on the step from `t` (no boundary temperature moves there).
+    pub(crate) fn time_rate_vanishes(&self, t: f64) -> bool {
+        self.scene.thermal.boundaries_still_at(t)
+    }
+
     /// ∂f/∂t at (t, y).
     pub(crate) fn time_derivative(&self, t: f64, y: &[f64], out: &mut [f64]) {
         self.scene.time_derivative(t, y, &mut self.work.borrow_mut(), out);
