@@ -32,12 +32,45 @@ pub enum ChurnSample {
     Law(ChangenetAtSpeed),
 }
 
+/// The per-sample powers of the input speed that churning laws share: ln ω_in, and ω_in raised to
+/// the last pair of law exponents asked for (the examples' gears all share one pair).
+pub struct InputSpeedPowers {
+    ln_w: f64,
+    memo: ([f64; 2], [f64; 2]),
+}
+
+impl InputSpeedPowers {
+    /// For input speed `w_in` (rad/s).
+    pub fn new(w_in: f64) -> Self {
+        InputSpeedPowers {
+            ln_w: w_in.abs().ln(),
+            memo: ([f64::NAN; 2], [0.0; 2]),
+        }
+    }
+
+    fn powers(&mut self, e: [f64; 2]) -> [f64; 2] {
+        if self.memo.0 != e {
+            self.memo = (e, e.map(|x| (x * self.ln_w).exp()));
+        }
+        self.memo.1
+    }
+}
+
 impl ChurnSample {
-    /// The sample's state for an entry with sum law `law` at speed `omega` (rad/s).
-    pub fn prepare(law: Option<&ChangenetSum>, omega: f64) -> Self {
+    /// The sample's state for an entry with sum law `law` (and its `ratio_terms` for the gear
+    /// state) whose gear turns at `omega` (rad/s) = ratio × the input speed of `input`.
+    pub fn prepare(
+        law: Option<&ChangenetSum>,
+        ratio_terms: &[f64; 3],
+        omega: f64,
+        input: &mut InputSpeedPowers,
+    ) -> Self {
         match law {
             _ if omega.abs() < STANDSTILL_RAD_S => ChurnSample::Still,
-            Some(l) => ChurnSample::Law(l.at_speed(omega)),
+            Some(l) => {
+                let p = input.powers(l.speed_exponents());
+                ChurnSample::Law(l.at_ratio(ratio_terms, input.ln_w, p))
+            }
             None => ChurnSample::Direct,
         }
     }

@@ -5,6 +5,7 @@
 
 use crate::model::bearings::BearingMount;
 use crate::model::gearbox::{GearMount, Gearbox};
+use crate::physics::losses::bearings::skf::speed_exponent_powers;
 use crate::physics::losses::bearings::{BearingFriction, BearingLoad, BearingOil, LoadTerms};
 use crate::physics::losses::seals::LipSeal;
 use crate::physics::oil::OilProperties;
@@ -33,6 +34,8 @@ struct BearingEntry {
     load: Vec<[f64; 2]>,
     /// Constant (radial, axial) loads, N.
     preload: [f64; 2],
+    /// SKF speed powers per unit input speed, per state (`None`: Palmgren).
+    speed_unit: Vec<Option<[f64; 4]>>,
 }
 
 #[derive(Debug, Clone)]
@@ -111,6 +114,10 @@ impl ElementLosses {
                 item: items.len(),
                 model: b.friction.clone(),
                 multiplicity,
+                speed_unit: speed
+                    .iter()
+                    .map(|&r| b.friction.speed_powers_per_unit(r))
+                    .collect(),
                 speed,
                 load,
                 preload: [b.preload.0, b.preload.1],
@@ -166,11 +173,17 @@ impl ElementLosses {
     /// (N·m) into `terms`. No allocation.
     /// A bearing after one with the same speed powers (same ring speed and size) takes them
     /// from it.
+    /// The SKF speed powers of every bearing are its per-state powers per unit input speed times
+    /// the powers of the input speed, computed once (one logarithm, four exponentials per sample
+    /// instead of per bearing).
     pub fn prepare(&self, state: usize, w_in: f64, t_in: f64, terms: &mut [LoadTerms]) {
-        for k in 0..self.bearings.len().min(terms.len()) {
-            let (done, rest) = terms.split_at_mut(k);
-            let prev = k.checked_sub(1).map(|p| (&self.bearings[p].model, &done[p]));
-            rest[0] = load_terms_after(&self.bearings[k], state, w_in, t_in, prev);
+        if self.bearings.is_empty() {
+            return;
+        }
+        let w_pow = speed_exponent_powers(w_in);
+        for (e, t) in self.bearings.iter().zip(terms) {
+            let speed = e.speed_unit[state].map(|u| [0, 1, 2, 3].map(|i| u[i] * w_pow[i]));
+            *t = load_terms_with_speed(e, state, w_in, t_in, speed);
         }
     }
 
@@ -219,17 +232,17 @@ impl ElementLosses {
 }
 
 fn load_terms(e: &BearingEntry, state: usize, w_in: f64, t_in: f64) -> LoadTerms {
-    load_terms_after(e, state, w_in, t_in, None)
+    load_terms_with_speed(e, state, w_in, t_in, None)
 }
 
-/// Load terms of `e`, with the speed powers of `prev` when they are the same
-/// ([`BearingFriction::load_terms_after`]).
-fn load_terms_after(
+/// Load terms of `e`, with its SKF speed powers `speed` when known
+/// ([`BearingFriction::load_terms_with_speed`]).
+fn load_terms_with_speed(
     e: &BearingEntry,
     state: usize,
     w_in: f64,
     t_in: f64,
-    prev: Option<(&BearingFriction, &LoadTerms)>,
+    speed: Option<[f64; 4]>,
 ) -> LoadTerms {
     let [r, a] = e.load[state];
     let t = t_in.abs();
@@ -237,7 +250,7 @@ fn load_terms_after(
         radial: r * t + e.preload[0],
         axial: a * t + e.preload[1],
     };
-    e.model.load_terms_after(e.speed[state] * w_in, load, prev)
+    e.model.load_terms_with_speed(e.speed[state] * w_in, load, speed)
 }
 
 fn default_heat(heat_to: &Option<Vec<(String, f64)>>, gear: Option<usize>) -> DefaultHeat {

@@ -14,7 +14,7 @@ use crate::physics::losses::sliding::friction::Schlenk;
 use crate::physics::losses::sliding::{OilState as SlideOil, PowerLaw, SlidingMesh, SlidingMeshInput};
 use crate::physics::oil::OilProperties;
 
-use super::churn_sample::{self, ChurnSample};
+use super::churn_sample::{self, ChurnSample, InputSpeedPowers};
 use crate::physics::losses::churning::ChangenetSum;
 
 /// Helical pockets: the exact infinitely-many-slices limit of the connected-slice model (one spur
@@ -99,6 +99,8 @@ struct ChurnEntry {
     models: Vec<(GearChurning, f64)>,
     /// Their sum as a law of the oil per speed (Changenet–Velex immersions of one gear).
     law: Option<ChangenetSum>,
+    /// Per gear state: the law's terms of the gear's speed ratio ([`ChangenetSum::ratio_terms`]).
+    ratio_terms: Vec<[f64; 3]>,
 }
 
 #[derive(Debug, Clone)]
@@ -299,6 +301,7 @@ impl LossScene {
                     churn.push(ChurnEntry {
                         item: items.len(),
                         law: churn_sample::sum_law(&models),
+                        ratio_terms: Vec::new(),
                         models,
                     });
                     if cfg.model == crate::physics::losses::churning::ChurningModel::Stavytskyi {
@@ -517,7 +520,12 @@ impl LossScene {
                     .collect();
                 f
             })
-            .collect();
+            .collect::<Vec<StateFactors>>();
+        for (j, e) in churn.iter_mut().enumerate() {
+            if let Some(law) = &e.law {
+                e.ratio_terms = states.iter().map(|f| law.ratio_terms(f.churn_speed[j])).collect();
+            }
+        }
 
         // The automatic's own parts: open clutch packs, pump, converter.
         let auto = super::automatic::AutoLosses::compile(
@@ -616,18 +624,29 @@ impl LossScene {
         // P(T, ω) = P(sign(T·ω)·1 N·m, 1 rad/s)·|T|^a·|ω|^b: reversing both T and ω leaves the
         // power flow and every magnitude unchanged.
         let dir = usize::from(t * w < 0.0);
+        // Meshes with the same friction law share their powers of |T| and |ω| (the last pair of
+        // exponents is remembered; the same values as computing them per mesh).
+        let mut memo = [(f64::NAN, 0.0); 2];
+        let mut power = |i: usize, x: f64, e: f64| {
+            if memo[i].0 != e {
+                memo[i] = (e, x.abs().powf(e));
+            }
+            memo[i].1
+        };
         for ((e, unit), u) in self.slide.iter().zip(&st.slide_unit).zip(&mut terms.slide_unit) {
             if let Some(law) = e.law {
                 *u = if t == 0.0 || w == 0.0 {
                     0.0
                 } else {
-                    unit[dir] * t.abs().powf(law.torque) * w.abs().powf(law.speed)
+                    unit[dir] * power(0, t, law.torque) * power(1, w, law.speed)
                 };
             }
         }
         self.elements.prepare(state, w, t, &mut terms.bearing);
+        let mut input = InputSpeedPowers::new(w);
         for ((e, k), c) in self.churn.iter().zip(&st.churn_speed).zip(&mut terms.churn) {
-            *c = ChurnSample::prepare(e.law.as_ref(), k * w);
+            let ratio = e.ratio_terms.get(state).unwrap_or(&[0.0; 3]);
+            *c = ChurnSample::prepare(e.law.as_ref(), ratio, k * w, &mut input);
         }
         terms.key = Some(key);
         terms.prepared += 1;

@@ -128,24 +128,22 @@ impl BearingFriction {
         }
     }
 
-    /// As [`Self::load_terms`], taking the speed powers from `prev` (another bearing's terms at
-    /// the same cycle sample) when they are the same: equal ring speed and speed law (two SKF
-    /// bearings of one size on one shaft). The result equals [`Self::load_terms`]'s.
-    pub fn load_terms_after(
-        &self,
-        omega: f64,
-        load: BearingLoad,
-        prev: Option<(&Self, &LoadTerms)>,
-    ) -> LoadTerms {
+    /// The SKF speed powers ([`LoadTerms::speed`]) of a ring turning at `ratio` times a
+    /// reference speed, per unit reference speed (rad/s): at reference speed ω they are this
+    /// times [`skf::speed_exponent_powers`]`(ω)`. `None` for Palmgren.
+    pub fn speed_powers_per_unit(&self, ratio: f64) -> Option<[f64; 4]> {
+        match self {
+            BearingFriction::Skf(m) => Some(m.speed_powers(ratio.abs() * RPM_PER_RAD_S)),
+            BearingFriction::Palmgren(_) => None,
+        }
+    }
+
+    /// As [`Self::load_terms`], with the SKF speed powers `speed` at `omega` when already known
+    /// (ignored by Palmgren). The result equals [`Self::load_terms`]'s to rounding.
+    pub fn load_terms_with_speed(&self, omega: f64, load: BearingLoad, speed: Option<[f64; 4]>) -> LoadTerms {
         let n = omega.abs() * RPM_PER_RAD_S;
         match self {
-            BearingFriction::Skf(m) => {
-                let speed = prev.and_then(|(p, t)| match p {
-                    BearingFriction::Skf(o) if t.n_rpm == n && m.same_speed_law(o) => Some(t.speed),
-                    _ => None,
-                });
-                m.load_terms_with(n, load, speed)
-            }
+            BearingFriction::Skf(m) => m.load_terms_with(n, load, speed),
             BearingFriction::Palmgren(m) => m.load_terms(n, load),
         }
     }

@@ -42,6 +42,16 @@
 
 use super::{BearingError, BearingLoad, BearingMoment, BearingOil, BearingSize, LoadTerms};
 
+/// Exponents of the speed n in [`LoadTerms::speed`]: (n d_m)^1.28, n^0.6, n^1.4 and the drag's
+/// n²·n^−1.379 (the SKF model's, module docs).
+pub const SPEED_EXPONENTS: [f64; 4] = [1.28, 0.6, 1.4, 2.0 - 1.379];
+
+/// `[|ω|^e for e in SPEED_EXPONENTS]` from one logarithm (ω = 0: all 0).
+pub fn speed_exponent_powers(omega: f64) -> [f64; 4] {
+    let ln_w = omega.abs().ln();
+    SPEED_EXPONENTS.map(|e| (e * ln_w).exp())
+}
+
 /// Which `G_rr`/`G_sl` forms of the SKF table apply.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SkfKind {
@@ -258,16 +268,9 @@ impl Skf {
         self.load_terms_with(n, load, None)
     }
 
-    /// True when `other`'s speed powers ([`LoadTerms::speed`]) equal this bearing's at every
-    /// speed: the same d_m and drag law.
-    pub fn same_speed_law(&self, other: &Skf) -> bool {
-        self.ln_dm == other.ln_dm
-            && (self.drag2 > 0.0) == (other.drag2 > 0.0)
-            && self.dm2_ft_pow == other.dm2_ft_pow
-    }
-
-    /// As [`Self::load_terms`], with the speed powers `speed` when already known (from a bearing
-    /// of the [`Self::same_speed_law`] at the same speed).
+    /// As [`Self::load_terms`], with the speed powers `speed` ([`LoadTerms::speed`] at `n`) when
+    /// already known (e.g. from [`Self::speed_powers`] per unit speed times the powers of the
+    /// speed, [`SPEED_EXPONENTS`]).
     pub fn load_terms_with(&self, n: f64, load: BearingLoad, speed: Option<[f64; 4]>) -> LoadTerms {
         let (fr, fa) = (load.radial.abs(), load.axial.abs());
         let (c, dm, p) = (&self.c, self.dm, &self.dm_pow);
@@ -309,8 +312,10 @@ impl Skf {
         }
     }
 
-    /// `[(n d_m)^1.28, n^0.6, n^1.4, n²·(n d_m² f_t)^−1.379]` at `n` (r/min).
-    fn speed_powers(&self, n: f64) -> [f64; 4] {
+    /// `[(n d_m)^1.28, n^0.6, n^1.4, n²·(n d_m² f_t)^−1.379]` at `n` (r/min). Each is a power of
+    /// n ([`SPEED_EXPONENTS`]) times a constant, so the powers at `c·n` are those at `c` times the
+    /// powers of n.
+    pub fn speed_powers(&self, n: f64) -> [f64; 4] {
         // The powers of n from one logarithm (exp is about half the cost of powf; the values
         // agree to rounding). n = 0 gives ln n = −∞ and every positive power 0, as powf does.
         let ln_n = n.ln();

@@ -422,32 +422,55 @@ fn vanishing_speeds_give_finite_power() {
     }
 }
 
-/// Speed powers taken from a bearing of the same size at the same speed give bitwise the terms
-/// computed from scratch; a different size or speed is not shared.
+/// Speed powers per unit speed times the powers of the speed give the terms computed at that
+/// speed, to rounding (the speed powers do not depend on the SKF form: a deep-groove ball bearing
+/// under radial and combined load, with and without oil-bath drag, turning and at standstill);
+/// Palmgren has none.
 #[test]
-fn shared_speed_powers_equal_computed_ones() {
+fn speed_powers_per_unit_times_powers_of_the_speed() {
     let c = dgbb(3.3e-7, 3.3e-3, 0.0);
-    let deep_groove = |d: f64, big_d: f64, c0: f64| {
-        let i = input(SkfKind::DeepGrooveBall, c, d, big_d, c0, (0.12, 0.1));
-        BearingFriction::Skf(Skf::new(&i).unwrap())
+    let dry = input(SkfKind::DeepGrooveBall, c, 40.0, 80.0, 19000.0, (0.12, 0.1));
+    let bath = SkfInput {
+        oil_level: 0.03,
+        lubrication: Lubrication::OilBath,
+        ..dry
     };
-    let (a, b) = (deep_groove(40.0, 80.0, 19000.0), deep_groove(40.0, 80.0, 19000.0));
-    let other = deep_groove(50.0, 90.0, 23000.0);
     let load = |fr, fa| BearingLoad {
         radial: fr,
         axial: fa,
     };
-    let w = 1500.0 * RPM;
-    let ta = a.load_terms(w, load(2000.0, 0.0));
-    // b carries an axial load (the other branch of G_rr, G_sl); its speed powers are a's.
-    let shared = b.load_terms_after(w, load(1200.0, 400.0), Some((&a, &ta)));
-    assert_eq!(shared, b.load_terms(w, load(1200.0, 400.0)));
-    let t_other = other.load_terms(w, load(2000.0, 0.0));
-    assert_ne!(t_other.speed, ta.speed);
-    assert_eq!(
-        other.load_terms_after(w, load(2000.0, 0.0), Some((&a, &ta))),
-        t_other
-    );
-    let slower = b.load_terms_after(0.5 * w, load(2000.0, 0.0), Some((&a, &ta)));
-    assert_eq!(slower, b.load_terms(0.5 * w, load(2000.0, 0.0)));
+    let size = BearingSize {
+        bore: 0.04,
+        outside: 0.08,
+    };
+    let palmgren = BearingFriction::Palmgren(Palmgren::new(size, 3.0, 0.0, 0.0, 1.0).unwrap());
+    assert_eq!(palmgren.speed_powers_per_unit(1.0), None);
+    let bearings = [dry, bath].map(|i| BearingFriction::Skf(Skf::new(&i).unwrap()));
+    // The dry one has no oil-bath drag term, the other has.
+    let drag = |b: &BearingFriction| b.speed_powers_per_unit(1.0).unwrap()[3];
+    assert!(drag(&bearings[0]) == 0.0 && drag(&bearings[1]) > 0.0);
+    for (deep_groove, ratio) in bearings
+        .iter()
+        .flat_map(|b| [1.0, -0.37, 2.9, 0.0].map(|r| (b, r)))
+    {
+        let unit = deep_groove.speed_powers_per_unit(ratio).unwrap();
+        for w in [0.0, 3.0, 150.0, 600.0] {
+            let p = skf::speed_exponent_powers(w);
+            let speed = [0, 1, 2, 3].map(|i| unit[i] * p[i]);
+            for l in [load(2000.0, 0.0), load(1200.0, 400.0)] {
+                let direct = deep_groove.load_terms(ratio * w, l);
+                let scaled = deep_groove.load_terms_with_speed(ratio * w, l, Some(speed));
+                assert_eq!(
+                    (scaled.g_rr, scaled.g_sl, scaled.n_rpm),
+                    (direct.g_rr, direct.g_sl, direct.n_rpm)
+                );
+                for (a, b) in scaled.speed.iter().zip(&direct.speed) {
+                    assert!(
+                        (a - b).abs() <= 1e-13 * b.abs(),
+                        "ratio {ratio} w {w}: {a} vs {b}"
+                    );
+                }
+            }
+        }
+    }
 }

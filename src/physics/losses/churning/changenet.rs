@@ -188,13 +188,14 @@ impl ChangenetGear {
         let ln_rp = self.rp.ln();
         let ln_wa0 = self.ln_re_c_low - ln_rp_b;
         let ln_wb0 = self.re_c_high.ln() - ln_rp_b;
-        let dry = !(self.immersed && self.k > 0.0 && self.low_geo > 0.0 && self.high_geo > 0.0);
-        let bridge = (!dry).then(|| {
+        // The bridge's logarithms need both laws non-zero (a dry gear has neither).
+        let wet = self.immersed && self.k > 0.0 && self.low_geo > 0.0 && self.high_geo > 0.0;
+        let bridge = wet.then(|| {
             let ca = self.low_geo.ln() + lf * (2.0 * ln_wa0 + rp_g) + lr * (ln_wa0 + 2.0 * ln_rp);
             let cb = self.high_geo.ln() + hf * (2.0 * ln_wb0 + rp_g);
             (self.k.ln() + ca, cb - ca)
         });
-        let on = if dry { 0.0 } else { 1.0 };
+        let on = if self.immersed { 1.0 } else { 0.0 };
         SumTerms {
             form: [self.rp, self.b, lf, lr, hf, self.re_c_low, self.re_c_high, self.g],
             low_unit: on * self.k * self.low_geo * (lf * rp_g + 2.0 * lr * ln_rp).exp(),

@@ -87,13 +87,43 @@ impl ChangenetSum {
     /// The law at speed `omega` (rad/s, sign irrelevant, non-zero).
     pub fn at_speed(&self, omega: f64) -> ChangenetAtSpeed {
         let ln_w = omega.abs().ln();
+        let [e_low, e_high] = self.speed_exponents();
+        self.at_ratio(
+            &self.ratio_terms(1.0),
+            ln_w,
+            [(e_low * ln_w).exp(), (e_high * ln_w).exp()],
+        )
+    }
+
+    /// Exponents of ω in the low and the high law's power at fixed oil (3 + 2a_Fr + a_Re and
+    /// 3 + 2b_Fr).
+    pub fn speed_exponents(&self) -> [f64; 2] {
+        [self.low_speed_exp, self.high_speed_exp]
+    }
+
+    /// What [`Self::at_ratio`] needs of a gear turning at `ratio` times a reference speed
+    /// (`ratio` > 0): [ln ratio, ratio^e_low, ratio^e_high].
+    pub fn ratio_terms(&self, ratio: f64) -> [f64; 3] {
+        let ln_r = ratio.abs().ln();
+        [
+            ln_r,
+            (self.low_speed_exp * ln_r).exp(),
+            (self.high_speed_exp * ln_r).exp(),
+        ]
+    }
+
+    /// The law at ω = ratio · ω_ref from the ratio's terms ([`Self::ratio_terms`]), ln ω_ref and
+    /// ω_ref's powers [ω_ref^e_low, ω_ref^e_high] ([`Self::speed_exponents`]): gears that share the
+    /// exponents share the reference speed's powers.
+    pub fn at_ratio(&self, ratio: &[f64; 3], ln_w_ref: f64, w_ref_pow: [f64; 2]) -> ChangenetAtSpeed {
+        let ln_w = ratio[0] + ln_w_ref;
         let ln_w_rp_b = ln_w + self.ln_rp_b;
         ChangenetAtSpeed {
             ln_w,
             ln_nu_low: ln_w_rp_b - self.ln_re_c_low,
             ln_nu_high: ln_w_rp_b - self.ln_re_c_high,
-            low: self.low_unit * (self.low_speed_exp * ln_w).exp(),
-            high: self.high_unit * (self.high_speed_exp * ln_w).exp(),
+            low: self.low_unit * ratio[1] * w_ref_pow[0],
+            high: self.high_unit * ratio[2] * w_ref_pow[1],
         }
     }
 
