@@ -171,8 +171,7 @@ impl ElementLosses {
 
     /// Load terms of every bearing for `state`, input speed `w_in` (rad/s) and torque `t_in`
     /// (N·m) into `terms`. No allocation.
-    /// A bearing after one with the same speed powers (same ring speed and size) takes them
-    /// from it.
+    ///
     /// The SKF speed powers of every bearing are its per-state powers per unit input speed times
     /// the powers of the input speed, computed once (one logarithm, four exponentials per sample
     /// instead of per bearing).
