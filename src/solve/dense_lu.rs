@@ -155,62 +155,97 @@ impl SmallDenseLu {
     }
 
     fn factor(&mut self) -> bool {
-        let n = self.n;
-        let a = &mut self.lu;
-        for k in 0..n {
-            let col = k * n;
-            let (mut p, mut big) = (k, 0.0);
-            for (i, v) in a[col + k..col + n].iter().enumerate() {
-                if v.abs() > big {
-                    (p, big) = (k + i, v.abs());
-                }
-            }
-            self.piv[k] = p;
-            if !(big > 0.0 && big.is_finite()) {
-                return false;
-            }
-            if p != k {
-                for j in 0..n {
-                    a.swap(j * n + k, j * n + p);
-                }
-            }
-            let d = 1.0 / a[col + k];
-            self.inv_diag[k] = d;
-            a[col + k + 1..col + n].iter_mut().for_each(|v| *v *= d);
-            // Columns right of k: a_j[k+1..] −= l_k[k+1..] · u_kj.
-            let (left, right) = a.split_at_mut((k + 1) * n);
-            let l = &left[col + k + 1..col + n];
-            for cj in right.chunks_exact_mut(n) {
-                let ukj = cj[k];
-                if ukj != 0.0 {
-                    for (x, li) in cj[k + 1..].iter_mut().zip(l) {
-                        *x -= li * ukj;
-                    }
-                }
-            }
+        // The node blocks of lumped networks are small: a size known at compile time lets the
+        // loops unroll (the same operations in the same order, so the same results).
+        let (a, piv, inv) = (&mut self.lu[..], &mut self.piv[..], &mut self.inv_diag[..]);
+        match self.n {
+            1 => factor_sized::<1>(a, piv, inv, 1),
+            2 => factor_sized::<2>(a, piv, inv, 2),
+            3 => factor_sized::<3>(a, piv, inv, 3),
+            4 => factor_sized::<4>(a, piv, inv, 4),
+            5 => factor_sized::<5>(a, piv, inv, 5),
+            6 => factor_sized::<6>(a, piv, inv, 6),
+            n => factor_sized::<0>(a, piv, inv, n),
         }
-        true
     }
 
     fn solve(&self, x: &mut [f64]) {
-        let n = self.n;
-        for (k, &p) in self.piv.iter().enumerate() {
-            x.swap(k, p);
+        let (lu, piv, inv) = (&self.lu[..], &self.piv[..], &self.inv_diag[..]);
+        match self.n {
+            1 => solve_sized::<1>(lu, piv, inv, x, 1),
+            2 => solve_sized::<2>(lu, piv, inv, x, 2),
+            3 => solve_sized::<3>(lu, piv, inv, x, 3),
+            4 => solve_sized::<4>(lu, piv, inv, x, 4),
+            5 => solve_sized::<5>(lu, piv, inv, x, 5),
+            6 => solve_sized::<6>(lu, piv, inv, x, 6),
+            n => solve_sized::<0>(lu, piv, inv, x, n),
         }
-        for (j, cj) in self.lu.chunks_exact(n).enumerate() {
-            let xj = x[j];
-            if xj != 0.0 {
-                for (xi, l) in x[j + 1..].iter_mut().zip(&cj[j + 1..]) {
-                    *xi -= l * xj;
+    }
+}
+
+/// LU with partial pivoting of the column-major `n`² matrix `a` in place (`N` = n, or 0 for a
+/// size known only at run time); pivots into `piv`, 1/U_kk into `inv`. False when a pivot is
+/// zero or not finite.
+#[inline(always)]
+fn factor_sized<const N: usize>(a: &mut [f64], piv: &mut [usize], inv: &mut [f64], n_dyn: usize) -> bool {
+    let n = if N > 0 { N } else { n_dyn };
+    let (a, piv, inv) = (&mut a[..n * n], &mut piv[..n], &mut inv[..n]);
+    for k in 0..n {
+        let col = k * n;
+        let (mut p, mut big) = (k, 0.0);
+        for (i, v) in a[col + k..col + n].iter().enumerate() {
+            if v.abs() > big {
+                (p, big) = (k + i, v.abs());
+            }
+        }
+        piv[k] = p;
+        if !(big > 0.0 && big.is_finite()) {
+            return false;
+        }
+        if p != k {
+            for j in 0..n {
+                a.swap(j * n + k, j * n + p);
+            }
+        }
+        let d = 1.0 / a[col + k];
+        inv[k] = d;
+        a[col + k + 1..col + n].iter_mut().for_each(|v| *v *= d);
+        // Columns right of k: a_j[k+1..] −= l_k[k+1..] · u_kj.
+        let (left, right) = a.split_at_mut((k + 1) * n);
+        let l = &left[col + k + 1..col + n];
+        for cj in right.chunks_exact_mut(n) {
+            let ukj = cj[k];
+            if ukj != 0.0 {
+                for (x, li) in cj[k + 1..].iter_mut().zip(l) {
+                    *x -= li * ukj;
                 }
             }
         }
-        for ((j, cj), d) in self.lu.chunks_exact(n).enumerate().zip(&self.inv_diag).rev() {
-            x[j] *= d;
-            let xj = x[j];
-            for (xi, u) in x[..j].iter_mut().zip(&cj[..j]) {
-                *xi -= u * xj;
+    }
+    true
+}
+
+/// Solve (LU) x = b in place with the factors of [`factor_sized`].
+#[inline(always)]
+fn solve_sized<const N: usize>(lu: &[f64], piv: &[usize], inv: &[f64], x: &mut [f64], n_dyn: usize) {
+    let n = if N > 0 { N } else { n_dyn };
+    let (lu, piv, inv, x) = (&lu[..n * n], &piv[..n], &inv[..n], &mut x[..n]);
+    for (k, &p) in piv.iter().enumerate() {
+        x.swap(k, p);
+    }
+    for (j, cj) in lu.chunks_exact(n).enumerate() {
+        let xj = x[j];
+        if xj != 0.0 {
+            for (xi, l) in x[j + 1..].iter_mut().zip(&cj[j + 1..]) {
+                *xi -= l * xj;
             }
+        }
+    }
+    for ((j, cj), d) in lu.chunks_exact(n).enumerate().zip(inv).rev() {
+        x[j] *= d;
+        let xj = x[j];
+        for (xi, u) in x[..j].iter_mut().zip(&cj[..j]) {
+            *xi -= u * xj;
         }
     }
 }
