@@ -548,18 +548,10 @@ impl Scene {
     fn network_partial_values(&self, t: f64, y: &[f64], work: &mut Work, vals: &mut [f64]) -> (usize, bool) {
         let n = self.nodes();
         let held = self.oil_conductances_at(t, y, work);
-        let mut k = 0;
-        let inv_cap = &self.thermal.inv_capacity;
-        let work = &*work;
         let oil_g = if held { &work.oil_g } else { &work.oil_g2 };
-        self.thermal
-            .network_heat_partials(&y[..n], oil_g, &work.net, &mut |r, _, d| {
-                vals[k] = match r {
-                    End::Node(i) => d * inv_cap[i],
-                    End::Boundary(_) => d,
-                };
-                k += 1;
-            });
+        let k = self
+            .thermal
+            .network_partial_values(&y[..n], oil_g, &work.net, vals);
         (k, held)
     }
 

@@ -130,6 +130,8 @@ pub struct ThermalScene {
     pub capacity: Vec<f64>,
     /// Their reciprocals, 1/(J/K) (the Jacobian multiplies).
     pub inv_capacity: Vec<f64>,
+    /// The fixed links' Jacobian values, constant: the head of [`Self::network_partial_values`].
+    fixed_partials: Vec<f64>,
     /// Initial temperatures, K.
     pub initial: Vec<f64>,
     /// Oil node.
@@ -321,7 +323,7 @@ impl ThermalScene {
             })
             .collect();
         debug_assert!(net.oil_node < n);
-        ThermalScene {
+        let mut scene = ThermalScene {
             names,
             boundary_names: net.boundaries.iter().map(|b| b.name.clone()).collect(),
             inv_capacity: capacity.iter().map(|c| 1.0 / c).collect(),
@@ -337,7 +339,12 @@ impl ThermalScene {
             radiation,
             coolers,
             oil_model: gb.oil.clone(),
-        }
+            fixed_partials: Vec::new(),
+        };
+        let mut fixed_partials = Vec::new();
+        scene.fixed_link_partials(&mut |r, _, d| fixed_partials.push(scene.scaled_partial(r, d)));
+        scene.fixed_partials = fixed_partials;
+        scene
     }
 
     /// Number of capacity nodes.
@@ -534,7 +541,8 @@ impl ThermalScene {
     /// properties held fixed as in [`Self::network_heat_jvp`]): calls `add(row, col, ∂q_row/∂T_col)`
     /// in W/K for every term, where `row` is the node receiving the heat or a boundary (the heat
     /// into boundaries). The sequence of `(row, col)` does not depend on the state, so a caller
-    /// can record the pattern once and then fill values in the same order.
+    /// can record the pattern once and then fill values in the same order: the fixed links
+    /// first ([`Self::fixed_link_partials`]), then the others.
     pub fn network_heat_partials(
         &self,
         temps: &[f64],
@@ -542,39 +550,93 @@ impl ThermalScene {
         work: &NetworkWork,
         add: &mut impl FnMut(End, usize, f64),
     ) {
-        let bt = &work.boundary_t;
-        // q flows a → b with ∂q/∂T_a = da and ∂q/∂T_b = db.
-        let mut pair = |a: End, b: End, da: f64, db: f64| {
-            for (e, d) in [(a, da), (b, db)] {
-                if let End::Node(col) = e {
-                    add(a, col, -d);
-                    add(b, col, d);
-                }
-            }
-        };
-        for c in &self.fixed {
-            pair(c.a, c.b, c.g, -c.g);
+        self.fixed_link_partials(add);
+        self.varying_link_partials(temps, oil_g, work, add);
+    }
+
+    /// The network's partials as the Jacobian holds them, in [`Self::network_heat_partials`]'s
+    /// order, into `vals`: node rows per unit capacity (K/s per K), boundary rows in W/K. The
+    /// fixed links' values are constant and copied. Returns how many were written.
+    pub fn network_partial_values(
+        &self,
+        temps: &[f64],
+        oil_g: &[f64],
+        work: &NetworkWork,
+        vals: &mut [f64],
+    ) -> usize {
+        let mut k = self.fixed_partials.len();
+        vals[..k].copy_from_slice(&self.fixed_partials);
+        self.varying_link_partials(temps, oil_g, work, &mut |r, _, d| {
+            vals[k] = self.scaled_partial(r, d);
+            k += 1;
+        });
+        k
+    }
+
+    /// A partial ∂q_row/∂T as the Jacobian holds it: per unit capacity for a node row.
+    #[inline]
+    fn scaled_partial(&self, row: End, d: f64) -> f64 {
+        match row {
+            End::Node(i) => d * self.inv_capacity[i],
+            End::Boundary(_) => d,
         }
+    }
+
+    /// q flows a → b with ∂q/∂T_a = da and ∂q/∂T_b = db: the entries of both ends' columns.
+    #[inline]
+    fn link_partials(a: End, b: End, da: f64, db: f64, add: &mut impl FnMut(End, usize, f64)) {
+        for (e, d) in [(a, da), (b, db)] {
+            if let End::Node(col) = e {
+                add(a, col, -d);
+                add(b, col, d);
+            }
+        }
+    }
+
+    /// The partials of the fixed-conductance links (constant).
+    fn fixed_link_partials(&self, add: &mut impl FnMut(End, usize, f64)) {
+        for c in &self.fixed {
+            Self::link_partials(c.a, c.b, c.g, -c.g, add);
+        }
+    }
+
+    /// The partials of the links whose conductance follows the sample, the oil or the
+    /// temperatures.
+    fn varying_link_partials(
+        &self,
+        temps: &[f64],
+        oil_g: &[f64],
+        work: &NetworkWork,
+        add: &mut impl FnMut(End, usize, f64),
+    ) {
+        let bt = &work.boundary_t;
         for (l, g) in self.sample.iter().zip(&work.sample_g) {
-            pair(l.a, l.b, *g, -g);
+            Self::link_partials(l.a, l.b, *g, -g, add);
         }
         for (l, g) in self.oil_links.iter().zip(oil_g) {
-            pair(l.a, l.b, *g, -g);
+            Self::link_partials(l.a, l.b, *g, -g, add);
         }
         for r in &self.radiation {
             let (ta, tb) = (Self::temp(r.a, temps, bt), Self::temp(r.b, temps, bt));
-            pair(
+            Self::link_partials(
                 r.a,
                 r.b,
                 radiation_derivative(r.k, ta),
                 -radiation_derivative(r.k, tb),
+                add,
             );
         }
         for c in &self.coolers {
             let th = temps[c.hot];
             let tc = Self::temp(c.cold, temps, bt);
             let (x, dx) = c.opening(th, tc);
-            pair(End::Node(c.hot), c.cold, c.g * (x + dx * (th - tc)), -c.g * x);
+            Self::link_partials(
+                End::Node(c.hot),
+                c.cold,
+                c.g * (x + dx * (th - tc)),
+                -c.g * x,
+                add,
+            );
         }
     }
 
