@@ -300,7 +300,8 @@ impl LossScene {
                         })?;
                     churn.push(ChurnEntry {
                         item: items.len(),
-                        law: churn_sample::sum_law(&models),
+                        // `evaluate_all` measures the scene without its per-sample laws.
+                        law: churn_sample::sum_law(&models).filter(|_| !needs.evaluate_all),
                         ratio_terms: Vec::new(),
                         models,
                     });
