@@ -343,16 +343,7 @@ impl Scene {
         let n = self.nodes();
         self.thermal.boundary_temperatures(t, &mut work.net);
         let t_oil = self.oil_temp(y);
-        let to_b = self.heat_balance(
-            y,
-            t_oil,
-            &work.inputs,
-            &work.terms,
-            &work.net,
-            &mut work.q,
-            (&mut work.oil_g, &mut work.oil_dg),
-            &mut work.heat,
-        );
+        let to_b = self.heat_balance_in(y, t_oil, work, false);
         for ((d, h), c) in dy.iter_mut().zip(&work.heat).zip(&self.thermal.capacity) {
             *d = h / c;
         }
@@ -432,17 +423,20 @@ impl Scene {
     /// [`Self::heat_balance`] at oil temperature `t_oil` into the work area's scratch buffers
     /// (`q2`, `oil_g2`, `oil_dg2`, `heat2`), leaving the last right-hand side's intact.
     fn scratch_heat_balance(&self, y: &[f64], t_oil: f64, work: &mut Work) -> f64 {
-        let inputs = work.inputs;
-        self.heat_balance(
-            y,
-            t_oil,
-            &inputs,
-            &work.terms,
-            &work.net,
-            &mut work.q2,
-            (&mut work.oil_g2, &mut work.oil_dg2),
-            &mut work.heat2,
-        )
+        self.heat_balance_in(y, t_oil, work, true)
+    }
+
+    /// [`Self::heat_balance`] with the work area's inputs and terms, into the right-hand side's
+    /// buffers (`q`, `oil_g`, `oil_dg`, `heat`) or, with `scratch`, into `q2`, `oil_g2`,
+    /// `oil_dg2`, `heat2`.
+    fn heat_balance_in(&self, y: &[f64], t_oil: f64, work: &mut Work, scratch: bool) -> f64 {
+        let w = work;
+        let (q, g, dg, heat) = if scratch {
+            (&mut w.q2, &mut w.oil_g2, &mut w.oil_dg2, &mut w.heat2)
+        } else {
+            (&mut w.q, &mut w.oil_g, &mut w.oil_dg, &mut w.heat)
+        };
+        self.heat_balance(y, t_oil, &w.inputs, &w.terms, &w.net, q, (g, dg), heat)
     }
 
     /// ∂f/∂T_oil through the oil properties (all rows of the state), by a forward difference,
@@ -657,16 +651,8 @@ impl Scene {
         work.base = None;
         self.thermal.boundary_temperatures(t, &mut work.net);
         let t_oil = self.oil_temp(y);
-        let inputs = work.inputs;
-        self.heat_balance(
-            y,
-            t_oil,
-            &inputs,
-            &work.terms,
-            &work.net,
-            &mut work.q,
-            (&mut work.oil_g, &mut work.oil_dg),
-            heat,
-        )
+        let to_b = self.heat_balance_in(y, t_oil, work, false);
+        heat.copy_from_slice(&work.heat);
+        to_b
     }
 }
