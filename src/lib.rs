@@ -6,6 +6,7 @@
 //! `src/main.rs` and `src/cli/`.
 
 pub mod cycle;
+pub mod job;
 pub mod model;
 pub mod physics;
 pub mod report;

@@ -4,11 +4,12 @@
 
 use std::path::PathBuf;
 
+use geartherm::job::validate::{validate as run_validate, ValidateOptions};
 use geartherm::report::files::OutputDir;
 use geartherm::report::validation::{rows_csv, summary_csv, summary_markdown, ValidationReport};
-use geartherm::solve::validation::{run_all, summarise};
 
-use super::{invalid, print_json, Failure, EXIT_IO};
+use super::output::{emit, emit_json, io_failure};
+use super::Failure;
 
 /// Arguments of `validate`.
 #[derive(clap::Args, Debug)]
@@ -24,52 +25,41 @@ pub struct ValidateArgs {
     pub json: bool,
 }
 
+impl ValidateArgs {
+    /// The job's options.
+    pub fn options(&self) -> ValidateOptions {
+        ValidateOptions {
+            dir: self.dir.clone(),
+        }
+    }
+}
+
 /// Run `validate`.
 pub fn validate(a: &ValidateArgs) -> Result<(), Failure> {
-    if !a.dir.is_dir() {
-        return Err(invalid(format!("validate: {}: not a directory", a.dir.display())));
-    }
     // Lock the output directory before the work (a second writer is refused now) and write the
     // result set as one transaction: the previous set stays whole until the commit.
     let out = OutputDir::begin(&a.out)?;
-    let rows = run_all(&a.dir).map_err(|e| invalid(format!("validate: {e}")))?;
-    if rows.is_empty() {
-        return Err(invalid(format!(
-            "validate: {}: no case.toml found",
-            a.dir.display()
-        )));
-    }
-    if let Some(r) = rows
-        .iter()
-        .find(|r| !(r.predicted.is_finite() && r.relative_error.is_finite()))
-    {
-        return Err(Failure {
-            code: super::EXIT_NUMERICAL,
-            message: format!(
-                "validate: case {} point {} model {}: non-finite result",
-                r.case, r.point, r.model
-            ),
-        });
-    }
-    let sum = summarise(&rows);
+    let r = run_validate(&a.options())?;
     let texts = [
-        ("validation.csv", rows_csv(&rows)),
-        ("validation_summary.csv", summary_csv(&sum)),
-        ("validation.md", summary_markdown(&sum)),
+        ("validation.csv", rows_csv(&r.rows)),
+        ("validation_summary.csv", summary_csv(&r.summary)),
+        ("validation.md", summary_markdown(&r.summary)),
     ];
-    geartherm::report::plots::render_validation(out.path(), &rows, &texts).map_err(|e| Failure {
-        code: EXIT_IO,
-        message: format!("validate: {e}"),
-    })?;
-    let target = out.commit()?;
+    geartherm::report::plots::render_validation(out.path(), &r.rows, &texts)
+        .map_err(|e| io_failure(format!("validate: {e}")))?;
     if a.json {
-        print_json(&ValidationReport {
-            rows: &rows,
-            summary: &sum,
-        })
+        emit_json(&ValidationReport {
+            rows: &r.rows,
+            summary: &r.summary,
+        })?;
     } else {
-        print!("{}", summary_markdown(&sum));
-        println!("\n{} rows written to {}", rows.len(), target.display());
-        Ok(())
+        emit(&format!(
+            "{}\n{} rows written to {}\n",
+            summary_markdown(&r.summary),
+            r.rows.len(),
+            out.target().display()
+        ))?;
     }
+    out.commit()?;
+    Ok(())
 }
