@@ -132,8 +132,10 @@ fn build(state: State) -> PyResult<Model> {
     })
 }
 
-fn options<T: serde::de::DeserializeOwned>(what: &str, json: &str) -> PyResult<T> {
-    serde_json::from_str(json).map_err(|e| json_error(what, e))
+/// A job's options from a Python mapping (floats pass as they are, NaN and infinities
+/// included, so that the job layer checks them as it does for the CLI).
+fn options<T: serde::de::DeserializeOwned>(what: &str, mapping: &Bound<'_, PyAny>) -> PyResult<T> {
+    pythonize::depythonize(mapping).map_err(|e| InputError::new_err(format!("{what}: {e}")))
 }
 
 #[pymethods]
@@ -211,33 +213,33 @@ impl Model {
         to_json(&geartherm::report::info::info(&self.m.gearbox))
     }
 
-    /// The `geartherm losses --json` report (JSON of `job::LossesOptions` in).
-    fn losses(&self, py: Python<'_>, options: &str) -> PyResult<String> {
+    /// The `geartherm losses --json` report (a mapping of `job::LossesOptions` in).
+    fn losses(&self, py: Python<'_>, options: &Bound<'_, PyAny>) -> PyResult<String> {
         let o: LossesOptions = self::options("losses", options)?;
         let m = self.m.clone();
         let r = py.detach(|| job::losses::losses(&m, &o)).map_err(job_error)?;
         to_json(&r)
     }
 
-    /// An equilibrium (JSON of `job::SteadyOptions` in, `job::SteadyResult` out).
-    fn steady(&self, py: Python<'_>, options: &str) -> PyResult<String> {
+    /// An equilibrium (a mapping of `job::SteadyOptions` in, `job::SteadyResult` out).
+    fn steady(&self, py: Python<'_>, options: &Bound<'_, PyAny>) -> PyResult<String> {
         let o: SteadyOptions = self::options("steady", options)?;
         let m = self.m.clone();
         let r = py.detach(|| job::steady::steady(&m, &o)).map_err(job_error)?;
         to_json(&r)
     }
 
-    /// Equilibria over a speed × torque grid (JSON of `job::MapOptions` in): `map.csv` text.
-    fn map(&self, py: Python<'_>, options: &str) -> PyResult<String> {
+    /// Equilibria over a speed × torque grid (a mapping of `job::MapOptions` in): `map.csv` text.
+    fn map(&self, py: Python<'_>, options: &Bound<'_, PyAny>) -> PyResult<String> {
         let o: MapOptions = self::options("map", options)?;
         let m = self.m.clone();
         let r = py.detach(|| job::map::map(&m, &o, &|| {})).map_err(job_error)?;
         Ok(r.csv)
     }
 
-    /// A drive-cycle run (JSON of `job::RunOptions` in): (`summary.json` text, `timeseries.csv`
+    /// A drive-cycle run (a mapping of `job::RunOptions` in): (`summary.json` text, `timeseries.csv`
     /// text or None).
-    fn run(&self, py: Python<'_>, options: &str) -> PyResult<(String, Option<String>)> {
+    fn run(&self, py: Python<'_>, options: &Bound<'_, PyAny>) -> PyResult<(String, Option<String>)> {
         let o: RunOptions = self::options("run", options)?;
         let m = self.m.clone();
         let r = py

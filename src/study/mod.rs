@@ -163,19 +163,26 @@ fn jobs_of(spec: &JobSpec) -> Result<Vec<Job>, String> {
 }
 
 /// Every job's options checked before any case runs (their ranges, the cycles read, the gear
-/// states known to the base model): a study with a bad option fails at once, not per case.
-fn check_jobs(jobs: &[Job], base: &job::Model) -> Result<(), StudyError> {
+/// states known to the base model): a study with a bad option fails at once, not per case. The
+/// message is the job layer's, after the key path of the job in the study file.
+fn check_jobs(spec: &JobSpec, jobs: &[Job], base: &job::Model) -> Result<(), StudyError> {
     let mut cycles_seen = std::collections::BTreeSet::new();
     for (k, j) in jobs.iter().enumerate() {
-        let at = |e: JobError| StudyError::Job(e.prefixed(&format!("job {k}")));
         match j {
             Job::Run(o) => {
-                o.check().map_err(at)?;
+                let at = |key: String| move |e: JobError| StudyError::Job(e.prefixed(&key));
+                o.check().map_err(at("job.options".into()))?;
                 if cycles_seen.insert(o.cycle.clone()) {
-                    crate::cycle::DriveCycle::resolve(&o.cycle).map_err(|e| at(e.into()))?;
+                    crate::cycle::DriveCycle::resolve(&o.cycle)
+                        .map_err(|e| at(format!("job.cycles[{k}]"))(e.into()))?;
                 }
             }
             Job::Steady(p) => {
+                let key = match spec {
+                    JobSpec::Steady { .. } => format!("job.points[{k}]"),
+                    _ => "job".to_string(),
+                };
+                let at = |e: JobError| StudyError::Job(e.prefixed(&key));
                 p.check().map_err(at)?;
                 base.state(&p.gear).map_err(at)?;
             }
@@ -311,7 +318,7 @@ impl Study {
             }
         }
         let jobs = jobs_of(&spec.job).map_err(invalid)?;
-        check_jobs(&jobs, &base_model)?;
+        check_jobs(&spec.job, &jobs, &base_model)?;
         check_outputs(&spec.outputs, &output_columns(&jobs, &base_model)?)?;
         let spec_json = serde_json::to_string(&spec).map_err(|e| invalid(e.to_string()))?;
         let fingerprint = format!("{:016x}", fnv1a(&[spec_json.as_bytes(), model_text.as_bytes()]));

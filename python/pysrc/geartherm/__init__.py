@@ -150,7 +150,7 @@ class Model:
     def losses(self, gear: str, speed_rpm: float, torque_nm: float, oil_temp_c: float) -> Dict[str, Any]:
         """Every loss item at one operating point (``geartherm losses --json``)."""
         o = {"gear": str(gear), "speed_rpm": float(speed_rpm), "torque_nm": float(torque_nm), "oil_temp_c": float(oil_temp_c)}
-        return json.loads(self._m.losses(json.dumps(o)))
+        return json.loads(self._m.losses(o))
 
     def steady(
         self,
@@ -162,7 +162,7 @@ class Model:
     ) -> Dict[str, Any]:
         """Equilibrium temperatures (°C), losses (W) and efficiency at one operating point."""
         p = _point(gear, speed_rpm, torque_nm, vehicle_speed_kmh, ambient_c)
-        return json.loads(self._m.steady(json.dumps(p)))
+        return json.loads(self._m.steady(p))
 
     def map(
         self,
@@ -181,7 +181,7 @@ class Model:
             "vehicle_speed_kmh": float(vehicle_speed_kmh),
             "ambient_c": None if ambient_c is None else float(ambient_c),
         }
-        return _frame(self._m.map(json.dumps(o)))
+        return _frame(self._m.map(o))
 
     def run(
         self,
@@ -210,7 +210,7 @@ class Model:
                 o[k] = v
         o["initial_temp_c"] = initial_temp_c
         o["ambient_c"] = ambient_c
-        summary, csv = self._m.run(json.dumps(o))
+        summary, csv = self._m.run(o)
         return RunResult(summary, csv)
 
     def __reduce__(self):
