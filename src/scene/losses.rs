@@ -128,7 +128,7 @@ struct SlideEntry {
     law: Option<PowerLaw>,
 }
 
-/// What a run needs from the scene (scene pruning, docs/performance.md).
+/// What a run needs from the scene (scene pruning, docs/physics.md "Pruning and the per-sample cache").
 #[derive(Debug, Clone, Default)]
 pub struct Needs {
     /// Gear states the run visits (`None`: every state of the model). Loss items idle in all of

@@ -41,7 +41,7 @@ pub enum LinearAlgebra {
 }
 
 /// State count from which [`LinearAlgebra::Auto`] uses the sparse LU (the measured crossover,
-/// docs/performance.md "Sparse networks and the integration floor").
+/// docs/performance.md "Large networks").
 pub const SPARSE_FROM_STATES: usize = 50;
 
 impl LinearAlgebra {

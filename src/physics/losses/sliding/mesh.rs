@@ -194,7 +194,7 @@ impl SlidingMesh {
     ///
     /// The scene uses this to run the element loop once per gear state and power-flow direction
     /// at compile time; a cycle sample then costs two powers and a right-hand-side call one
-    /// power of η (docs/performance.md).
+    /// power of η (docs/physics.md "Pruning and the per-sample cache").
     pub fn power_law(&self) -> Option<PowerLaw> {
         match (self.options.friction, self.options.loss_form) {
             (FrictionLaw::Constant(_), _) => Some(PowerLaw {
