@@ -1,4 +1,4 @@
-//! Churning of planets averaged over the carrier revolution (issue 14).
+//! Churning of planets averaged over the carrier revolution.
 //!
 //! A planet's axis orbits the set axis at radius R. With the carrier angle φ measured from the
 //! lowest orbit position, the planet's immersion is `h(φ) = h_max − R(1 − cos φ)` (h_max: the

@@ -268,7 +268,7 @@ pub struct Summary {
     pub energy_lost_j: Option<EnergyBySource>,
     pub energy_by_item_j: Vec<ItemEnergy>,
     pub energy_balance_relative: Option<f64>,
-    /// `cycle_efficiency` (∫P_out/∫P_in); `mean_efficiency` in directories written before it.
+    /// `cycle_efficiency` (∫P_out/∫P_in); `mean_efficiency` in directories of earlier versions.
     #[serde(alias = "mean_efficiency")]
     pub cycle_efficiency: Option<f64>,
     pub temperatures_c: BTreeMap<String, TempStats>,

@@ -1,5 +1,5 @@
 //! Reference cases (`validation/<case>/case.toml`) evaluated with every applicable model choice
-//! (issue 14; docs/validation.md).
+//! (docs/validation.md).
 //!
 //! A case names a model file, a quantity (any loss source, optionally one item, or the
 //! efficiency over chosen sources), the kind of reference (peer, standard, measurement, trend,
