@@ -51,12 +51,20 @@ pub struct Row {
 pub enum ValidationError {
     /// Unreadable or malformed case or reference file.
     #[error("{}: {msg}", path.display())]
-    Case { path: PathBuf, msg: String },
+    Case {
+        /// The case or reference file.
+        path: PathBuf,
+        /// What is wrong with it.
+        msg: String,
+    },
     /// The model file (with a choice applied) does not load or compile.
     #[error("{}: model choice {choice}: {msg}", path.display())]
     Model {
+        /// The model file the case names.
         path: PathBuf,
+        /// The model choice applied (keys written over the model file).
         choice: String,
+        /// Why it does not load or compile.
         msg: String,
     },
 }
