@@ -1,7 +1,7 @@
 //! Transient driver: integrates a [`Scene`] over piecewise-constant input segments (drive-cycle
 //! intervals) with ROS3 ([`super::rosenbrock`], the default for lumped networks through
 //! [`Method::Auto`]) or a diffsol solver (TR-BDF2 above 24 nodes, BDF, ESDIRK34, Tsit45). Both
-//! share [`Driver`]: the rows, the step budget and the failure diagnosis.
+//! share `Driver`: the rows, the step budget and the failure diagnosis.
 //!
 //! How the diffsol pitfalls of docs/numerics.md are handled (each has a test in `tests/transient.rs`):
 //! 1. `max_nonlinear_solver_failures` counts over the solver's life: raised to the step budget;
