@@ -5,6 +5,8 @@
 //! `physics` is pure (SI units, no I/O); `model` reads and validates model files; the CLI lives in
 //! `src/main.rs` and `src/cli/`.
 
+#![warn(missing_docs)]
+
 pub mod cycle;
 pub mod job;
 pub mod model;

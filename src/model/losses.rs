@@ -129,7 +129,7 @@ pub fn validate_losses(
                 .pocketing_discharge_coefficient
                 .unwrap_or(DEFAULT_DISCHARGE_COEFFICIENT);
             problems.in_range("losses.pocketing_discharge_coefficient", cd, 0.1, 1.0, "");
-            // No default: the density a mesh above the oil pumps has no source (issue 14).
+            // No default: the density a mesh above the oil pumps has no source.
             let rho = l.pocketing_mixture_density_kg_m3;
             if let Some(r) = rho {
                 problems.in_range("losses.pocketing_mixture_density_kg_m3", r, 0.0, 1000.0, " kg/m3");

@@ -314,10 +314,10 @@ pub struct LossesSpec {
     /// Stavytskyi: edge coefficient k_s (0.85 sharp, 0.9 deburred).
     #[serde(default)]
     pub stavytskyi_ks: Option<f64>,
-    /// Changenet–Velex low-Re law [factor, exp(h/D), exp(V0/D³), exp(Fr), exp(Re)] [recalled].
+    /// Changenet–Velex low-Re law [factor, exp(h/D), exp(V0/D³), exp(Fr), exp(Re)] \[recalled\].
     #[serde(default)]
     pub changenet_low: Option<[f64; 5]>,
-    /// Changenet–Velex high-Re law [factor, exp(h/D), exp(V0/D³), exp(Fr), exp(b/D)] [recalled].
+    /// Changenet–Velex high-Re law [factor, exp(h/D), exp(V0/D³), exp(Fr), exp(b/D)] \[recalled\].
     #[serde(default)]
     pub changenet_high: Option<[f64; 5]>,
 }

@@ -18,7 +18,8 @@ use super::churn_sample::{self, ChurnSample, InputSpeedPowers};
 use crate::physics::losses::churning::ChangenetSum;
 
 /// Helical pockets: the exact infinitely-many-slices limit of the connected-slice model (one spur
-/// pocket history summed over phases; was 48 discrete slices, 0.5 % off and 0.35 s per AT6 compile).
+/// pocket history summed over phases; 48 discrete slices are 1.8–2 % high on the AT6 meshes,
+/// docs/performance.md "Helical pocket integral").
 pub const HELIX_POCKET_SLICES: Option<usize> = None;
 
 pub use crate::model::source::{PerSource, Source, N_SOURCES};
@@ -128,7 +129,7 @@ struct SlideEntry {
     law: Option<PowerLaw>,
 }
 
-/// What a run needs from the scene (scene pruning, docs/performance.md).
+/// What a run needs from the scene (scene pruning, docs/physics.md "Pruning and the per-sample cache").
 #[derive(Debug, Clone, Default)]
 pub struct Needs {
     /// Gear states the run visits (`None`: every state of the model). Loss items idle in all of

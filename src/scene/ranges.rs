@@ -1,5 +1,5 @@
 //! Warnings: loss models used outside the range they were fitted or derived on, and loss items
-//! whose value is not known (issue 14). Reported in `warnings` of the JSON outputs and
+//! whose value is not known. Reported in `warnings` of the JSON outputs and
 //! summary.json, and one stderr line per item and range.
 //!
 //! Range checks depend on the operating point (speeds, oil viscosity), so they are gathered over

@@ -542,7 +542,7 @@ impl ThermalScene {
     /// in W/K for every term, where `row` is the node receiving the heat or a boundary (the heat
     /// into boundaries). The sequence of `(row, col)` does not depend on the state, so a caller
     /// can record the pattern once and then fill values in the same order: the fixed links
-    /// first ([`Self::fixed_link_partials`]), then the others.
+    /// first (`Self::fixed_link_partials`), then the others.
     pub fn network_heat_partials(
         &self,
         temps: &[f64],

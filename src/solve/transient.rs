@@ -1,7 +1,7 @@
 //! Transient driver: integrates a [`Scene`] over piecewise-constant input segments (drive-cycle
 //! intervals) with ROS3 ([`super::rosenbrock`], the default for lumped networks through
 //! [`Method::Auto`]) or a diffsol solver (TR-BDF2 above 24 nodes, BDF, ESDIRK34, Tsit45). Both
-//! share [`Driver`]: the rows, the step budget and the failure diagnosis.
+//! share `Driver`: the rows, the step budget and the failure diagnosis.
 //!
 //! How the diffsol pitfalls of docs/numerics.md are handled (each has a test in `tests/transient.rs`):
 //! 1. `max_nonlinear_solver_failures` counts over the solver's life: raised to the step budget;
@@ -41,7 +41,7 @@ pub enum LinearAlgebra {
 }
 
 /// State count from which [`LinearAlgebra::Auto`] uses the sparse LU (the measured crossover,
-/// docs/performance.md "Sparse networks and the integration floor").
+/// docs/performance.md "Large networks").
 pub const SPARSE_FROM_STATES: usize = 50;
 
 impl LinearAlgebra {
@@ -171,7 +171,7 @@ pub struct TransientOptions {
     /// Dense or sparse linear algebra (default: by size).
     pub linear_algebra: LinearAlgebra,
     /// Assemble the Jacobian entry by entry (default). Off: one Jacobian–vector product per
-    /// column, as before issue 15 (dense only; for measuring the difference).
+    /// column (dense only; for measuring the difference).
     pub assembled_jacobian: bool,
 }
 

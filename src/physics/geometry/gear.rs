@@ -34,21 +34,21 @@ use super::profile::{ProfileInput, ToothProfile};
 pub struct GearSpec {
     /// Number of teeth (positive also for an internal gear).
     pub z: u32,
-    /// Normal module m_n [m].
+    /// Normal module m_n \[m\].
     pub mn: f64,
-    /// Normal pressure angle α_n [rad].
+    /// Normal pressure angle α_n \[rad\].
     pub alpha_n: f64,
-    /// Helix angle β on the reference cylinder, magnitude [rad] (0 = spur). Hand not needed.
+    /// Helix angle β on the reference cylinder, magnitude \[rad\] (0 = spur). Hand not needed.
     pub beta: f64,
     /// Profile shift coefficient x [-] (for a ring see the module docs: `x = −x_ISO`).
     pub x: f64,
-    /// Face width b [m].
+    /// Face width b \[m\].
     pub b: f64,
     /// True for an internal (ring) gear.
     pub internal: bool,
-    /// Tip diameter override [m]; takes precedence over the nominal value.
+    /// Tip diameter override \[m\]; takes precedence over the nominal value.
     pub tip_diameter: Option<f64>,
-    /// Root diameter override [m]; takes precedence over the nominal value.
+    /// Root diameter override \[m\]; takes precedence over the nominal value.
     pub root_diameter: Option<f64>,
     /// Addendum factor h_aP* of the gear (basic rack dedendum) [-], default 1.0.
     pub ha_p: f64,
@@ -86,12 +86,12 @@ impl GearSpec {
         self.internal = internal;
         self
     }
-    /// Tip diameter override [m].
+    /// Tip diameter override \[m\].
     pub fn with_tip_diameter(mut self, d_a: f64) -> Self {
         self.tip_diameter = Some(d_a);
         self
     }
-    /// Root diameter override [m].
+    /// Root diameter override \[m\].
     pub fn with_root_diameter(mut self, d_f: f64) -> Self {
         self.root_diameter = Some(d_f);
         self
@@ -180,44 +180,44 @@ impl GearSpec {
 pub struct GearGeometry {
     /// The input this was built from.
     pub spec: GearSpec,
-    /// Transverse pressure angle `α_t = atan(tan α_n / cos β)` [rad].
+    /// Transverse pressure angle `α_t = atan(tan α_n / cos β)` \[rad\].
     pub alpha_t: f64,
-    /// Base helix angle `β_b = asin(sin β cos α_n)` [rad].
+    /// Base helix angle `β_b = asin(sin β cos α_n)` \[rad\].
     pub beta_b: f64,
-    /// Transverse module `m_t = m_n / cos β` [m].
+    /// Transverse module `m_t = m_n / cos β` \[m\].
     pub m_t: f64,
-    /// Reference diameter `d = m_t z` [m].
+    /// Reference diameter `d = m_t z` \[m\].
     pub d: f64,
-    /// Base diameter `d_b = d cos α_t` [m].
+    /// Base diameter `d_b = d cos α_t` \[m\].
     pub d_b: f64,
-    /// Tip diameter [m] (override or nominal; ring: the inner circle).
+    /// Tip diameter \[m\] (override or nominal; ring: the inner circle).
     pub d_a: f64,
-    /// Root diameter [m] (override or nominal; ring: the outer circle).
+    /// Root diameter \[m\] (override or nominal; ring: the outer circle).
     pub d_f: f64,
-    /// Form diameter: where the involute meets the root fillet [m].
+    /// Form diameter: where the involute meets the root fillet \[m\].
     pub d_form: f64,
-    /// Transverse pitch `p_t = π m_t` [m].
+    /// Transverse pitch `p_t = π m_t` \[m\].
     pub p_t: f64,
-    /// Transverse base pitch `p_bt = π m_t cos α_t` [m].
+    /// Transverse base pitch `p_bt = π m_t cos α_t` \[m\].
     pub p_bt: f64,
-    /// Normal pitch `p_n = π m_n` [m].
+    /// Normal pitch `p_n = π m_n` \[m\].
     pub p_n: f64,
-    /// Normal base pitch `p_bn = π m_n cos α_n` [m].
+    /// Normal base pitch `p_bn = π m_n cos α_n` \[m\].
     pub p_bn: f64,
-    /// Transverse tooth thickness on the reference circle [m]:
+    /// Transverse tooth thickness on the reference circle \[m\]:
     /// external `m_t(π/2 + 2x tan α_n)`, ring `m_t(π/2 − 2x tan α_n)`.
     pub s_t: f64,
-    /// Normal tooth thickness on the reference cylinder `s_n = s_t cos β` [m].
+    /// Normal tooth thickness on the reference cylinder `s_n = s_t cos β` \[m\].
     pub s_n: f64,
-    /// Transverse tooth thickness (arc) on the tip circle [m].
+    /// Transverse tooth thickness (arc) on the tip circle \[m\].
     pub s_at: f64,
-    /// Transverse space width (arc) on the tip circle [m] (the opening of a tooth space).
+    /// Transverse space width (arc) on the tip circle \[m\] (the opening of a tooth space).
     pub e_at: f64,
-    /// Tooth height `|d_a − d_f|/2` [m].
+    /// Tooth height `|d_a − d_f|/2` \[m\].
     pub h: f64,
     /// Effective tool dedendum factor `h_fP,eff` implied by the actual root diameter [-].
     pub hf_p_eff: f64,
-    /// Tool tip (fillet) radius actually used [m] (`ρ_fP* m_n` unless reduced).
+    /// Tool tip (fillet) radius actually used \[m\] (`ρ_fP* m_n` unless reduced).
     pub rho_f: f64,
     /// True if `ρ_fP* m_n` did not fit in the tool tooth / tooth space and was reduced to the
     /// largest value that fits (full-radius root).
@@ -395,49 +395,49 @@ impl GearGeometry {
     pub fn is_internal(&self) -> bool {
         self.spec.internal
     }
-    /// Reference radius [m].
+    /// Reference radius \[m\].
     pub fn r(&self) -> f64 {
         self.d / 2.0
     }
-    /// Base radius [m].
+    /// Base radius \[m\].
     pub fn r_b(&self) -> f64 {
         self.d_b / 2.0
     }
-    /// Tip radius [m].
+    /// Tip radius \[m\].
     pub fn r_a(&self) -> f64 {
         self.d_a / 2.0
     }
-    /// Root radius [m].
+    /// Root radius \[m\].
     pub fn r_f(&self) -> f64 {
         self.d_f / 2.0
     }
-    /// Form radius (involute/fillet junction) [m].
+    /// Form radius (involute/fillet junction) \[m\].
     pub fn r_form(&self) -> f64 {
         self.d_form / 2.0
     }
-    /// Face width [m].
+    /// Face width \[m\].
     pub fn b(&self) -> f64 {
         self.spec.b
     }
 
-    /// Angular half-thickness of the tooth on the involute at radius `r` [rad] [std]:
+    /// Angular half-thickness of the tooth on the involute at radius `r` \[rad\] [std]:
     /// external `ψ(r) = s_t/d + inv α_t − inv α_r`, ring `ψ(r) = s_t/d − inv α_t + inv α_r`
     /// with `cos α_r = r_b / r`. Precondition: `r ≥ r_b` (clamped to the base circle below).
     pub fn half_thickness_angle(&self, r: f64) -> f64 {
         self.profile.half_thickness_angle(r)
     }
 
-    /// Transverse tooth thickness (arc) on the involute at radius `r` [m]: `2 r ψ(r)`.
+    /// Transverse tooth thickness (arc) on the involute at radius `r` \[m\]: `2 r ψ(r)`.
     pub fn tooth_thickness_at(&self, r: f64) -> f64 {
         2.0 * r * self.half_thickness_angle(r)
     }
 
-    /// Transverse space width (arc) on the involute at radius `r` [m]: `2πr/z − s(r)`.
+    /// Transverse space width (arc) on the involute at radius `r` \[m\]: `2πr/z − s(r)`.
     pub fn space_width_at(&self, r: f64) -> f64 {
         2.0 * PI * r / f64::from(self.spec.z) - self.tooth_thickness_at(r)
     }
 
-    /// Pressure angle of the involute at radius `r` [rad] (`acos(r_b/r)`).
+    /// Pressure angle of the involute at radius `r` \[rad\] (`acos(r_b/r)`).
     pub fn pressure_angle_at(&self, r: f64) -> f64 {
         pressure_angle_at(r, self.r_b())
     }

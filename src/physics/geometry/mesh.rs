@@ -3,14 +3,14 @@
 //!
 //! # Coordinate along the line of action
 //!
-//! `s` [m] is measured along the transverse line of action from the pitch point C (s = 0),
+//! `s` \[m\] is measured along the transverse line of action from the pitch point C (s = 0),
 //! **negative towards gear 1's base tangent point T1** (`s_T1 = −r_b1 tan α_wt`). Gear 1 is
 //! the pinion (always an external gear); in an internal mesh gear 2 is the ring.
 //!
 //! * External mesh: T1 and T2 lie on opposite sides of C, `s_T2 = +r_b2 tan α_wt`.
 //!   Curvature radii (distances from T1, T2) `ρ1 = r_b1 tan α_wt + s`, `ρ2 = r_b2 tan α_wt − s`,
 //!   both flanks convex.
-//! * Internal mesh [derived]: the line of action touches both base circles on the same side
+//! * Internal mesh \[derived\]: the line of action touches both base circles on the same side
 //!   of C, so `s_T2 = −r_b2 tan α_wt` (beyond T1, since r_b2 > r_b1), and
 //!   `T1T2 = (r_b2 − r_b1) tan α_wt = a_w sin α_wt`. The distances from the centres of curvature
 //!   are `ρ1 = r_b1 tan α_wt + s` (convex pinion flank) and `ρ2 = r_b2 tan α_wt + s` (concave
@@ -50,55 +50,55 @@ pub struct MeshGeometry {
     pub z2: u32,
     /// Gear ratio `u = z2/z1` (> 0 for both kinds).
     pub u: f64,
-    /// Normal module [m].
+    /// Normal module \[m\].
     pub mn: f64,
-    /// Transverse module [m].
+    /// Transverse module \[m\].
     pub m_t: f64,
-    /// Normal pressure angle [rad].
+    /// Normal pressure angle \[rad\].
     pub alpha_n: f64,
-    /// Transverse pressure angle on the reference circle [rad].
+    /// Transverse pressure angle on the reference circle \[rad\].
     pub alpha_t: f64,
-    /// Helix angle [rad].
+    /// Helix angle \[rad\].
     pub beta: f64,
-    /// Base helix angle [rad].
+    /// Base helix angle \[rad\].
     pub beta_b: f64,
-    /// Reference centre distance `a = m_t (z2 ± z1)/2` (+ external, − internal) [m].
+    /// Reference centre distance `a = m_t (z2 ± z1)/2` (+ external, − internal) \[m\].
     pub a: f64,
-    /// Operating centre distance [m].
+    /// Operating centre distance \[m\].
     pub a_w: f64,
-    /// Operating transverse pressure angle α_wt [rad].
+    /// Operating transverse pressure angle α_wt \[rad\].
     pub alpha_wt: f64,
-    /// Zero-backlash operating centre distance from the profile shifts [m].
+    /// Zero-backlash operating centre distance from the profile shifts \[m\].
     pub a_w_from_shifts: f64,
-    /// Operating pitch radius of gear 1 `r_b1 / cos α_wt` [m].
+    /// Operating pitch radius of gear 1 `r_b1 / cos α_wt` \[m\].
     pub r_w1: f64,
-    /// Operating pitch radius of gear 2 [m].
+    /// Operating pitch radius of gear 2 \[m\].
     pub r_w2: f64,
-    /// Base radii [m].
+    /// Base radii \[m\].
     pub r_b1: f64,
-    /// Base radius of gear 2 [m].
+    /// Base radius of gear 2 \[m\].
     pub r_b2: f64,
-    /// Tip radii [m].
+    /// Tip radii \[m\].
     pub r_a1: f64,
-    /// Tip radius of gear 2 [m].
+    /// Tip radius of gear 2 \[m\].
     pub r_a2: f64,
-    /// Transverse base pitch (common) [m].
+    /// Transverse base pitch (common) \[m\].
     pub p_bt: f64,
-    /// Length T1T2 of the line of action between the base tangent points [m].
+    /// Length T1T2 of the line of action between the base tangent points \[m\].
     pub t1t2: f64,
-    /// Position of T1 on the line of action [m].
+    /// Position of T1 on the line of action \[m\].
     pub s_t1: f64,
-    /// Position of T2 on the line of action [m].
+    /// Position of T2 on the line of action \[m\].
     pub s_t2: f64,
-    /// Start of contact A (end nearer T1) [m].
+    /// Start of contact A (end nearer T1) \[m\].
     pub s_a: f64,
-    /// Point B = E − p_bt [m].
+    /// Point B = E − p_bt \[m\].
     pub s_b: f64,
-    /// Point D = A + p_bt [m].
+    /// Point D = A + p_bt \[m\].
     pub s_d: f64,
-    /// End of contact E [m].
+    /// End of contact E \[m\].
     pub s_e: f64,
-    /// Length of the path of contact `g_α = s_E − s_A` [m].
+    /// Length of the path of contact `g_α = s_E − s_A` \[m\].
     pub g_alpha: f64,
     /// Transverse contact ratio `ε_α = g_α / p_bt`.
     pub eps_alpha: f64,
@@ -106,10 +106,10 @@ pub struct MeshGeometry {
     pub eps_beta: f64,
     /// Total contact ratio `ε_γ = ε_α + ε_β`.
     pub eps_gamma: f64,
-    /// Common (smaller) face width [m].
+    /// Common (smaller) face width \[m\].
     pub b: f64,
     /// Circumferential backlash on the operating pitch circle
-    /// `j_wt = 2π r_w1/z1 − s_w1 − s_w2` [m] (s_w: tooth thicknesses on the operating pitch
+    /// `j_wt = 2π r_w1/z1 − s_w1 − s_w2` \[m\] (s_w: tooth thicknesses on the operating pitch
     /// circles; ring: its own tooth). Zero for the shift-derived centre distance.
     pub backlash_t: f64,
     /// Gear 2's tip reaches gear 1 below gear 1's form circle (involute interference/undercut).
@@ -147,7 +147,7 @@ impl MeshGeometry {
     /// `T1A = T1T2 − √(r_a2² − r_b2²)`; internal [derived, same construction]
     /// `T1A = √(r_a2² − r_b2²) − T1T2`. `ε_α = g_α/p_bt`, `ε_β = b sin β/(π m_n)`.
     ///
-    /// Tip interference of internal meshes [recalled] (KHK Co., "Gear technical reference",
+    /// Tip interference of internal meshes \[recalled\] (KHK Co., "Gear technical reference",
     /// internal gear interference; also Maitra, Handbook of Gear Design): with `θ1 =
     /// acos((r_a2² − r_a1² − a_w²)/(2 a_w r_a1)) + inv α_a1 − inv α_wt`, `θ2 =
     /// acos((a_w² + r_a2² − r_a1²)/(2 a_w r_a2))`, no interference iff
@@ -342,18 +342,18 @@ impl MeshGeometry {
         self.kind == MeshKind::Internal
     }
 
-    /// Curvature radius of gear 1's flank at position s: `r_b1 tan α_wt + s` [m].
+    /// Curvature radius of gear 1's flank at position s: `r_b1 tan α_wt + s` \[m\].
     pub fn rho1(&self, s: f64) -> f64 {
         s - self.s_t1
     }
 
-    /// Curvature radius (magnitude) of gear 2's flank at position s [m]: external
+    /// Curvature radius (magnitude) of gear 2's flank at position s \[m\]: external
     /// `r_b2 tan α_wt − s`, internal `r_b2 tan α_wt + s` (concave ring flank).
     pub fn rho2(&self, s: f64) -> f64 {
         (self.s_t2 - s).abs()
     }
 
-    /// Reduced (equivalent) radius of curvature at s [m]: external `ρ1ρ2/(ρ1 + ρ2)`,
+    /// Reduced (equivalent) radius of curvature at s \[m\]: external `ρ1ρ2/(ρ1 + ρ2)`,
     /// internal `ρ1ρ2/(ρ2 − ρ1)` (concave ring flank) [std].
     pub fn reduced_radius(&self, s: f64) -> f64 {
         let (r1, r2) = (self.rho1(s), self.rho2(s));
@@ -387,12 +387,12 @@ impl MeshGeometry {
         w1 * self.rho1(s) + w1 / self.u * self.rho2(s)
     }
 
-    /// Position s at which gear 1's flank is in contact at radius r [m].
+    /// Position s at which gear 1's flank is in contact at radius r \[m\].
     pub fn s_at_radius1(&self, r: f64) -> f64 {
         (r * r - self.r_b1 * self.r_b1).max(0.0).sqrt() + self.s_t1
     }
 
-    /// Position s at which gear 2's flank is in contact at radius r [m].
+    /// Position s at which gear 2's flank is in contact at radius r \[m\].
     pub fn s_at_radius2(&self, r: f64) -> f64 {
         let l = (r * r - self.r_b2 * self.r_b2).max(0.0).sqrt();
         if self.is_internal() {
@@ -402,17 +402,17 @@ impl MeshGeometry {
         }
     }
 
-    /// Radius on gear 1 of the contact point at s [m].
+    /// Radius on gear 1 of the contact point at s \[m\].
     pub fn radius1_at(&self, s: f64) -> f64 {
         self.r_b1.hypot(self.rho1(s))
     }
 
-    /// Radius on gear 2 of the contact point at s [m].
+    /// Radius on gear 2 of the contact point at s \[m\].
     pub fn radius2_at(&self, s: f64) -> f64 {
         self.r_b2.hypot(self.rho2(s))
     }
 
-    /// Rotation of gear 1 while the contact moves over the whole path: `g_α / r_b1` [rad].
+    /// Rotation of gear 1 while the contact moves over the whole path: `g_α / r_b1` \[rad\].
     pub fn contact_angle1(&self) -> f64 {
         self.g_alpha / self.r_b1
     }

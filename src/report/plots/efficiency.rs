@@ -38,6 +38,7 @@ pub fn weighted_quantile(pairs: &[(f64, f64)], q: f64) -> Option<f64> {
     v.last().map(|p| p.0)
 }
 
+/// Draw `efficiency.png` of the run: efficiency vs time and its time-weighted histogram.
 pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     let ts = &run.ts;
     let sm = &run.summary;

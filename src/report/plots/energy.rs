@@ -73,6 +73,7 @@ pub fn source_energies(run: &RunData) -> PerSource {
     out
 }
 
+/// Draw `energy.png` of the run: energy lost per item and per source, kJ.
 pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     let sm = &run.summary;
     let title = format!(

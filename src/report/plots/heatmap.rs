@@ -11,16 +11,22 @@ use super::data::{MapGrid, MapRow};
 use super::style::{self, ColourMap, LegendEntry, Swatch};
 use super::{Canvas, DrawResult};
 
+/// The quantity a map heatmap shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Quantity {
+    /// Efficiency at the equilibrium (fraction).
     Efficiency,
+    /// Total loss at the equilibrium, W.
     TotalLoss,
+    /// Oil temperature at the equilibrium, °C.
     OilTemp,
 }
 
 impl Quantity {
+    /// Every quantity, in the order the map report draws them.
     pub const ALL: [Quantity; 3] = [Quantity::Efficiency, Quantity::TotalLoss, Quantity::OilTemp];
 
+    /// File name of the quantity's figure.
     pub fn file_name(self) -> &'static str {
         match self {
             Quantity::Efficiency => "map_efficiency.png",
@@ -84,7 +90,7 @@ pub fn cell_edges(axis: &[f64]) -> Vec<f64> {
     }
 }
 
-/// Marching squares on the grid of point values `z[j*nx + i]` at (xs[i], ys[j]) for `level`.
+/// Marching squares on the grid of point values `z[j*nx + i]` at `(xs[i], ys[j])` for `level`.
 /// Squares with a missing (NaN) corner are skipped. Returns line segments in data coordinates.
 pub fn contour_segments(xs: &[f64], ys: &[f64], z: &[f64], level: f64) -> Vec<[(f64, f64); 2]> {
     let nx = xs.len();
@@ -149,6 +155,7 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
     sorted[k.min(sorted.len() - 1)]
 }
 
+/// Draw the heatmap of `q` over the map's speed × torque grid.
 pub fn draw(root: &Canvas, grid: &MapGrid, q: Quantity) -> DrawResult {
     let model = grid.meta.model.as_deref().unwrap_or("model");
     let gear = super::data::value_text(&grid.meta.gear);

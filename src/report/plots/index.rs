@@ -15,6 +15,7 @@ fn opt(v: Option<f64>, f: impl Fn(f64) -> String) -> String {
     v.filter(|x| x.is_finite()).map(f).unwrap_or_else(|| "–".into())
 }
 
+/// The run's `report.md`: its summary figures and the four PNGs.
 pub fn markdown(run: &RunData) -> String {
     let sm = &run.summary;
     let ts = &run.ts;

@@ -9,6 +9,7 @@ use super::{Canvas, DrawResult};
 
 const LEGEND_W: u32 = 300;
 
+/// Draw `losses.png` of the run: loss power stacked by source vs time, W.
 pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     let ts = &run.ts;
     let sm = &run.summary;

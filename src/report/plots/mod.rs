@@ -36,24 +36,49 @@ mod tests;
 /// Errors of the plot reports. Every variant names the file concerned.
 #[derive(Debug, thiserror::Error)]
 pub enum PlotError {
+    /// A file could not be read or written.
     #[error("{}: {source}", path.display())]
     Io {
+        /// The file.
         path: PathBuf,
+        /// The I/O error.
         #[source]
         source: std::io::Error,
     },
+    /// A CSV file is malformed (field count, a value that is not a finite number).
     #[error("{}: malformed CSV: {msg}", path.display())]
-    Csv { path: PathBuf, msg: String },
+    Csv {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong, with line and column where known.
+        msg: String,
+    },
+    /// A JSON file does not parse.
     #[error("{}: malformed JSON: {source}", path.display())]
     Json {
+        /// The file.
         path: PathBuf,
+        /// The parser's error.
         #[source]
         source: serde_json::Error,
     },
+    /// A file parses but lacks what the figure needs (a required column, any data rows).
     #[error("{}: {what}", path.display())]
-    Data { path: PathBuf, what: String },
+    Data {
+        /// The file.
+        path: PathBuf,
+        /// What is missing.
+        what: String,
+    },
+    /// Rendering a figure failed.
     #[error("{}: drawing failed: {msg}", path.display())]
-    Draw { path: PathBuf, msg: String },
+    Draw {
+        /// The figure's file.
+        path: PathBuf,
+        /// The drawing backend's error.
+        msg: String,
+    },
+    /// The embedded font could not be registered.
     #[error("the embedded DejaVu Sans font could not be loaded")]
     Font,
 }

@@ -37,6 +37,7 @@ pub fn gear_levels(gears: &[String]) -> Vec<String> {
     names.into_iter().map(String::from).collect()
 }
 
+/// Draw `temperatures.png` of the run: node temperatures, vehicle speed and gear vs time.
 pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     let ts = &run.ts;
     let sm = &run.summary;

@@ -69,6 +69,7 @@ fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo / f, hi * f)
 }
 
+/// Draw `work_precision.png`: wall time vs maximum temperature error per solver.
 pub fn draw(root: &Canvas, rows: &[BenchRow], meta: &BenchMeta) -> DrawResult {
     let title = format!(
         "Work–precision — {} / {}",

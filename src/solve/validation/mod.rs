@@ -1,5 +1,5 @@
 //! Reference cases (`validation/<case>/case.toml`) evaluated with every applicable model choice
-//! (issue 14; docs/validation.md).
+//! (docs/validation.md).
 //!
 //! A case names a model file, a quantity (any loss source, optionally one item, or the
 //! efficiency over chosen sources), the kind of reference (peer, standard, measurement, trend,
@@ -51,12 +51,20 @@ pub struct Row {
 pub enum ValidationError {
     /// Unreadable or malformed case or reference file.
     #[error("{}: {msg}", path.display())]
-    Case { path: PathBuf, msg: String },
+    Case {
+        /// The case or reference file.
+        path: PathBuf,
+        /// What is wrong with it.
+        msg: String,
+    },
     /// The model file (with a choice applied) does not load or compile.
     #[error("{}: model choice {choice}: {msg}", path.display())]
     Model {
+        /// The model file the case names.
         path: PathBuf,
+        /// The model choice applied (keys written over the model file).
         choice: String,
+        /// Why it does not load or compile.
         msg: String,
     },
 }

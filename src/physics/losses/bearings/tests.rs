@@ -395,8 +395,8 @@ fn roller_units_and_scaling() {
     assert_eq!(moment(&t, 0.0, 1000.0, 100.0, 30.0).total(), 0.0);
 }
 
-/// Vanishing speeds (a cycle row of 1e-300 rpm) give finite, non-negative power: the drag term's
-/// n²·(n f_t dm²)^-1.379 once gave 0·∞ = NaN there (issue 16 campaign, case 79658).
+/// Vanishing speeds (a cycle row of 1e-300 rpm) give finite, non-negative power: the drag term
+/// written as n²·(n f_t dm²)^-1.379 would give 0·∞ = NaN there (hostile-input campaign, seed 23, case 79658).
 #[test]
 fn vanishing_speeds_give_finite_power() {
     let mut i = input(

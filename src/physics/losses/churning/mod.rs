@@ -7,7 +7,7 @@
 //!   dimensionally consistent forms of physics.md §5.1: periphery + faces + tooth cavities.
 //! - [`stavytskyi`]: Stavytskyi et al. 2022 (seed 001): Coriolis term of the oil pumped through the
 //!   tooth spaces + periphery + faces, reconstructed from a garbled scan (decisions listed there).
-//! - [`changenet`]: Changenet & Velex 2007 empirical moment coefficient [recalled].
+//! - [`changenet`]: Changenet & Velex 2007 empirical moment coefficient \[recalled\].
 //!
 //! Common conventions: SI units; `h` is the depth of the gear's lowest point (tip circle) below
 //! the static oil level; `h ≤ 0` means not immersed (zero power; the scene should skip the gear),
@@ -252,7 +252,7 @@ pub enum ChurningModel {
     Seetharaman,
     /// Stavytskyi et al. 2022 (seed 001), reconstructed.
     Stavytskyi,
-    /// Changenet & Velex 2007 [recalled]. Recommended default.
+    /// Changenet & Velex 2007 \[recalled\]. Recommended default.
     #[default]
     Changenet,
 }

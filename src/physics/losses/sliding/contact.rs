@@ -7,7 +7,7 @@
 //! ρ2 = r_b2 tan α_wt − s; end of contact at gear 1's tip, s_E = √(r_a1² − r_b1²) − r_b1 tan α_wt;
 //! start at gear 2's tip, s_A = r_b2 tan α_wt − √(r_a2² − r_b2²).
 //!
-//! **Internal mesh (gear 2 = ring) [derived]:** both tangency points lie on the same side of C,
+//! **Internal mesh (gear 2 = ring) \[derived\]:** both tangency points lie on the same side of C,
 //! T1 between T2 and C, T1T2 = T2C − T1C = (r_b2 − r_b1) tan α_wt = a_w cos α_wt tan α_wt
 //! = a_w sin α_wt (a_w = r_w2 − r_w1, a_w cos α_wt = r_b2 − r_b1). A point at s is ρ1 = r_b1 tan α_wt + s
 //! from T1 and ρ2 = r_b2 tan α_wt + s from T2 (concave ring flank). The ring's tip circle

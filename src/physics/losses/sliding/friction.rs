@@ -33,7 +33,7 @@ pub struct ContactState {
     pub roughness: f64,
 }
 
-/// Benedict & Kelley (1961) [recalled]:
+/// Benedict & Kelley (1961) \[recalled\]:
 /// `μ = c·(50/(50 − S))·log10(K·W/(η0·v_g·v_Σ²))`, US units: W lbf/in, η0 cP, v_g and v_Σ in/s,
 /// S composite roughness in µin; c = 0.0127, K = 3.17e8.
 ///
@@ -97,7 +97,7 @@ impl BenedictKelley {
     }
 }
 
-/// ISO TC60 draft (as quoted in seed 003 table 4.1) [recalled]:
+/// ISO TC60 draft (as quoted in seed 003 table 4.1) \[recalled\]:
 /// `μ = c·(w·Ra/(η·R·v_Σ))^e`, w N/mm, Ra µm, η mPa·s, R mm, v_Σ m/s; c = 0.12, e = 0.25.
 /// (In SI the bracket is dimensionless: bracket_native = 1e-3·bracket_SI.)
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -189,9 +189,9 @@ pub const SCHLENK_VISCOSITY_EXPONENT: f64 = 0.05;
 pub enum FrictionLaw {
     /// Constant μ (dimensionless).
     Constant(f64),
-    /// Benedict & Kelley [recalled], local per contact element.
+    /// Benedict & Kelley \[recalled\], local per contact element.
     BenedictKelley(BenedictKelley),
-    /// ISO TC60 draft [recalled], local per contact element.
+    /// ISO TC60 draft \[recalled\], local per contact element.
     IsoTc60(IsoTc60),
     /// Schlenk / ISO/TR 14179-2 μ_mz [std]: one mean value for the whole mesh (pitch-point data).
     Schlenk(Schlenk),

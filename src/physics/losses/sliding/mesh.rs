@@ -182,7 +182,7 @@ impl SlidingMesh {
     /// and viscosity, `P(λ_T·T1, λ_ω·ω1, λ_ω·ω2, λ_η·η) = λ_T^a·λ_ω^b·λ_η^c·P(T1, ω1, ω2, η)`
     /// for λ > 0, or `None` when it is not.
     ///
-    /// [derived] With the first-order loss form every element contributes `μ_k F_k v_g,k`, with
+    /// \[derived\] With the first-order loss form every element contributes `μ_k F_k v_g,k`, with
     /// F_k ∝ T1 and v_g,k ∝ ω, both independent of η, and the load shares fixed by geometry.
     /// - ISO TC60, `μ = c·(w·Ra/(η·R·v_Σ))^e` with w ∝ T1 and v_Σ ∝ ω: (1 + e, 1 − e, −e).
     /// - Schlenk's μ_mz, `∝ (F_bt/b/(v_ΣC ρ))^0.2·η^−0.05`: (1.2, 0.8, −0.05).
@@ -194,7 +194,7 @@ impl SlidingMesh {
     ///
     /// The scene uses this to run the element loop once per gear state and power-flow direction
     /// at compile time; a cycle sample then costs two powers and a right-hand-side call one
-    /// power of η (docs/performance.md).
+    /// power of η (docs/physics.md "Pruning and the per-sample cache").
     pub fn power_law(&self) -> Option<PowerLaw> {
         match (self.options.friction, self.options.loss_form) {
             (FrictionLaw::Constant(_), _) => Some(PowerLaw {
