@@ -17,6 +17,7 @@
 //! line is rendered from its options by [`command`].
 
 pub mod bench;
+pub mod calibrate;
 pub mod command;
 pub mod error;
 pub mod limits;
@@ -28,6 +29,7 @@ pub mod steady;
 pub mod validate;
 
 pub use bench::{BenchOptions, BenchResult};
+pub use calibrate::{CalibrateOptions, CalibrateResult};
 pub use error::{ErrorKind, JobError};
 pub use losses::LossesOptions;
 pub use map::{MapOptions, MapResult};
