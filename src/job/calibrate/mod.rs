@@ -166,12 +166,12 @@ impl CalibrateResult {
     }
 }
 
-/// The model document with the model's overrides applied (for the parameters' start values).
-fn document(m: &Model, text: &str) -> Result<toml::Table, JobError> {
+/// The model document with the base overrides applied (for the parameters' start values).
+fn document(m: &Model, text: &str, base: &[crate::model::Override]) -> Result<toml::Table, JobError> {
     let mut problems = Problems::default();
     let mut doc = parse_document(text, &mut problems)
         .ok_or_else(|| JobError::invalid(format!("{}: the model text does not parse", m.label())))?;
-    for ov in &m.overrides {
+    for ov in base {
         overrides::apply(&mut doc, ov).map_err(|e| JobError::invalid(format!("{}: {e}", m.label())))?;
     }
     Ok(doc)
@@ -190,15 +190,15 @@ pub struct Prepared<'a> {
 /// Check the options and map the trace onto the model: every invalid input fails here.
 pub fn prepare<'a>(m: &Model, text: &'a str, trace: &'a Trace, o: &CalibrateOptions) -> Result<Prepared<'a>, JobError> {
     let (specs, windows) = o.check()?;
-    let doc = document(m, text)?;
-    let params = specs
-        .iter()
-        .map(|s| Parameter::resolve(s, &doc).map_err(|e| JobError::option("fit", s.to_string(), "a number in the model", e)))
-        .collect::<Result<Vec<_>, _>>()?;
     let mut base = m.overrides.clone();
     if o.initial_from_trace {
         base.extend(initial_overrides(trace));
     }
+    let doc = document(m, text, &base)?;
+    let params = specs
+        .iter()
+        .map(|s| Parameter::resolve(s, &doc).map_err(|e| JobError::option("fit", s.to_string(), "a number in the model", e)))
+        .collect::<Result<Vec<_>, _>>()?;
     let opts = SensitivityOptions {
         rtol: o.rtol,
         atol: o.atol,
