@@ -190,6 +190,7 @@ pub struct Prepared<'a> {
 /// Check the options and map the trace onto the model: every invalid input fails here.
 pub fn prepare<'a>(m: &Model, text: &'a str, trace: &'a Trace, o: &CalibrateOptions) -> Result<Prepared<'a>, JobError> {
     let (specs, windows) = o.check()?;
+    problem::check_names(m, trace)?;
     let mut base = m.overrides.clone();
     if o.initial_from_trace {
         base.extend(initial_overrides(trace));

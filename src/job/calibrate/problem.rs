@@ -76,6 +76,46 @@ fn output_rows(trace: &Trace, segs: &[Segment]) -> Result<Vec<usize>, String> {
         .collect()
 }
 
+/// The node of every measured column (an unknown node or boundary is invalid input, naming the
+/// column and what the model has).
+pub fn check_names(m: &Model, trace: &Trace) -> Result<Vec<usize>, JobError> {
+    let label = m.label();
+    let net = m
+        .gearbox
+        .thermal
+        .as_ref()
+        .ok_or_else(|| invalid(&label, "the model has no [thermal] section: nothing to calibrate".into()))?;
+        let names: Vec<&str> = net.nodes.iter().map(|n| n.name.as_str()).collect();
+        let channels = trace
+            .measured
+            .iter()
+            .map(|c| {
+                names.iter().position(|n| *n == c.name).ok_or_else(|| {
+                    JobError::invalid(format!(
+                        "{}: column {}: {label} has no capacity node \"{}\" (nodes: {})",
+                        trace.source,
+                        c.column,
+                        c.name,
+                        names.join(", ")
+                    ))
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let bnames: Vec<&str> = net.boundaries.iter().map(|b| b.name.as_str()).collect();
+        for c in &trace.boundaries {
+            if !bnames.contains(&c.name.as_str()) {
+                return Err(JobError::invalid(format!(
+                    "{}: column {}: {label} has no boundary \"{}\" (boundaries: {})",
+                    trace.source,
+                    c.column,
+                    c.name,
+                    bnames.join(", ")
+                )));
+            }
+        }
+    Ok(channels)
+}
+
 /// The initial temperatures the trace sets: every measured node at its first value, the
 /// network's default at their mean.
 pub fn initial_overrides(trace: &Trace) -> Vec<Override> {
@@ -111,39 +151,7 @@ impl<'a> Problem<'a> {
         opts: SensitivityOptions,
     ) -> Result<Problem<'a>, JobError> {
         let label = m.label();
-        let net = m
-            .gearbox
-            .thermal
-            .as_ref()
-            .ok_or_else(|| invalid(&label, "the model has no [thermal] section: nothing to calibrate".into()))?;
-        let names: Vec<&str> = net.nodes.iter().map(|n| n.name.as_str()).collect();
-        let channels = trace
-            .measured
-            .iter()
-            .map(|c| {
-                names.iter().position(|n| *n == c.name).ok_or_else(|| {
-                    JobError::invalid(format!(
-                        "{}: column {}: {label} has no capacity node \"{}\" (nodes: {})",
-                        trace.source,
-                        c.column,
-                        c.name,
-                        names.join(", ")
-                    ))
-                })
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let bnames: Vec<&str> = net.boundaries.iter().map(|b| b.name.as_str()).collect();
-        for c in &trace.boundaries {
-            if !bnames.contains(&c.name.as_str()) {
-                return Err(JobError::invalid(format!(
-                    "{}: column {}: {label} has no boundary \"{}\" (boundaries: {})",
-                    trace.source,
-                    c.column,
-                    c.name,
-                    bnames.join(", ")
-                )));
-            }
-        }
+        let channels = check_names(m, trace)?;
         let (_, segs) = segments(&m.gearbox, &trace.cycle).map_err(|e| invalid(&label, e.to_string()))?;
         let rows = output_rows(trace, &segs).map_err(|e| invalid(&trace.source, e))?;
         let needs = Needs {
