@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use clap::{Parser, Subcommand};
 
 mod bench;
+mod calibrate;
 mod check;
 mod output;
 mod report;
@@ -59,6 +60,9 @@ pub enum Command {
     Validate(validate::ValidateArgs),
     /// PNG plots and report.md from an existing output directory (a run, a map or a bench).
     Report(report::ReportArgs),
+    /// Fit model parameters (key paths with bounds) to a measured temperature trace: values with
+    /// 95 % intervals, correlations, errors on fitted and held-out rows, calibrated.toml.
+    Calibrate(calibrate::CalibrateArgs),
 }
 
 /// The model file and `--set PATH=VALUE` overrides, shared by every command that reads a model.
@@ -97,5 +101,6 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         Command::Bench(a) => bench::bench(&a),
         Command::Validate(a) => validate::validate(&a),
         Command::Report(a) => report::report(&a),
+        Command::Calibrate(a) => calibrate::calibrate(&a),
     }
 }

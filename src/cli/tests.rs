@@ -140,3 +140,30 @@ fn validate_options_round_trip() {
     };
     assert_eq!(a.options(), o, "{l}");
 }
+
+#[test]
+fn calibrate_options_round_trip() {
+    use geartherm::job::CalibrateOptions;
+    let all = [
+        CalibrateOptions {
+            trace: "traces/rig 1.csv".into(),
+            ..CalibrateOptions::default()
+        },
+        CalibrateOptions {
+            trace: "t.csv".into(),
+            fit: vec!["thermal.links[\"oil-housing\"].h_w_per_m2k=50:2000".into(), "thermal.nodes[\"oil\"].mass_kg".into()],
+            holdout: vec!["0:600".into(), "3000:3600".into()],
+            rtol: 1.25e-7,
+            atol: 3e-9,
+            max_steps: 1234,
+            max_iterations: 7,
+            initial_from_trace: false,
+        },
+    ];
+    for o in all {
+        let l = line(&o);
+        let Command::Calibrate(a) = parse(&l) else { panic!("{l}") };
+        check_source(&a.source);
+        assert_eq!(a.options(), o, "{l}");
+    }
+}

@@ -451,7 +451,7 @@ fn assemble(
         fit: FitStats {
             evaluations: res.evaluations,
             iterations: res.iterations,
-            stop: format!("{:?}", res.stop).to_lowercase(),
+            stop: serde_json::to_value(res.stop).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default(),
             sigma_k: lin.sigma2.sqrt(),
             dof: lin.dof,
             t975: t,
@@ -494,3 +494,23 @@ fn check_finite(s: &CalibrationSummary) -> Result<(), JobError> {
 
 /// The limits a calibration's options are checked against.
 pub const LIMITS: [Limit; 4] = [limits::RTOL, limits::ATOL, limits::MAX_STEPS, MAX_ITERATIONS];
+
+impl super::command::ToArgs for CalibrateOptions {
+    const COMMAND: &'static str = "calibrate";
+    fn to_args(&self) -> Vec<String> {
+        let mut a = vec!["--trace".to_string(), self.trace.clone()];
+        for f in &self.fit {
+            a.extend(["--fit".to_string(), f.clone()]);
+        }
+        for h in &self.holdout {
+            a.extend(["--holdout".to_string(), h.clone()]);
+        }
+        a.extend(["--rtol".into(), format!("{}", self.rtol), "--atol".into(), format!("{}", self.atol)]);
+        a.extend(["--max-steps".into(), self.max_steps.to_string()]);
+        a.extend(["--max-iterations".into(), self.max_iterations.to_string()]);
+        if !self.initial_from_trace {
+            a.push("--keep-initial".into());
+        }
+        a
+    }
+}

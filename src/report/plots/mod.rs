@@ -17,6 +17,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use tempfile::NamedTempFile;
 
+pub mod calibration;
 pub mod data;
 pub mod efficiency;
 pub mod energy;
