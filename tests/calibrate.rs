@@ -186,3 +186,43 @@ fn a_parameter_the_trace_does_not_influence_is_warned_about() {
     assert!(r.summary.parameters[1].ci95_low.is_none());
     assert!(r.summary.parameters[0].ci95_low.is_some());
 }
+
+#[test]
+fn loss_multipliers_scale_their_items() {
+    use geartherm::scene::{Inputs, Scene};
+    let (text, base) = model();
+    let ovs: Vec<geartherm::model::Override> = ["losses.multiplier.churning = 2.0", "losses.multiplier.\"bearing:input_a\" = 0.5"]
+        .iter()
+        .map(|s| s.parse().unwrap())
+        .collect();
+    let scaled = Model::from_text(&text, Path::new(MODEL), &ovs).unwrap();
+    let inputs = Inputs { state: 0, input_speed: 300.0, input_torque: 150.0, vehicle_speed: 0.0 };
+    let q = |m: &Model| {
+        let s = Scene::compile(&m.gearbox).unwrap();
+        let mut w = s.work(inputs);
+        let y = s.initial_state(Some(330.0));
+        s.evaluate_losses(&y, &mut w);
+        (s.losses.items.clone(), w.q)
+    };
+    let (items, q0) = q(&base);
+    let (_, q1) = q(&scaled);
+    for ((it, a), b) in items.iter().zip(&q0).zip(&q1) {
+        let f = match (it.source.as_str(), it.name.as_str()) {
+            ("churning", _) => 2.0,
+            ("bearing", "input_a") => 0.5,
+            _ => 1.0,
+        };
+        assert!(*a > 0.0 && (b - f * a).abs() <= 1e-12 * a.abs(), "{}:{} {a} {b}", it.source.as_str(), it.name);
+    }
+    let bad = |o: &str| {
+        let ov: geartherm::model::Override = o.parse().unwrap();
+        match Model::from_text(&text, Path::new(MODEL), &[ov]) {
+            Err(e) => e.to_string(),
+            Ok(m) => Scene::compile(&m.gearbox).unwrap_err().to_string(),
+        }
+    };
+    assert!(bad("losses.multiplier.foo = 1.0").contains("must name a source"));
+    assert!(bad("losses.multiplier.churning = 0.0").contains("(0, 100]"));
+    let e = bad("losses.multiplier.\"churning:nope\" = 1.0");
+    assert!(e.contains("no churning item named nope") && e.contains("wheel"), "{e}");
+}

@@ -39,6 +39,9 @@ pub struct LossModels {
     pub pocketing: Option<PocketingOptions>,
     /// Sliding.
     pub sliding: SlidingChoice,
+    /// Loss multipliers `[losses] multiplier`: (source, None) for a source, (source, Some(item))
+    /// for one item; each multiplies the item's loss (default 1).
+    pub multipliers: Vec<(crate::model::source::Source, Option<String>, f64)>,
 }
 
 /// A rotating member (shaft, carrier, drum).

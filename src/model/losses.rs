@@ -3,6 +3,7 @@
 use super::gearbox::{LossModels, PocketingOptions, SlidingChoice};
 use super::problems::Problems;
 use super::schema::LossesSpec;
+use super::source::Source;
 use crate::physics::losses::churning::{
     changenet::ChangenetParams, seetharaman::CavityTerm, ChurningConfig, ChurningModel,
 };
@@ -251,6 +252,7 @@ pub fn validate_losses(
         Some("off") => SlidingChoice::Off,
         _ => SlidingChoice::Detailed(opts),
     };
+    let multipliers = multipliers(l, problems);
     if problems.len() > start {
         return None;
     }
@@ -258,5 +260,32 @@ pub fn validate_losses(
         churning,
         pocketing,
         sliding,
+        multipliers,
     })
+}
+
+/// Largest loss multiplier.
+pub const MAX_MULTIPLIER: f64 = 100.0;
+
+/// `[losses] multiplier = { SOURCE = m, "SOURCE:ITEM" = m }`: each m in (0, 100]; the item
+/// names are checked when the scene is compiled (they depend on what reaches the oil).
+fn multipliers(l: &LossesSpec, problems: &mut Problems) -> Vec<(Source, Option<String>, f64)> {
+    let mut out = Vec::new();
+    for (key, &m) in l.multiplier.iter().flatten() {
+        let path = format!("losses.multiplier.\"{key}\"");
+        let (src, item) = match key.split_once(':') {
+            Some((s, i)) => (s, Some(i.to_string())),
+            None => (key.as_str(), None),
+        };
+        let Some(source) = Source::parse(src) else {
+            problems.push(path, key, format!("must name a source ({}) or SOURCE:ITEM", Source::names()));
+            continue;
+        };
+        if !(m.is_finite() && m > 0.0 && m <= MAX_MULTIPLIER) {
+            problems.push(path, m, format!("must lie in (0, {MAX_MULTIPLIER}]"));
+            continue;
+        }
+        out.push((source, item, m));
+    }
+    out
 }

@@ -320,6 +320,9 @@ pub struct LossesSpec {
     /// Changenet–Velex high-Re law [factor, exp(h/D), exp(V0/D³), exp(Fr), exp(b/D)] \[recalled\].
     #[serde(default)]
     pub changenet_high: Option<[f64; 5]>,
+    /// Loss multipliers: a source (`churning = 1.3`) or one item (`"bearing:hss_a" = 0.8`).
+    #[serde(default)]
+    pub multiplier: Option<std::collections::BTreeMap<String, f64>>,
 }
 
 /// The whole model file.

@@ -197,6 +197,8 @@ pub struct LossScene {
     auto: super::automatic::AutoLosses,
     /// Bearings and seals.
     elements: super::element_losses::ElementLosses,
+    /// Multiplier of each item (`[losses] multiplier`), when any differs from 1.
+    factor: Option<Vec<f64>>,
 }
 
 /// A loss model could not be built for a part of the model.
@@ -547,7 +549,9 @@ impl LossScene {
             &mut items,
             &mut skipped,
         );
+        let factor = multipliers(&models.multipliers, &items)?;
         Ok(LossScene {
+            factor,
             items,
             skipped,
             churn,
@@ -575,6 +579,11 @@ impl LossScene {
     /// Evaluate every loss item (W) at `op` into `out` (length [`Self::len`]), everything in
     /// full. No allocation.
     pub fn evaluate(&self, op: &OperatingPoint, out: &mut [f64]) {
+        self.evaluate_unscaled(op, out);
+        self.scale(out);
+    }
+
+    fn evaluate_unscaled(&self, op: &OperatingPoint, out: &mut [f64]) {
         self.evaluate_load_independent(op, None, out);
         let none = super::automatic::AutoSample::default();
         self.auto
@@ -661,6 +670,18 @@ impl LossScene {
         if terms.key != Some((op.state, op.input_speed.to_bits(), op.input_torque.to_bits())) {
             return self.evaluate(op, out);
         }
+        self.evaluate_cached_unscaled(op, terms, out);
+        self.scale(out);
+    }
+
+    /// Apply the items' multipliers.
+    fn scale(&self, out: &mut [f64]) {
+        if let Some(f) = &self.factor {
+            out.iter_mut().zip(f).for_each(|(q, m)| *q *= m);
+        }
+    }
+
+    fn evaluate_cached_unscaled(&self, op: &OperatingPoint, terms: &SampleTerms, out: &mut [f64]) {
         self.evaluate_load_independent(op, Some(&terms.churn), out);
         self.auto.evaluate(
             op.state,
@@ -892,4 +913,36 @@ mod tests {
         // level at the bottom quarter: cos t < −0.5 → t ∈ (2π/3, 4π/3): 1/3 of the circle.
         assert!((wet_fraction(0.0, 1.0, -0.5) - 1.0 / 3.0).abs() < 1e-12);
     }
+}
+
+/// Each item's multiplier from `[losses] multiplier` (source, then item), or None when none is
+/// given; an item name that matches no item is an error naming the items of that source.
+fn multipliers(
+    given: &[(crate::model::source::Source, Option<String>, f64)],
+    items: &[LossItem],
+) -> Result<Option<Vec<f64>>, SceneError> {
+    if given.is_empty() {
+        return Ok(None);
+    }
+    let mut f = vec![1.0; items.len()];
+    for (source, item, m) in given.iter().filter(|g| g.1.is_none()) {
+        debug_assert!(item.is_none());
+        f.iter_mut().zip(items).filter(|(_, it)| it.source == *source).for_each(|(x, _)| *x *= m);
+    }
+    for (source, item, m) in given {
+        let Some(name) = item else { continue };
+        let k = items
+            .iter()
+            .position(|it| it.source == *source && it.name == *name)
+            .ok_or_else(|| SceneError {
+                what: format!("losses.multiplier.\"{}:{name}\"", source.as_str()),
+                why: format!(
+                    "no {} item named {name} (items: {})",
+                    source.as_str(),
+                    items.iter().filter(|it| it.source == *source).map(|it| it.name.as_str()).collect::<Vec<_>>().join(", ")
+                ),
+            })?;
+        f[k] *= m;
+    }
+    Ok(Some(f))
 }
