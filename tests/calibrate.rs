@@ -110,6 +110,7 @@ fn calibrated_model_reproduces_the_fit_under_run() {
     let o = CalibrateOptions {
         fit: vec![H.into(), M.into()],
         holdout: vec!["2400:3600".into()],
+        rtol: 1e-7,
         ..CalibrateOptions::default()
     };
     let r = calibrate::calibrate(&m, &text, &trace, &o).unwrap();

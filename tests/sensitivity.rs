@@ -14,10 +14,11 @@ use geartherm::job::calibrate::{self, CalibrateOptions, Trace};
 use geartherm::job::Model;
 use geartherm::solve::sensitivity::{integrate_fixed, integrate_sensitivities, Direction, SensitivityOptions};
 
-const MODELS: [&str; 4] = [
+const MODELS: [&str; 5] = [
     "models/at6_lepelletier.toml",
     "models/fzg_c.toml",
     "models/helical_stage.toml",
+    "models/mm82_wind_gearbox.toml",
     "models/pt6_spur_pair.toml",
 ];
 

@@ -19,12 +19,13 @@
 //! ```
 //!
 //! where df_i is the derivative of f at stage i along (dY_i, e_j), dY_i = S + Σ a_ij dK_j, and
-//! dJ·K_i the derivative of the Jacobian–vector product J·K_i along (S, e_j): the second
+//! dJ·K_i the derivative of J along (S, e_j) applied to K_i: the second
 //! derivatives that make S the exact derivative of the discrete solution (without dJ·K_i the
 //! sensitivities would follow a method of lower order). Each of these directional derivatives is
 //! a central difference along the combined direction (state δ·S, parameter ±δ): the right-hand
 //! side of the scene compiled at θ_j + δ_j evaluated at y + δ_j·S against the scene at θ_j − δ_j
-//! at y − δ_j·S. A parameter that enters f linearly (a conductance, a loss multiplier) is
+//! at y − δ_j·S (for dJ, the two scenes' Jacobians at those states). A parameter that enters f
+//! linearly (a conductance, a loss multiplier) is
 //! differenced exactly up to rounding; one that enters smoothly (a capacity through 1/C) with an
 //! error O(δ²). The linear systems reuse the nominal step's LU of W.
 //!
@@ -99,7 +100,6 @@ struct Eval<'s> {
     work: Work,
     y: Vec<f64>,
     dy: Vec<f64>,
-    v: Vec<f64>,
 }
 
 impl<'s> Eval<'s> {
@@ -110,7 +110,6 @@ impl<'s> Eval<'s> {
             work: scene.work(seg.inputs),
             y: vec![0.0; ns],
             dy: vec![0.0; ns],
-            v: vec![0.0; ns],
         }
     }
 
@@ -124,12 +123,6 @@ impl<'s> Eval<'s> {
     /// f at (t, state) into `self.dy` (node rows used).
     fn rhs(&mut self, t: f64) {
         self.scene.rhs(t, &self.y, &mut self.work, &mut self.dy);
-    }
-
-    /// J(t, state)·v (node part of `v` given) into `self.dy`.
-    fn jvp(&mut self, t: f64, v: &[f64]) {
-        self.v[..v.len()].copy_from_slice(v);
-        self.scene.jvp(t, &self.y, &self.v, &mut self.work, &mut self.dy);
     }
 
     /// ∂f/∂t at (t, state) into `self.dy`.
@@ -151,16 +144,23 @@ impl NodeJacobian {
         NodeJacobian { pattern, vals }
     }
 
-    /// W = I − γh·J at the evaluator's state (its right-hand side just evaluated there).
-    fn iteration_matrix(&mut self, e: &mut Eval<'_>, t: f64, gamma_h: f64, n: usize) -> DMatrix<f64> {
+    /// The node block of J at the evaluator's state (its right-hand side just evaluated there,
+    /// so that the oil column starts from that heat balance).
+    fn matrix(&mut self, e: &mut Eval<'_>, t: f64, n: usize) -> DMatrix<f64> {
         e.scene.jacobian_values(t, &e.y, &mut e.work, &mut self.vals);
-        let mut w = DMatrix::<f64>::identity(n, n);
+        let mut j = DMatrix::<f64>::zeros(n, n);
         for (&(r, c), v) in self.pattern.iter().zip(&self.vals) {
             if r < n && c < n {
-                w[(r, c)] -= gamma_h * v;
+                j[(r, c)] += v;
             }
         }
-        w
+        j
+    }
+
+    /// W = I − γh·J at the evaluator's state.
+    fn iteration_matrix(&mut self, e: &mut Eval<'_>, t: f64, gamma_h: f64, n: usize) -> DMatrix<f64> {
+        let j = self.matrix(e, t, n);
+        DMatrix::<f64>::identity(n, n) - j * gamma_h
     }
 }
 
@@ -180,6 +180,9 @@ struct Tangent<'s> {
     minus: Vec<Eval<'s>>,
     delta: Vec<f64>,
     jac: NodeJacobian,
+    /// Jacobian patterns of the scenes at θ ± δ.
+    jac_plus: Vec<NodeJacobian>,
+    jac_minus: Vec<NodeJacobian>,
     n: usize,
     /// Node temperatures, K.
     y: DVector<f64>,
@@ -212,6 +215,8 @@ impl<'s> Tangent<'s> {
             minus: dirs.iter().map(|d| Eval::new(d.minus, seg)).collect(),
             delta: dirs.iter().map(|d| d.delta).collect(),
             jac: NodeJacobian::new(scene),
+            jac_plus: dirs.iter().map(|d| NodeJacobian::new(d.plus)).collect(),
+            jac_minus: dirs.iter().map(|d| NodeJacobian::new(d.minus)).collect(),
             n,
             y: DVector::from_vec(y0),
             s,
@@ -300,13 +305,12 @@ impl<'s> Tangent<'s> {
         DVector::from_fn(n, |i, _| (p.dy[i] - m.dy[i]) / (2.0 * dl))
     }
 
-    /// Central difference of J·v at the states `dir_rhs` left (along (S, e_j)).
-    fn dir_jvp(&mut self, j: usize, t: f64, v: &DVector<f64>) -> DVector<f64> {
+    /// Central difference of J along (S, e_j) at the states `dir_rhs` left: (J⁺ − J⁻) / 2δ.
+    fn dir_jacobian(&mut self, j: usize, t: f64) -> DMatrix<f64> {
         let (n, dl) = (self.n, self.delta[j]);
-        let (p, m) = (&mut self.plus[j], &mut self.minus[j]);
-        p.jvp(t, v.as_slice());
-        m.jvp(t, v.as_slice());
-        DVector::from_fn(n, |i, _| (p.dy[i] - m.dy[i]) / (2.0 * dl))
+        let jp = self.jac_plus[j].matrix(&mut self.plus[j], t, n);
+        let jm = self.jac_minus[j].matrix(&mut self.minus[j], t, n);
+        (jp - jm) / (2.0 * dl)
     }
 
     /// Central difference of ∂f/∂t at the states `dir_rhs` left.
@@ -327,7 +331,8 @@ impl<'s> Tangent<'s> {
         let (y, sj) = (self.y.clone(), self.s.column(j).into_owned());
         // Stage 1 point and the derivative of J·K_i there (W is J at the step's start).
         let df1 = self.dir_rhs(j, t, &y, &sj);
-        let djk: Vec<DVector<f64>> = st.k.iter().map(|k| self.dir_jvp(j, t, k)).collect();
+        let dj = self.dir_jacobian(j, t);
+        let djk: Vec<DVector<f64>> = st.k.iter().map(|k| &dj * k).collect();
         let dft = if st.ft_on {
             self.dir_time_derivative(j, t)
         } else {

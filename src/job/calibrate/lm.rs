@@ -5,8 +5,8 @@
 //! follows Nielsen's rule (Madsen, Nielsen & Tingleff, Methods for Non-Linear Least Squares
 //! Problems, 2004, §3.2): on a gain ratio ρ > 0 the step is taken and μ ← μ·max(1/3, 1 − (2ρ − 1)³),
 //! ν ← 2; else μ ← μ·ν, ν ← 2ν. Stops when the step is below `x_tol`·(‖θ‖ + x_tol), the
-//! relative decrease of the cost below `f_tol`, the scaled gradient below `g_tol`, or after
-//! `max_iterations` evaluations with the Jacobian.
+//! actual and the predicted relative decrease of the cost below `f_tol` (Moré's MINPACK test),
+//! the scaled gradient below `g_tol`, or after `max_iterations` evaluations with the Jacobian.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -134,7 +134,9 @@ pub fn minimise<E>(
             iterations += 1;
             mu = Some(m * (1.0_f64 / 3.0).max(1.0 - (2.0 * rho - 1.0).powi(3)));
             nu = 2.0;
-            if (c0 - c1) <= o.f_tol * c0 {
+            // Both the actual and the predicted decrease negligible (MINPACK's ftol test): a
+            // heavily damped step that gains little is not convergence.
+            if (c0 - c1) <= o.f_tol * c0 && predicted <= o.f_tol * c0 && rho <= 2.0 {
                 return Ok(LmResult { theta, at, evaluations, iterations, stop: Stop::Cost });
             }
         } else {

@@ -38,8 +38,9 @@ use params::{FitSpec, Parameter};
 use problem::{initial_overrides, Problem};
 pub use trace::Trace;
 
-/// Default relative tolerance of a calibration's integrations.
-pub const DEFAULT_RTOL: f64 = 1e-5;
+/// Default relative tolerance of a calibration's integrations (that of `run`: the fit and its
+/// sensitivities are those of the discrete solution `run` computes).
+pub const DEFAULT_RTOL: f64 = crate::solve::transient::DEFAULT_RTOL;
 /// Default most evaluations with sensitivities.
 pub const DEFAULT_MAX_ITERATIONS: usize = 30;
 /// A parameter that moves no fitted temperature by more than this per unit of its coordinate

@@ -4,8 +4,11 @@
 
 use std::path::PathBuf;
 
+use crate::model::overrides;
+use crate::model::parse::{parse_document, parse_table};
 use crate::model::thermal::BoundaryTemp;
-use crate::model::{self, Gearbox, Override};
+use crate::model::validate::validate;
+use crate::model::{self, Gearbox, Override, Problems};
 use crate::physics::oil::KELVIN_OFFSET;
 use crate::scene::{Needs, Scene};
 use crate::solve::drive::segments;
@@ -41,6 +44,8 @@ pub struct Problem<'a> {
     pub rows: Vec<usize>,
     /// Integration options.
     pub opts: SensitivityOptions,
+    /// The model document with the base overrides applied, parsed once.
+    doc: toml::Table,
 }
 
 /// Simulated temperatures at every trace row (°C, `[row][channel]`) and, with sensitivities,
@@ -56,6 +61,16 @@ pub struct Simulation {
 
 fn invalid(label: &str, what: String) -> JobError {
     JobError::invalid(format!("{label}: {what}"))
+}
+
+/// The model text parsed, with `base` applied.
+fn base_document(text: &str, base: &[Override]) -> Result<toml::Table, String> {
+    let mut problems = Problems::default();
+    let mut doc = parse_document(text, &mut problems).ok_or("the model text does not parse")?;
+    for ov in base {
+        overrides::apply(&mut doc, ov)?;
+    }
+    Ok(doc)
 }
 
 /// Position of every trace row among the output times (the segment boundaries).
@@ -159,7 +174,9 @@ impl<'a> Problem<'a> {
             evaluate_all: false,
             energy_per_source_only: true,
         };
+        let doc = base_document(text, &base).map_err(|e| invalid(&label, e))?;
         Ok(Problem {
+            doc,
             text,
             file: m.file.clone(),
             base,
@@ -180,9 +197,23 @@ impl<'a> Problem<'a> {
         ovs
     }
 
-    /// The checked gearbox at θ with the trace's boundary temperatures.
+    /// The checked gearbox at θ with the trace's boundary temperatures: the parameters written
+    /// into the parsed document; a model they make invalid is checked again from the text, for
+    /// the messages that name the overrides.
     pub fn gearbox_at(&self, theta: &[f64]) -> Result<Gearbox, JobError> {
-        let mut gb = model::from_str_with(self.text, &self.file, &self.overrides_at(theta))?;
+        let mut doc = self.doc.clone();
+        let mut problems = Problems::default();
+        for (p, &t) in self.params.iter().zip(theta) {
+            if let Err(e) = overrides::apply(&mut doc, &p.override_at(p.value(t))) {
+                problems.push(p.name(), t, e);
+            }
+        }
+        let parsed = problems.is_empty().then(|| parse_table(doc, &mut problems)).flatten();
+        let checked = parsed.and_then(|f| validate(&f, &mut problems)).filter(|_| problems.is_empty());
+        let mut gb = match checked {
+            Some(gb) => gb,
+            None => model::from_str_with(self.text, &self.file, &self.overrides_at(theta))?,
+        };
         if let Some(net) = gb.thermal.as_mut() {
             for c in &self.trace.boundaries {
                 if let Some(b) = net.boundaries.iter_mut().find(|b| b.name == c.name) {
