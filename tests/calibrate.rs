@@ -54,10 +54,11 @@ fn model() -> (String, Model) {
 
 /// The oil and housing temperatures geartherm computes with h and mass at `truth`, every node
 /// starting at 30 °C.
-fn synthetic(text: &str, m: &Model, truth: [f64; 2]) -> Vec<Vec<f64>> {
+fn synthetic(text: &str, m: &Model, truth: [f64; 2], rtol: f64) -> Vec<Vec<f64>> {
     let trace = Trace::parse(&trace_text(None), "truth").unwrap();
     let o = CalibrateOptions {
         fit: vec![H.into(), M.into()],
+        rtol,
         ..CalibrateOptions::default()
     };
     let p = calibrate::prepare(m, text, &trace, &o).unwrap();
@@ -69,7 +70,7 @@ fn synthetic(text: &str, m: &Model, truth: [f64; 2]) -> Vec<Vec<f64>> {
 fn recovers_known_parameters_within_their_intervals() {
     let (text, m) = model();
     let truth = [400.0, 11.0];
-    let exact = synthetic(&text, &m, truth);
+    let exact = synthetic(&text, &m, truth, 1e-4);
     let sigma = 0.3;
     let m30 = Model::from_text(&text, Path::new(MODEL), &["thermal.initial_temp_c = 30.0".parse().unwrap()]).unwrap();
     let (mut covered, mut fits) = ([0usize; 2], 0);
@@ -105,7 +106,7 @@ fn recovers_known_parameters_within_their_intervals() {
 #[test]
 fn calibrated_model_reproduces_the_fit_under_run() {
     let (text, m) = model();
-    let exact = synthetic(&text, &m, [400.0, 11.0]);
+    let exact = synthetic(&text, &m, [400.0, 11.0], 1e-7);
     let trace = Trace::parse(&trace_text(Some(&exact)), "synthetic").unwrap();
     let o = CalibrateOptions {
         fit: vec![H.into(), M.into()],
@@ -175,7 +176,7 @@ fn bad_input_is_refused_naming_what() {
 #[test]
 fn a_parameter_the_trace_does_not_influence_is_warned_about() {
     let (text, m) = model();
-    let exact = synthetic(&text, &m, [400.0, 11.0]);
+    let exact = synthetic(&text, &m, [400.0, 11.0], 1e-4);
     let trace = Trace::parse(&trace_text(Some(&exact)), "synthetic").unwrap();
     let o = CalibrateOptions {
         fit: vec![H.into(), "losses.seetharaman_transition_reynolds=1e4:1e6".into()],
