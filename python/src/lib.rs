@@ -248,6 +248,29 @@ impl Model {
         Ok((to_json(&r.summary)?, r.timeseries_csv))
     }
 
+    // --- calibrate -----------------------------------------------------------------------
+    /// Calibrate against a trace given as CSV text (`trace_name` names it in messages; a
+    /// mapping of `job::CalibrateOptions` in): (`calibration.json`, `fit.csv`,
+    /// `calibrated.toml`, `cycle.csv`) texts.
+    fn calibrate(
+        &self,
+        py: Python<'_>,
+        trace_csv: &str,
+        trace_name: &str,
+        options: &Bound<'_, PyAny>,
+    ) -> PyResult<(String, String, String, String)> {
+        let mut o: job::CalibrateOptions = self::options("calibrate", options)?;
+        o.trace = trace_name.to_string();
+        let trace = job::calibrate::Trace::parse(trace_csv, trace_name)
+            .map_err(|e| job_error(JobError::invalid(e.to_string())))?;
+        let (m, text) = (self.m.clone(), self.state.text.clone());
+        let r = py
+            .detach(|| job::calibrate::calibrate(&m, &text, &trace, &o))
+            .map_err(job_error)?;
+        Ok((to_json(&r.summary)?, r.fit_csv, r.calibrated_model, r.cycle_csv))
+    }
+    // --- end calibrate -------------------------------------------------------------------
+
     /// Pickle support: rebuilt from its state (text, file name, overrides) as JSON.
     fn __reduce__(slf: &Bound<'_, Self>) -> PyResult<(Py<PyAny>, (String,))> {
         let restore = slf.get_type().getattr("_from_state")?.unbind();
