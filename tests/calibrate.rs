@@ -32,7 +32,8 @@ impl Normal {
 /// Rig trace text: speed and torque steps over an hour every 60 s, the ambient at 20 °C, the
 /// oil and the housing "measured" with `values` (°C per row and channel; 30 °C when None).
 fn trace_text(values: Option<&[Vec<f64>]>) -> String {
-    let mut s = String::from("time_s,input_speed_rpm,input_torque_nm,gear,boundary:ambient,node:oil,node:housing\n");
+    let mut s =
+        String::from("time_s,input_speed_rpm,input_torque_nm,gear,boundary:ambient,node:oil,node:housing\n");
     for k in 0..61 {
         let (w, t) = match k / 15 {
             0 => (3000.0, 200.0),
@@ -72,7 +73,12 @@ fn recovers_known_parameters_within_their_intervals() {
     let truth = [400.0, 11.0];
     let exact = synthetic(&text, &m, truth, 1e-4);
     let sigma = 0.3;
-    let m30 = Model::from_text(&text, Path::new(MODEL), &["thermal.initial_temp_c = 30.0".parse().unwrap()]).unwrap();
+    let m30 = Model::from_text(
+        &text,
+        Path::new(MODEL),
+        &["thermal.initial_temp_c = 30.0".parse().unwrap()],
+    )
+    .unwrap();
     let (mut covered, mut fits) = ([0usize; 2], 0);
     for seed in 0..100u64 {
         let mut rng = Normal(seed);
@@ -97,9 +103,15 @@ fn recovers_known_parameters_within_their_intervals() {
             }
         }
         let s = r.summary.fit.sigma_k;
-        assert!((0.2..0.4).contains(&s), "seed {seed}: σ = {s} K for noise of {sigma} K");
+        assert!(
+            (0.2..0.4).contains(&s),
+            "seed {seed}: σ = {s} K for noise of {sigma} K"
+        );
     }
-    println!("coverage of the 95 % intervals over {fits} fits: h {} / mass {}", covered[0], covered[1]);
+    println!(
+        "coverage of the 95 % intervals over {fits} fits: h {} / mass {}",
+        covered[0], covered[1]
+    );
     assert!(covered.iter().all(|&c| c >= 90), "coverage {covered:?} of 100");
 }
 
@@ -116,7 +128,10 @@ fn calibrated_model_reproduces_the_fit_under_run() {
     };
     let r = calibrate::calibrate(&m, &text, &trace, &o).unwrap();
     let p = &r.summary.parameters;
-    assert!((p[0].value / 400.0 - 1.0).abs() < 1e-4 && (p[1].value / 11.0 - 1.0).abs() < 1e-4, "{p:?}");
+    assert!(
+        (p[0].value / 400.0 - 1.0).abs() < 1e-4 && (p[1].value / 11.0 - 1.0).abs() < 1e-4,
+        "{p:?}"
+    );
     let e = r.summary.channels[0].holdout.unwrap();
     assert!(e.rmse_k < 1e-3 && e.rows == 21, "{e:?}");
     // `run` on calibrated.toml with cycle.csv: the same oil temperatures.
@@ -133,8 +148,16 @@ fn calibrated_model_reproduces_the_fit_under_run() {
     let csv = run.timeseries_csv.unwrap();
     let mut lines = csv.lines();
     let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = head.iter().position(|h| *h == "temp_oil_c").expect("an oil column");
-    let fit: Vec<Vec<&str>> = r.fit_csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    let col = head
+        .iter()
+        .position(|h| *h == "temp_oil_c")
+        .expect("an oil column");
+    let fit: Vec<Vec<&str>> = r
+        .fit_csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
     for (row, l) in lines.enumerate() {
         let v: f64 = l.split(',').nth(col).unwrap().parse().unwrap();
         let sim: f64 = fit[row][3].parse().unwrap();
@@ -162,14 +185,20 @@ fn refusal(trace: &str, fit: &[&str]) -> String {
 fn bad_input_is_refused_naming_what() {
     let ok = trace_text(None);
     let e = refusal(&ok.replace("node:housing", "node:case"), &[H]);
-    assert!(e.contains("node:case") && e.contains("no capacity node \"case\"") && e.contains("housing"), "{e}");
+    assert!(
+        e.contains("node:case") && e.contains("no capacity node \"case\"") && e.contains("housing"),
+        "{e}"
+    );
     let e = refusal(&ok.replace("boundary:ambient", "boundary:water"), &[H]);
     assert!(e.contains("boundary:water") && e.contains("no boundary"), "{e}");
     let e = refusal(&ok, &["thermal.links[\"nope\"].h_w_per_m2k"]);
     assert!(e.contains("nope"), "{e}");
     let e = refusal(&ok, &[H, H]);
     assert!(e.contains("twice"), "{e}");
-    let e = refusal(&ok.replace("120,3000,200,1,20,30,30", "120,3000,200,1,20,NaN,30"), &[H]);
+    let e = refusal(
+        &ok.replace("120,3000,200,1,20,30,30", "120,3000,200,1,20,NaN,30"),
+        &[H],
+    );
     assert!(e.contains("line 4") && e.contains("node:oil"), "{e}");
 }
 
@@ -184,7 +213,10 @@ fn a_parameter_the_trace_does_not_influence_is_warned_about() {
     };
     let r = calibrate::calibrate(&m, &text, &trace, &o).unwrap();
     let w = r.summary.warnings.join("\n");
-    assert!(w.contains("seetharaman_transition_reynolds") && w.contains("does not influence"), "{w}");
+    assert!(
+        w.contains("seetharaman_transition_reynolds") && w.contains("does not influence"),
+        "{w}"
+    );
     assert!(r.summary.parameters[1].ci95_low.is_none());
     assert!(r.summary.parameters[0].ci95_low.is_some());
 }
@@ -193,12 +225,20 @@ fn a_parameter_the_trace_does_not_influence_is_warned_about() {
 fn loss_multipliers_scale_their_items() {
     use geartherm::scene::{Inputs, Scene};
     let (text, base) = model();
-    let ovs: Vec<geartherm::model::Override> = ["losses.multiplier.churning = 2.0", "losses.multiplier.\"bearing:input_a\" = 0.5"]
-        .iter()
-        .map(|s| s.parse().unwrap())
-        .collect();
+    let ovs: Vec<geartherm::model::Override> = [
+        "losses.multiplier.churning = 2.0",
+        "losses.multiplier.\"bearing:input_a\" = 0.5",
+    ]
+    .iter()
+    .map(|s| s.parse().unwrap())
+    .collect();
     let scaled = Model::from_text(&text, Path::new(MODEL), &ovs).unwrap();
-    let inputs = Inputs { state: 0, input_speed: 300.0, input_torque: 150.0, vehicle_speed: 0.0 };
+    let inputs = Inputs {
+        state: 0,
+        input_speed: 300.0,
+        input_torque: 150.0,
+        vehicle_speed: 0.0,
+    };
     let q = |m: &Model| {
         let s = Scene::compile(&m.gearbox).unwrap();
         let mut w = s.work(inputs);
@@ -214,7 +254,12 @@ fn loss_multipliers_scale_their_items() {
             ("bearing", "input_a") => 0.5,
             _ => 1.0,
         };
-        assert!(*a > 0.0 && (b - f * a).abs() <= 1e-12 * a.abs(), "{}:{} {a} {b}", it.source.as_str(), it.name);
+        assert!(
+            *a > 0.0 && (b - f * a).abs() <= 1e-12 * a.abs(),
+            "{}:{} {a} {b}",
+            it.source.as_str(),
+            it.name
+        );
     }
     let bad = |o: &str| {
         let ov: geartherm::model::Override = o.parse().unwrap();
@@ -226,5 +271,8 @@ fn loss_multipliers_scale_their_items() {
     assert!(bad("losses.multiplier.foo = 1.0").contains("must name a source"));
     assert!(bad("losses.multiplier.churning = 0.0").contains("(0, 100]"));
     let e = bad("losses.multiplier.\"churning:nope\" = 1.0");
-    assert!(e.contains("no churning item named nope") && e.contains("wheel"), "{e}");
+    assert!(
+        e.contains("no churning item named nope") && e.contains("wheel"),
+        "{e}"
+    );
 }

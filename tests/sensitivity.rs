@@ -12,7 +12,9 @@ use std::path::Path;
 
 use geartherm::job::calibrate::{self, CalibrateOptions, Trace};
 use geartherm::job::Model;
-use geartherm::solve::sensitivity::{integrate_fixed, integrate_sensitivities, Direction, SensitivityOptions};
+use geartherm::solve::sensitivity::{
+    integrate_fixed, integrate_sensitivities, Direction, SensitivityOptions,
+};
 
 const MODELS: [&str; 5] = [
     "models/at6_lepelletier.toml",
@@ -36,7 +38,11 @@ fn trace_for(m: &Model, rows: usize, dt: f64) -> String {
     }
     s.push('\n');
     for k in 0..rows {
-        let (w, t) = if k < rows / 2 { (1500.0, 80.0) } else { (2500.0, 150.0) };
+        let (w, t) = if k < rows / 2 {
+            (1500.0, 80.0)
+        } else {
+            (2500.0, 150.0)
+        };
         s.push_str(&format!("{},{w},{t},{gear}", k as f64 * dt));
         for _ in &net.nodes {
             s.push_str(",40");
@@ -59,12 +65,18 @@ fn fit_specs(text: &str) -> Vec<String> {
     let links = th["links"].as_array().unwrap();
     for key in ["h_w_per_m2k", "conductance_w_per_k"] {
         if let Some(l) = links.iter().find(|l| l.get(key).is_some()) {
-            out.push(format!("thermal.links[\"{}\"].{key}", l["name"].as_str().unwrap()));
+            out.push(format!(
+                "thermal.links[\"{}\"].{key}",
+                l["name"].as_str().unwrap()
+            ));
         }
     }
     let nodes = th["nodes"].as_array().unwrap();
     let n = nodes.iter().find(|n| n.get("mass_kg").is_some()).unwrap();
-    out.push(format!("thermal.nodes[\"{}\"].mass_kg", n["name"].as_str().unwrap()));
+    out.push(format!(
+        "thermal.nodes[\"{}\"].mass_kg",
+        n["name"].as_str().unwrap()
+    ));
     out.push("lubrication.oil_level_mm".into());
     let oil = th["oil_node"].as_str().unwrap();
     out.push(format!("thermal.nodes[\"{oil}\"].initial_temp_c"));
@@ -99,9 +111,18 @@ fn check_model(path: &str, rows: usize, dt: f64, rtol: f64, replay: bool) -> Vec
         .collect();
     let dirs: Vec<Direction<'_>> = pairs
         .iter()
-        .map(|(a, b, d)| Direction { plus: a, minus: b, delta: *d })
+        .map(|(a, b, d)| Direction {
+            plus: a,
+            minus: b,
+            delta: *d,
+        })
         .collect();
-    let opts = SensitivityOptions { rtol, atol: 1e-9, max_steps: 10_000_000, initial: None };
+    let opts = SensitivityOptions {
+        rtol,
+        atol: 1e-9,
+        max_steps: 10_000_000,
+        initial: None,
+    };
     let nominal = integrate_sensitivities(&scene, &dirs, &pr.segs, &opts).unwrap();
     let np = pr.params.len();
     let n = scene.nodes();
@@ -110,7 +131,13 @@ fn check_model(path: &str, rows: usize, dt: f64, rtol: f64, replay: bool) -> Vec
         // Replayed: twice the tangent's own difference step (a loss law with a kink, such as a
         // regime bridge, stays out of reach); adaptive: large enough that the step choices'
         // rounding-level changes stay below the difference.
-        let h = if replay { 2.0 * q.delta() } else if q.log { 1e-2 } else { 1e-1 };
+        let h = if replay {
+            2.0 * q.delta()
+        } else if q.log {
+            1e-2
+        } else {
+            1e-1
+        };
         let run = |s: f64| {
             let mut th = theta.clone();
             th[k] += s * h;

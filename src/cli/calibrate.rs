@@ -93,7 +93,11 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
     if args.json {
         emit_json(&result.summary)?;
     } else {
-        emit(&format!("{}outputs in {}\n", to_text(&result.summary), out.target().display()))?;
+        emit(&format!(
+            "{}outputs in {}\n",
+            to_text(&result.summary),
+            out.target().display()
+        ))?;
     }
     out.commit()?;
     Ok(())

@@ -151,7 +151,10 @@ fn calibrate_options_round_trip() {
         },
         CalibrateOptions {
             trace: "t.csv".into(),
-            fit: vec!["thermal.links[\"oil-housing\"].h_w_per_m2k=50:2000".into(), "thermal.nodes[\"oil\"].mass_kg".into()],
+            fit: vec![
+                "thermal.links[\"oil-housing\"].h_w_per_m2k=50:2000".into(),
+                "thermal.nodes[\"oil\"].mass_kg".into(),
+            ],
             holdout: vec!["0:600".into(), "3000:3600".into()],
             rtol: 1.25e-7,
             atol: 3e-9,
@@ -162,7 +165,9 @@ fn calibrate_options_round_trip() {
     ];
     for o in all {
         let l = line(&o);
-        let Command::Calibrate(a) = parse(&l) else { panic!("{l}") };
+        let Command::Calibrate(a) = parse(&l) else {
+            panic!("{l}")
+        };
         check_source(&a.source);
         assert_eq!(a.options(), o, "{l}");
     }

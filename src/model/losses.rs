@@ -278,7 +278,11 @@ fn multipliers(l: &LossesSpec, problems: &mut Problems) -> Vec<(Source, Option<S
             None => (key.as_str(), None),
         };
         let Some(source) = Source::parse(src) else {
-            problems.push(path, key, format!("must name a source ({}) or SOURCE:ITEM", Source::names()));
+            problems.push(
+                path,
+                key,
+                format!("must name a source ({}) or SOURCE:ITEM", Source::names()),
+            );
             continue;
         };
         if !(m.is_finite() && m > 0.0 && m <= MAX_MULTIPLIER) {

@@ -167,12 +167,24 @@ pub fn to_text(s: &CalibrationSummary) -> String {
             (Some(a), Some(b)) => format!("[{a:.5}, {b:.5}]"),
             _ => "not identifiable".into(),
         };
-        t.push_str(&format!("  {:<40} {:>10.5} {:>12.5}   {ci}\n", p.key_path, p.start, p.value));
+        t.push_str(&format!(
+            "  {:<40} {:>10.5} {:>12.5}   {ci}\n",
+            p.key_path, p.start, p.value
+        ));
     }
     t.push_str("channel               fitted rmse / max, K    held-out rmse / max, K\n");
     for c in &s.channels {
-        let e = |x: &Option<Errors>| x.map_or("—".to_string(), |e| format!("{:.3} / {:.3}", e.rmse_k, e.max_abs_k));
-        t.push_str(&format!("  {:<20} {:>22} {:>24}\n", c.node, e(&c.fitted), e(&c.holdout)));
+        let e = |x: &Option<Errors>| {
+            x.map_or("—".to_string(), |e| {
+                format!("{:.3} / {:.3}", e.rmse_k, e.max_abs_k)
+            })
+        };
+        t.push_str(&format!(
+            "  {:<20} {:>22} {:>24}\n",
+            c.node,
+            e(&c.fitted),
+            e(&c.holdout)
+        ));
     }
     t
 }

@@ -927,7 +927,10 @@ fn multipliers(
     let mut f = vec![1.0; items.len()];
     for (source, item, m) in given.iter().filter(|g| g.1.is_none()) {
         debug_assert!(item.is_none());
-        f.iter_mut().zip(items).filter(|(_, it)| it.source == *source).for_each(|(x, _)| *x *= m);
+        f.iter_mut()
+            .zip(items)
+            .filter(|(_, it)| it.source == *source)
+            .for_each(|(x, _)| *x *= m);
     }
     for (source, item, m) in given {
         let Some(name) = item else { continue };
@@ -939,7 +942,12 @@ fn multipliers(
                 why: format!(
                     "no {} item named {name} (items: {})",
                     source.as_str(),
-                    items.iter().filter(|it| it.source == *source).map(|it| it.name.as_str()).collect::<Vec<_>>().join(", ")
+                    items
+                        .iter()
+                        .filter(|it| it.source == *source)
+                        .map(|it| it.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 ),
             })?;
         f[k] *= m;

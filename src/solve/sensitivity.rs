@@ -127,7 +127,8 @@ impl<'s> Eval<'s> {
 
     /// ∂f/∂t at (t, state) into `self.dy`.
     fn time_derivative(&mut self, t: f64) {
-        self.scene.time_derivative(t, &self.y, &mut self.work, &mut self.dy);
+        self.scene
+            .time_derivative(t, &self.y, &mut self.work, &mut self.dy);
     }
 }
 
@@ -279,7 +280,14 @@ impl<'s> Tangent<'s> {
         let err = (sum / n as f64).sqrt();
         self.lu = Some(lu);
         let err = if err.is_finite() { err } else { f64::INFINITY };
-        (StepStages { k: [k1, k2, k3], h, ft_on }, err)
+        (
+            StepStages {
+                k: [k1, k2, k3],
+                h,
+                ft_on,
+            },
+            err,
+        )
     }
 
     /// Accept the step: y⁺ = y + Σ m_i K_i, and the tangent S⁺ of every parameter.
@@ -367,11 +375,7 @@ impl<'s> Tangent<'s> {
 
     fn failure(&self, t: f64, message: String) -> NumericalFailure {
         let th = &self.nominal.scene.thermal;
-        let node = self
-            .y
-            .iter()
-            .position(|v| !v.is_finite())
-            .unwrap_or(th.oil);
+        let node = self.y.iter().position(|v| !v.is_finite()).unwrap_or(th.oil);
         NumericalFailure {
             time: t,
             node: th.names[node].clone(),
@@ -421,7 +425,11 @@ fn start_step(y: &DVector<f64>, f: &DVector<f64>, opts: &SensitivityOptions, len
     }
     let k = y.len() as f64;
     let (d0, d1) = ((d0 / k).sqrt(), (d1 / k).sqrt());
-    let h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
+    let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    };
     h0.min(len).max(1e-10)
 }
 
@@ -480,7 +488,9 @@ fn integrate_segment(
         let h_try = match steps {
             Steps::Adaptive if h >= rest * (1.0 - 1e-9) => rest,
             Steps::Adaptive => h,
-            Steps::Fixed(it) => *it.next().ok_or_else(|| r.failure(t, "the replayed step sequence ended early".into()))?,
+            Steps::Fixed(it) => *it
+                .next()
+                .ok_or_else(|| r.failure(t, "the replayed step sequence ended early".into()))?,
         };
         let (st, err) = r.step(t, h_try, opts.rtol, opts.atol);
         let accept = match steps {
@@ -490,7 +500,11 @@ fn integrate_segment(
         if accept {
             r.accept(t, &st);
             out.steps.push(h_try);
-            t = if h_try >= rest * (1.0 - 1e-9) { seg.t1 } else { t + h_try };
+            t = if h_try >= rest * (1.0 - 1e-9) {
+                seg.t1
+            } else {
+                t + h_try
+            };
             h = h_try * (SAFETY * err.max(1e-10).powf(expo)).min(GROW_MAX);
             if let Some(i) = r.y.iter().position(|v| !v.is_finite()) {
                 return Err(r.failure(t, format!("node {i} is not finite")));

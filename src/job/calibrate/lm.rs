@@ -88,7 +88,13 @@ pub fn minimise<E>(
     let mut evaluations = 1;
     let mut iterations = 0;
     if !free.iter().any(|&f| f) {
-        return Ok(LmResult { theta, at, evaluations, iterations, stop: Stop::NoParameter });
+        return Ok(LmResult {
+            theta,
+            at,
+            evaluations,
+            iterations,
+            stop: Stop::NoParameter,
+        });
     }
     let cost = |e: &Evaluation| 0.5 * e.r.norm_squared();
     let mut mu: Option<f64> = None;
@@ -98,9 +104,17 @@ pub fn minimise<E>(
         let a = jf.transpose() * &jf;
         let g = jf.transpose() * &at.r;
         if gradient_small(&jf, &at.r, &g, o.g_tol) {
-            return Ok(LmResult { theta, at, evaluations, iterations, stop: Stop::Gradient });
+            return Ok(LmResult {
+                theta,
+                at,
+                evaluations,
+                iterations,
+                stop: Stop::Gradient,
+            });
         }
-        let diag: Vec<f64> = (0..p).map(|k| if free[k] { a[(k, k)].max(1e-300) } else { 1.0 }).collect();
+        let diag: Vec<f64> = (0..p)
+            .map(|k| if free[k] { a[(k, k)].max(1e-300) } else { 1.0 })
+            .collect();
         let m = *mu.get_or_insert(1e-3);
         let mut lhs = a.clone();
         for k in 0..p {
@@ -112,22 +126,44 @@ pub fn minimise<E>(
             continue;
         };
         let trial: Vec<f64> = (0..p)
-            .map(|k| if free[k] { (theta[k] + step[k]).clamp(bounds[k].0, bounds[k].1) } else { theta[k] })
+            .map(|k| {
+                if free[k] {
+                    (theta[k] + step[k]).clamp(bounds[k].0, bounds[k].1)
+                } else {
+                    theta[k]
+                }
+            })
             .collect();
         let dx = DVector::from_fn(p, |k, _| trial[k] - theta[k]);
         let norm_theta = DVector::from_column_slice(&theta).norm();
         if dx.norm() <= o.x_tol * (norm_theta + o.x_tol) {
-            return Ok(LmResult { theta, at, evaluations, iterations, stop: Stop::Step });
+            return Ok(LmResult {
+                theta,
+                at,
+                evaluations,
+                iterations,
+                stop: Stop::Step,
+            });
         }
         if evaluations >= o.max_iterations {
-            return Ok(LmResult { theta, at, evaluations, iterations, stop: Stop::Budget });
+            return Ok(LmResult {
+                theta,
+                at,
+                evaluations,
+                iterations,
+                stop: Stop::Budget,
+            });
         }
         let next = eval(&trial)?;
         evaluations += 1;
         // Gain ratio: actual over predicted decrease of the linear model.
         let predicted = -(g.dot(&dx)) - 0.5 * (&a * &dx).dot(&dx);
         let (c0, c1) = (cost(&at), cost(&next));
-        let rho = if predicted > 0.0 { (c0 - c1) / predicted } else { -1.0 };
+        let rho = if predicted > 0.0 {
+            (c0 - c1) / predicted
+        } else {
+            -1.0
+        };
         if rho > 0.0 && c1.is_finite() {
             theta = trial;
             at = next;
@@ -137,7 +173,13 @@ pub fn minimise<E>(
             // Both the actual and the predicted decrease negligible (MINPACK's ftol test): a
             // heavily damped step that gains little is not convergence.
             if (c0 - c1) <= o.f_tol * c0 && predicted <= o.f_tol * c0 && rho <= 2.0 {
-                return Ok(LmResult { theta, at, evaluations, iterations, stop: Stop::Cost });
+                return Ok(LmResult {
+                    theta,
+                    at,
+                    evaluations,
+                    iterations,
+                    stop: Stop::Cost,
+                });
             }
         } else {
             mu = Some(m * nu);
@@ -181,7 +223,11 @@ mod tests {
             let r = DVector::from_fn(t.len(), |i, _| th[0] * (-th[1] * t[i]).exp() - y[i]);
             let j = DMatrix::from_fn(t.len(), 2, |i, c| {
                 let e = (-th[1] * t[i]).exp();
-                if c == 0 { e } else { -th[0] * t[i] * e }
+                if c == 0 {
+                    e
+                } else {
+                    -th[0] * t[i] * e
+                }
             });
             Ok(Evaluation { r, j })
         };
@@ -189,7 +235,11 @@ mod tests {
             minimise(eval, th, eval(th).unwrap(), b, free, &LmOptions::default()).unwrap()
         };
         let res = fit(&[1.0, 0.1], &[(0.0, 10.0), (0.0, 5.0)], &[true, true]);
-        assert!((res.theta[0] - 3.0).abs() < 1e-7 && (res.theta[1] - 0.7).abs() < 1e-7, "{:?}", res.theta);
+        assert!(
+            (res.theta[0] - 3.0).abs() < 1e-7 && (res.theta[1] - 0.7).abs() < 1e-7,
+            "{:?}",
+            res.theta
+        );
         let res = fit(&[1.0, 0.1], &[(0.0, 2.0), (0.0, 5.0)], &[true, true]);
         assert!((res.theta[0] - 2.0).abs() < 1e-12, "{:?}", res.theta);
         let res = fit(&[1.0, 0.7], &[(0.0, 10.0), (0.0, 5.0)], &[true, false]);

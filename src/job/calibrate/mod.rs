@@ -107,7 +107,10 @@ fn window(s: &str) -> Result<(f64, f64), JobError> {
         )
     };
     let (a, b) = s.split_once(':').ok_or_else(bad)?;
-    let (a, b): (f64, f64) = (a.trim().parse().map_err(|_| bad())?, b.trim().parse().map_err(|_| bad())?);
+    let (a, b): (f64, f64) = (
+        a.trim().parse().map_err(|_| bad())?,
+        b.trim().parse().map_err(|_| bad())?,
+    );
     if a.is_finite() && b.is_finite() && a < b {
         Ok((a, b))
     } else {
@@ -133,7 +136,11 @@ impl CalibrateOptions {
             }
             specs.push(s);
         }
-        let windows = self.holdout.iter().map(|h| window(h)).collect::<Result<Vec<_>, _>>()?;
+        let windows = self
+            .holdout
+            .iter()
+            .map(|h| window(h))
+            .collect::<Result<Vec<_>, _>>()?;
         Ok((specs, windows))
     }
 }
@@ -189,7 +196,12 @@ pub struct Prepared<'a> {
 }
 
 /// Check the options and map the trace onto the model: every invalid input fails here.
-pub fn prepare<'a>(m: &Model, text: &'a str, trace: &'a Trace, o: &CalibrateOptions) -> Result<Prepared<'a>, JobError> {
+pub fn prepare<'a>(
+    m: &Model,
+    text: &'a str,
+    trace: &'a Trace,
+    o: &CalibrateOptions,
+) -> Result<Prepared<'a>, JobError> {
     let (specs, windows) = o.check()?;
     problem::check_names(m, trace)?;
     let mut base = m.overrides.clone();
@@ -199,7 +211,10 @@ pub fn prepare<'a>(m: &Model, text: &'a str, trace: &'a Trace, o: &CalibrateOpti
     let doc = document(m, text, &base)?;
     let params = specs
         .iter()
-        .map(|s| Parameter::resolve(s, &doc).map_err(|e| JobError::option("fit", s.to_string(), "a number in the model", e)))
+        .map(|s| {
+            Parameter::resolve(s, &doc)
+                .map_err(|e| JobError::option("fit", s.to_string(), "a number in the model", e))
+        })
         .collect::<Result<Vec<_>, _>>()?;
     let opts = SensitivityOptions {
         rtol: o.rtol,
@@ -224,7 +239,11 @@ pub fn prepare<'a>(m: &Model, text: &'a str, trace: &'a Trace, o: &CalibrateOpti
     }
     // The model at the start point must check (bounds written into the file are checked there).
     problem.gearbox_at(&start(&problem.params))?;
-    Ok(Prepared { problem, windows, held })
+    Ok(Prepared {
+        problem,
+        windows,
+        held,
+    })
 }
 
 fn start(params: &[Parameter]) -> Vec<f64> {
@@ -254,7 +273,12 @@ fn evaluate(p: &Prepared<'_>, theta: &[f64]) -> Result<Evaluation, JobError> {
 
 /// Calibrate: fit the parameters of `o.fit` to the trace. `text` is the model file's text (`m`
 /// is it checked with its overrides).
-pub fn calibrate(m: &Model, text: &str, trace: &Trace, o: &CalibrateOptions) -> Result<CalibrateResult, JobError> {
+pub fn calibrate(
+    m: &Model,
+    text: &str,
+    trace: &Trace,
+    o: &CalibrateOptions,
+) -> Result<CalibrateResult, JobError> {
     let p = prepare(m, text, trace, o)?;
     fit(m, &p, o)
 }
@@ -349,7 +373,10 @@ fn correlation(pr: &Problem<'_>, lin: &stats::Linearised, warnings: &mut Vec<Str
         .iter()
         .map(|row| row.iter().map(|&x| x.is_finite().then_some(x)).collect())
         .collect();
-    Correlation { parameters: names, matrix }
+    Correlation {
+        parameters: names,
+        matrix,
+    }
 }
 
 /// Errors per channel on the fitted and the held-out rows.
@@ -395,7 +422,9 @@ fn cycle_csv(trace: &Trace) -> String {
                 r.input_speed / RPM,
                 r.input_torque
             )),
-            (CycleKind::Vehicle, true) => s.push_str(&format!("{},{},{gear}\n", r.time, r.vehicle_speed / KMH)),
+            (CycleKind::Vehicle, true) => {
+                s.push_str(&format!("{},{},{gear}\n", r.time, r.vehicle_speed / KMH))
+            }
             (CycleKind::Vehicle, false) => s.push_str(&format!("{},{}\n", r.time, r.vehicle_speed / KMH)),
         }
     }
@@ -437,7 +466,17 @@ fn assemble(
         .trace
         .boundaries
         .iter()
-        .map(|c| (c.name.clone(), pr.trace.times.iter().copied().zip(c.values_c.iter().copied()).collect()))
+        .map(|c| {
+            (
+                c.name.clone(),
+                pr.trace
+                    .times
+                    .iter()
+                    .copied()
+                    .zip(c.values_c.iter().copied())
+                    .collect(),
+            )
+        })
         .collect();
     let calibrated = model_file::calibrated_text(pr.text, &pr.overrides_at(&res.theta), &series)
         .map_err(|e| JobError::invalid(format!("{}: {e}", m.label())))?;
@@ -452,7 +491,10 @@ fn assemble(
         fit: FitStats {
             evaluations: res.evaluations,
             iterations: res.iterations,
-            stop: serde_json::to_value(res.stop).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default(),
+            stop: serde_json::to_value(res.stop)
+                .ok()
+                .and_then(|v| v.as_str().map(String::from))
+                .unwrap_or_default(),
             sigma_k: lin.sigma2.sqrt(),
             dof: lin.dof,
             t975: t,
@@ -473,9 +515,20 @@ fn assemble(
 
 /// No NaN reaches a file: every number of the summary must be finite.
 fn check_finite(s: &CalibrationSummary) -> Result<(), JobError> {
-    let bad = |what: &str| JobError::numerical(format!("calibration of {} on {}: {what} is not finite", s.model, s.trace));
+    let bad = |what: &str| {
+        JobError::numerical(format!(
+            "calibration of {} on {}: {what} is not finite",
+            s.model, s.trace
+        ))
+    };
     for p in &s.parameters {
-        let vals = [Some(p.value), p.std_error, p.ci95_low, p.ci95_high, Some(p.influence_k)];
+        let vals = [
+            Some(p.value),
+            p.std_error,
+            p.ci95_low,
+            p.ci95_high,
+            Some(p.influence_k),
+        ];
         if vals.iter().flatten().any(|v| !v.is_finite()) {
             return Err(bad(&p.key_path));
         }
@@ -506,7 +559,12 @@ impl super::command::ToArgs for CalibrateOptions {
         for h in &self.holdout {
             a.extend(["--holdout".to_string(), h.clone()]);
         }
-        a.extend(["--rtol".into(), format!("{}", self.rtol), "--atol".into(), format!("{}", self.atol)]);
+        a.extend([
+            "--rtol".into(),
+            format!("{}", self.rtol),
+            "--atol".into(),
+            format!("{}", self.atol),
+        ]);
         a.extend(["--max-steps".into(), self.max_steps.to_string()]);
         a.extend(["--max-iterations".into(), self.max_iterations.to_string()]);
         if !self.initial_from_trace {

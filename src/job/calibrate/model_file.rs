@@ -33,7 +33,9 @@ fn table_at<'a>(t: &'a mut dyn TableLike, steps: &[Step]) -> Result<&'a mut dyn 
                     .ok_or_else(|| format!("`{k}` has no entry named \"{name}\""))?,
                 Step::Key(_) => return Err("a selector must follow a key".into()),
             };
-            let entry = a.get_mut(pos).ok_or_else(|| format!("`{k}` has no entry [{pos}]"))?;
+            let entry = a
+                .get_mut(pos)
+                .ok_or_else(|| format!("`{k}` has no entry [{pos}]"))?;
             table_at(entry, after)
         }
         _ => {
@@ -78,7 +80,9 @@ pub fn calibrated_text(
     overrides: &[Override],
     series: &[(String, Vec<(f64, f64)>)],
 ) -> Result<String, String> {
-    let mut doc: DocumentMut = text.parse().map_err(|e| format!("the model text does not parse: {e}"))?;
+    let mut doc: DocumentMut = text
+        .parse()
+        .map_err(|e| format!("the model text does not parse: {e}"))?;
     for ov in overrides {
         set(&mut doc, ov)?;
     }

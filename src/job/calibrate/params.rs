@@ -74,7 +74,8 @@ impl std::str::FromStr for FitSpec {
         let bounds = match bounds {
             None => None,
             Some(b) => {
-                let bad = || format!("fit (--fit) = {s}: bounds must be LO:HI, two finite numbers with LO < HI");
+                let bad =
+                    || format!("fit (--fit) = {s}: bounds must be LO:HI, two finite numbers with LO < HI");
                 let (lo, hi) = b.split_once(':').ok_or_else(bad)?;
                 let lo: f64 = lo.trim().parse().map_err(|_| bad())?;
                 let hi: f64 = hi.trim().parse().map_err(|_| bad())?;
@@ -109,7 +110,11 @@ impl Parameter {
         let value = match overrides::get(doc, &spec.path) {
             Ok(Value::Float(x)) => Some(x),
             Ok(Value::Integer(i)) => Some(i as f64),
-            Ok(v) => return Err(format!("fit (--fit) = {name}: the model holds {v} there, not a number")),
+            Ok(v) => {
+                return Err(format!(
+                    "fit (--fit) = {name}: the model holds {v} there, not a number"
+                ))
+            }
             Err(_) => None,
         };
         let temp = is_temperature(&spec.path);

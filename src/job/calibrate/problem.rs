@@ -95,39 +95,40 @@ fn output_rows(trace: &Trace, segs: &[Segment]) -> Result<Vec<usize>, String> {
 /// column and what the model has).
 pub fn check_names(m: &Model, trace: &Trace) -> Result<Vec<usize>, JobError> {
     let label = m.label();
-    let net = m
-        .gearbox
-        .thermal
-        .as_ref()
-        .ok_or_else(|| invalid(&label, "the model has no [thermal] section: nothing to calibrate".into()))?;
-        let names: Vec<&str> = net.nodes.iter().map(|n| n.name.as_str()).collect();
-        let channels = trace
-            .measured
-            .iter()
-            .map(|c| {
-                names.iter().position(|n| *n == c.name).ok_or_else(|| {
-                    JobError::invalid(format!(
-                        "{}: column {}: {label} has no capacity node \"{}\" (nodes: {})",
-                        trace.source,
-                        c.column,
-                        c.name,
-                        names.join(", ")
-                    ))
-                })
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let bnames: Vec<&str> = net.boundaries.iter().map(|b| b.name.as_str()).collect();
-        for c in &trace.boundaries {
-            if !bnames.contains(&c.name.as_str()) {
-                return Err(JobError::invalid(format!(
-                    "{}: column {}: {label} has no boundary \"{}\" (boundaries: {})",
+    let net = m.gearbox.thermal.as_ref().ok_or_else(|| {
+        invalid(
+            &label,
+            "the model has no [thermal] section: nothing to calibrate".into(),
+        )
+    })?;
+    let names: Vec<&str> = net.nodes.iter().map(|n| n.name.as_str()).collect();
+    let channels = trace
+        .measured
+        .iter()
+        .map(|c| {
+            names.iter().position(|n| *n == c.name).ok_or_else(|| {
+                JobError::invalid(format!(
+                    "{}: column {}: {label} has no capacity node \"{}\" (nodes: {})",
                     trace.source,
                     c.column,
                     c.name,
-                    bnames.join(", ")
-                )));
-            }
+                    names.join(", ")
+                ))
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let bnames: Vec<&str> = net.boundaries.iter().map(|b| b.name.as_str()).collect();
+    for c in &trace.boundaries {
+        if !bnames.contains(&c.name.as_str()) {
+            return Err(JobError::invalid(format!(
+                "{}: column {}: {label} has no boundary \"{}\" (boundaries: {})",
+                trace.source,
+                c.column,
+                c.name,
+                bnames.join(", ")
+            )));
         }
+    }
     Ok(channels)
 }
 
@@ -193,7 +194,12 @@ impl<'a> Problem<'a> {
     /// The overrides at coordinates θ: the base ones, then each parameter's value.
     pub fn overrides_at(&self, theta: &[f64]) -> Vec<Override> {
         let mut ovs = self.base.clone();
-        ovs.extend(self.params.iter().zip(theta).map(|(p, &t)| p.override_at(p.value(t))));
+        ovs.extend(
+            self.params
+                .iter()
+                .zip(theta)
+                .map(|(p, &t)| p.override_at(p.value(t))),
+        );
         ovs
     }
 
@@ -208,8 +214,13 @@ impl<'a> Problem<'a> {
                 problems.push(p.name(), t, e);
             }
         }
-        let parsed = problems.is_empty().then(|| parse_table(doc, &mut problems)).flatten();
-        let checked = parsed.and_then(|f| validate(&f, &mut problems)).filter(|_| problems.is_empty());
+        let parsed = problems
+            .is_empty()
+            .then(|| parse_table(doc, &mut problems))
+            .flatten();
+        let checked = parsed
+            .and_then(|f| validate(&f, &mut problems))
+            .filter(|_| problems.is_empty());
         let mut gb = match checked {
             Some(gb) => gb,
             None => model::from_str_with(self.text, &self.file, &self.overrides_at(theta))?,
@@ -265,7 +276,11 @@ impl<'a> Problem<'a> {
         }
         let dirs: Vec<Direction<'_>> = pairs
             .iter()
-            .map(|(plus, minus, d)| Direction { plus, minus, delta: *d })
+            .map(|(plus, minus, d)| Direction {
+                plus,
+                minus,
+                delta: *d,
+            })
             .collect();
         let traj = integrate_sensitivities(&scene, &dirs, &self.segs, &self.opts)
             .map_err(|e| JobError::numerical(format!("{}: {e}", self.file.display())))?;
@@ -277,7 +292,12 @@ impl<'a> Problem<'a> {
         let mut temps_c = Vec::with_capacity(self.rows.len());
         let mut sens = Vec::with_capacity(if p > 0 { self.rows.len() } else { 0 });
         for &r in &self.rows {
-            temps_c.push(self.channels.iter().map(|&n| traj.temps[r][n] - KELVIN_OFFSET).collect());
+            temps_c.push(
+                self.channels
+                    .iter()
+                    .map(|&n| traj.temps[r][n] - KELVIN_OFFSET)
+                    .collect(),
+            );
             if p > 0 {
                 let mut row = Vec::with_capacity(self.channels.len() * p);
                 for &n in &self.channels {

@@ -21,7 +21,13 @@ pub const MIN_TEMP_C: f64 = -60.0;
 /// Greatest temperature a trace may hold, °C.
 pub const MAX_TEMP_C: f64 = 400.0;
 
-const CYCLE_COLUMNS: [&str; 5] = ["time_s", "speed_kmh", "input_speed_rpm", "input_torque_nm", "gear"];
+const CYCLE_COLUMNS: [&str; 5] = [
+    "time_s",
+    "speed_kmh",
+    "input_speed_rpm",
+    "input_torque_nm",
+    "gear",
+];
 
 /// One temperature column.
 #[derive(Debug, Clone, PartialEq)]
@@ -119,12 +125,17 @@ impl Trace {
             kinds.push(classify(source, head + 1, col)?);
         }
         // The cycle columns, on the same line numbers, for the cycle reader.
-        let cycle_cols: Vec<usize> = (0..header.len()).filter(|&i| matches!(kinds[i], Kind::Cycle)).collect();
+        let cycle_cols: Vec<usize> = (0..header.len())
+            .filter(|&i| matches!(kinds[i], Kind::Cycle))
+            .collect();
         let mut cycle_text = String::with_capacity(text.len());
         for (k, l) in lines.iter().enumerate() {
             if k >= head && is_record(l) {
                 let fields: Vec<&str> = l.split(',').collect();
-                let keep: Vec<&str> = cycle_cols.iter().filter_map(|&i| fields.get(i).copied()).collect();
+                let keep: Vec<&str> = cycle_cols
+                    .iter()
+                    .filter_map(|&i| fields.get(i).copied())
+                    .collect();
                 cycle_text.push_str(&keep.join(","));
             } else {
                 cycle_text.push('#');
@@ -209,7 +220,9 @@ fn column_values(
         let raw = fields[i].trim();
         let at = |what: &str| TraceError(format!("{source}, line {line}: column {col} = \"{raw}\": {what}"));
         if raw.is_empty() {
-            return Err(at("empty (a gap in the record): every row needs a value; fill or cut the gap"));
+            return Err(at(
+                "empty (a gap in the record): every row needs a value; fill or cut the gap",
+            ));
         }
         let v: f64 = raw.parse().map_err(|_| at("not a number"))?;
         if !v.is_finite() {
@@ -270,7 +283,10 @@ mod tests {
     #[test]
     fn bad_traces_name_line_and_column() {
         let e = err(&OK.replace("0,1000,50,g1,20,21", "0,1000,50,g1,20,nan"));
-        assert!(e.contains("line 3") && e.contains("node:sump") && e.contains("finite"), "{e}");
+        assert!(
+            e.contains("line 3") && e.contains("node:sump") && e.contains("finite"),
+            "{e}"
+        );
         let e = err(&OK.replace(",20,22", ",20,"));
         assert!(e.contains("line 4") && e.contains("gap"), "{e}");
         let e = err(&OK.replace("node:sump", "boundary:ambient"));

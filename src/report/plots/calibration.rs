@@ -22,8 +22,14 @@ struct Fit {
 
 fn read_fit(dir: &Path) -> Result<Fit, PlotError> {
     let path = dir.join("fit.csv");
-    let text = std::fs::read_to_string(&path).map_err(|source| PlotError::Io { path: path.clone(), source })?;
-    let csv_err = |msg: String| PlotError::Csv { path: path.clone(), msg };
+    let text = std::fs::read_to_string(&path).map_err(|source| PlotError::Io {
+        path: path.clone(),
+        source,
+    })?;
+    let csv_err = |msg: String| PlotError::Csv {
+        path: path.clone(),
+        msg,
+    };
     let mut lines = text.lines();
     let head: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
     if head.len() < 5 || head[0] != "time_s" || head[1] != "holdout" || (head.len() - 2) % 3 != 0 {
@@ -46,13 +52,22 @@ fn read_fit(dir: &Path) -> Result<Fit, PlotError> {
     for (k, l) in lines.enumerate() {
         let f: Vec<&str> = l.split(',').collect();
         if f.len() != head.len() {
-            return Err(csv_err(format!("line {}: {} fields, the header has {}", k + 2, f.len(), head.len())));
+            return Err(csv_err(format!(
+                "line {}: {} fields, the header has {}",
+                k + 2,
+                f.len(),
+                head.len()
+            )));
         }
         let num = |i: usize| -> Result<f64, PlotError> {
-            f[i].parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| csv_err(format!("line {}, column {}: \"{}\" is not a finite number", k + 2, head[i], f[i])))
+            f[i].parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
+                csv_err(format!(
+                    "line {}, column {}: \"{}\" is not a finite number",
+                    k + 2,
+                    head[i],
+                    f[i]
+                ))
+            })
         };
         fit.time_s.push(num(0)?);
         fit.holdout.push(f[1] == "1");
@@ -63,7 +78,10 @@ fn read_fit(dir: &Path) -> Result<Fit, PlotError> {
         }
     }
     if fit.time_s.is_empty() {
-        return Err(PlotError::Data { path, what: "no data rows".into() });
+        return Err(PlotError::Data {
+            path,
+            what: "no data rows".into(),
+        });
     }
     Ok(fit)
 }
@@ -102,7 +120,12 @@ fn draw(root: &Canvas, fit: &Fit) -> DrawResult {
     let shade = RGBColor(232, 232, 232).filled();
     let t: Vec<f64> = fit.time_s.iter().map(|x| x * scale).collect();
 
-    let (y0, y1) = style::padded_range(fit.channels.iter().flat_map(|c| c.1.iter().chain(c.2.iter()).copied()), 0.06);
+    let (y0, y1) = style::padded_range(
+        fit.channels
+            .iter()
+            .flat_map(|c| c.1.iter().chain(c.2.iter()).copied()),
+        0.06,
+    );
     let mut chart = ChartBuilder::on(&upper)
         .margin_left(20)
         .margin_right(20)
@@ -120,20 +143,37 @@ fn draw(root: &Canvas, fit: &Fit) -> DrawResult {
         .x_label_formatter(&|_| String::new())
         .y_label_formatter(&|v| style::fmt_num(*v))
         .draw()?;
-    chart.draw_series(spans.iter().map(|&(a, b)| Rectangle::new([(a, y0), (b, y1)], shade)))?;
+    chart.draw_series(
+        spans
+            .iter()
+            .map(|&(a, b)| Rectangle::new([(a, y0), (b, y1)], shade)),
+    )?;
     let mut entries = Vec::new();
     for (k, (name, meas, sim, _)) in fit.channels.iter().enumerate() {
         let colour = style::series_colour(k);
-        chart.draw_series(t.iter().zip(meas).map(|(&x, &y)| Circle::new((x, y), 3, colour.mix(0.55).filled())))?;
-        chart.draw_series(LineSeries::new(t.iter().copied().zip(sim.iter().copied()), colour.stroke_width(3)))?;
+        chart.draw_series(
+            t.iter()
+                .zip(meas)
+                .map(|(&x, &y)| Circle::new((x, y), 3, colour.mix(0.55).filled())),
+        )?;
+        chart.draw_series(LineSeries::new(
+            t.iter().copied().zip(sim.iter().copied()),
+            colour.stroke_width(3),
+        ))?;
         entries.push(LegendEntry::new(name.clone(), Swatch::Line(colour, 3)));
     }
     if !spans.is_empty() {
-        entries.push(LegendEntry::new("held out (grey)", Swatch::Line(RGBColor(200, 200, 200), 12)));
+        entries.push(LegendEntry::new(
+            "held out (grey)",
+            Swatch::Line(RGBColor(200, 200, 200), 12),
+        ));
     }
     style::draw_legend_column(&legend, Some("Measured channels"), &entries, 14)?;
 
-    let (r0, r1) = style::padded_range(fit.channels.iter().flat_map(|c| c.3.iter().copied()).chain([0.0]), 0.08);
+    let (r0, r1) = style::padded_range(
+        fit.channels.iter().flat_map(|c| c.3.iter().copied()).chain([0.0]),
+        0.08,
+    );
     let mut low = ChartBuilder::on(&lower)
         .margin_left(20)
         .margin_right(20)
@@ -152,11 +192,21 @@ fn draw(root: &Canvas, fit: &Fit) -> DrawResult {
         .x_label_formatter(&|v| style::fmt_num(*v))
         .y_label_formatter(&|v| style::fmt_num(*v))
         .draw()?;
-    low.draw_series(spans.iter().map(|&(a, b)| Rectangle::new([(a, r0), (b, r1)], shade)))?;
-    low.draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], style::NEUTRAL.stroke_width(2)))?;
+    low.draw_series(
+        spans
+            .iter()
+            .map(|&(a, b)| Rectangle::new([(a, r0), (b, r1)], shade)),
+    )?;
+    low.draw_series(LineSeries::new(
+        [(x0, 0.0), (x1, 0.0)],
+        style::NEUTRAL.stroke_width(2),
+    ))?;
     for (k, (_, _, _, res)) in fit.channels.iter().enumerate() {
         let colour = style::series_colour(k);
-        low.draw_series(LineSeries::new(t.iter().copied().zip(res.iter().copied()), colour.stroke_width(2)))?;
+        low.draw_series(LineSeries::new(
+            t.iter().copied().zip(res.iter().copied()),
+            colour.stroke_width(2),
+        ))?;
     }
     Ok(())
 }
