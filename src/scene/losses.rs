@@ -901,20 +901,6 @@ fn mesh_zone(gb: &Gearbox, mi: usize) -> (f64, f64) {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::wet_fraction;
-
-    #[test]
-    fn wet_fraction_of_a_circle() {
-        assert_eq!(wet_fraction(0.0, 1.0, -2.0), 0.0);
-        assert_eq!(wet_fraction(0.0, 1.0, 2.0), 1.0);
-        assert!((wet_fraction(0.0, 1.0, 0.0) - 0.5).abs() < 1e-15);
-        // level at the bottom quarter: cos t < −0.5 → t ∈ (2π/3, 4π/3): 1/3 of the circle.
-        assert!((wet_fraction(0.0, 1.0, -0.5) - 1.0 / 3.0).abs() < 1e-12);
-    }
-}
-
 /// Each item's multiplier from `[losses] multiplier` (source, then item), or None when none is
 /// given; an item name that matches no item is an error naming the items of that source.
 fn multipliers(
@@ -953,4 +939,18 @@ fn multipliers(
         f[k] *= m;
     }
     Ok(Some(f))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::wet_fraction;
+
+    #[test]
+    fn wet_fraction_of_a_circle() {
+        assert_eq!(wet_fraction(0.0, 1.0, -2.0), 0.0);
+        assert_eq!(wet_fraction(0.0, 1.0, 2.0), 1.0);
+        assert!((wet_fraction(0.0, 1.0, 0.0) - 0.5).abs() < 1e-15);
+        // level at the bottom quarter: cos t < −0.5 → t ∈ (2π/3, 4π/3): 1/3 of the circle.
+        assert!((wet_fraction(0.0, 1.0, -0.5) - 1.0 / 3.0).abs() < 1e-12);
+    }
 }

@@ -118,9 +118,12 @@ fn window(s: &str) -> Result<(f64, f64), JobError> {
     }
 }
 
+/// The parsed `--fit` specs and `--holdout` windows (s).
+pub type Checked = (Vec<FitSpec>, Vec<(f64, f64)>);
+
 impl CalibrateOptions {
     /// Range checks; the parsed fit specs and holdout windows.
-    pub fn check(&self) -> Result<(Vec<FitSpec>, Vec<(f64, f64)>), JobError> {
+    pub fn check(&self) -> Result<Checked, JobError> {
         limits::RTOL.check(self.rtol)?;
         limits::ATOL.check(self.atol)?;
         limits::MAX_STEPS.check(self.max_steps as f64)?;

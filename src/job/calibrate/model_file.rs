@@ -87,7 +87,7 @@ pub fn calibrated_text(
         set(&mut doc, ov)?;
     }
     for (name, points) in series {
-        let path = vec![
+        let path = [
             Step::Key("thermal".into()),
             Step::Key("boundaries".into()),
             Step::Named(name.clone()),

@@ -12,12 +12,14 @@ use super::{commit, stage_png, Canvas, DrawResult, PlotError};
 const LEGEND_W: u32 = 320;
 const Y_LABEL_W: u32 = 110;
 
+/// One channel of `fit.csv`: (node, measured, simulated, residual).
+type Channel = (String, Vec<f64>, Vec<f64>, Vec<f64>);
+
 /// The columns of `fit.csv`.
 struct Fit {
     time_s: Vec<f64>,
     holdout: Vec<bool>,
-    /// (node, measured, simulated, residual).
-    channels: Vec<(String, Vec<f64>, Vec<f64>, Vec<f64>)>,
+    channels: Vec<Channel>,
 }
 
 fn read_fit(dir: &Path) -> Result<Fit, PlotError> {
