@@ -4,9 +4,9 @@
 
 use std::path::PathBuf;
 
+use geartherm::reference::{run_all, summarise};
 use geartherm::report::files::OutputDir;
 use geartherm::report::validation::{rows_csv, summary_csv, summary_markdown, ValidationReport};
-use geartherm::solve::validation::{run_all, summarise};
 
 use super::{invalid, print_json, Failure, EXIT_IO};
 

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::ValidationError;
+use super::ReferenceError;
 use crate::model::Gearbox;
 use crate::scene::Source;
 
@@ -179,9 +179,9 @@ pub struct Case {
 
 impl Case {
     /// Read `dir/case.toml` and its reference CSV.
-    pub fn load(dir: &Path) -> Result<Case, ValidationError> {
+    pub fn load(dir: &Path) -> Result<Case, ReferenceError> {
         let path = dir.join("case.toml");
-        let bad = |msg: String| ValidationError::Case {
+        let bad = |msg: String| ReferenceError::Case {
             path: path.clone(),
             msg,
         };
@@ -194,17 +194,17 @@ impl Case {
                 .comment(Some(b'#'))
                 .trim(csv::Trim::All)
                 .from_path(&rp)
-                .map_err(|e| ValidationError::Case {
+                .map_err(|e| ReferenceError::Case {
                     path: rp.clone(),
                     msg: e.to_string(),
                 })?;
             for rec in rd.deserialize::<Point>() {
-                let p = rec.map_err(|e| ValidationError::Case {
+                let p = rec.map_err(|e| ReferenceError::Case {
                     path: rp.clone(),
                     msg: e.to_string(),
                 })?;
                 if !(p.reference_w.is_finite() && p.reference_w > 0.0) {
-                    return Err(ValidationError::Case {
+                    return Err(ReferenceError::Case {
                         path: rp.clone(),
                         msg: format!("point {}: reference_w must be > 0", p.point),
                     });

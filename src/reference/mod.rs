@@ -1,5 +1,7 @@
-//! Reference cases (`validation/<case>/case.toml`) evaluated with every applicable model choice
-//! (issue 14; docs/validation.md).
+//! Reference cases and their comparison: each case of `validation/<case>/case.toml` evaluated
+//! with every applicable model choice and compared with its reference (docs/validation.md). This
+//! layer reads case files and loads models; it calls no solver (it evaluates the loss scene at
+//! fixed operating points). Checking a model file's input is `model`'s job, not this one's.
 //!
 //! A case names a model file, a quantity (any loss source, optionally one item, or the
 //! efficiency over chosen sources), the kind of reference (peer, standard, measurement, trend,
@@ -46,9 +48,9 @@ pub struct Row {
     pub relative_error: f64,
 }
 
-/// A case that could not be evaluated.
+/// A reference case that could not be evaluated.
 #[derive(Debug, thiserror::Error)]
-pub enum ValidationError {
+pub enum ReferenceError {
     /// Unreadable or malformed case or reference file.
     #[error("{}: {msg}", path.display())]
     Case { path: PathBuf, msg: String },
@@ -62,8 +64,8 @@ pub enum ValidationError {
 }
 
 /// Every case directory under `dir` (those holding a `case.toml`), sorted.
-pub fn case_dirs(dir: &Path) -> Result<Vec<PathBuf>, ValidationError> {
-    let rd = std::fs::read_dir(dir).map_err(|e| ValidationError::Case {
+pub fn case_dirs(dir: &Path) -> Result<Vec<PathBuf>, ReferenceError> {
+    let rd = std::fs::read_dir(dir).map_err(|e| ReferenceError::Case {
         path: dir.to_path_buf(),
         msg: e.to_string(),
     })?;
@@ -76,7 +78,7 @@ pub fn case_dirs(dir: &Path) -> Result<Vec<PathBuf>, ValidationError> {
 }
 
 /// Evaluate every case under `dir` with every model choice of its family.
-pub fn run_all(dir: &Path) -> Result<Vec<Row>, ValidationError> {
+pub fn run_all(dir: &Path) -> Result<Vec<Row>, ReferenceError> {
     let mut rows = Vec::new();
     for d in case_dirs(dir)? {
         rows.extend(run_case(&Case::load(&d)?)?);
@@ -85,21 +87,21 @@ pub fn run_all(dir: &Path) -> Result<Vec<Row>, ValidationError> {
 }
 
 /// Evaluate one case.
-pub fn run_case(c: &Case) -> Result<Vec<Row>, ValidationError> {
+pub fn run_case(c: &Case) -> Result<Vec<Row>, ReferenceError> {
     let mut rows = Vec::new();
     for (label, keys) in &c.choices {
-        let gb = c.gearbox(keys).map_err(|msg| ValidationError::Model {
+        let gb = c.gearbox(keys).map_err(|msg| ReferenceError::Model {
             path: c.model_path.clone(),
             choice: label.to_string(),
             msg,
         })?;
-        let scene = LossScene::compile(&gb).map_err(|e| ValidationError::Model {
+        let scene = LossScene::compile(&gb).map_err(|e| ReferenceError::Model {
             path: c.model_path.clone(),
             choice: label.to_string(),
             msg: e.to_string(),
         })?;
-        let eval = |gear: &str, rpm: f64, torque: f64, temp: f64| -> Result<f64, ValidationError> {
-            value(&gb, &scene, c, gear, rpm, torque, temp).map_err(|msg| ValidationError::Case {
+        let eval = |gear: &str, rpm: f64, torque: f64, temp: f64| -> Result<f64, ReferenceError> {
+            value(&gb, &scene, c, gear, rpm, torque, temp).map_err(|msg| ReferenceError::Case {
                 path: c.dir.join("case.toml"),
                 msg,
             })
