@@ -37,6 +37,15 @@ pub struct CatalogueOil {
     /// Where the X_L comes from (required with `lubricant_factor`).
     #[serde(default)]
     pub lubricant_factor_source: Option<String>,
+    /// Fitted SKF (μ_bl, μ_EHL) of roller bearings in this oil.
+    #[serde(default)]
+    pub bearing_mu_roller: Option<[f64; 2]>,
+    /// Fitted SKF (μ_bl, μ_EHL) of ball bearings in this oil.
+    #[serde(default)]
+    pub bearing_mu_ball: Option<[f64; 2]>,
+    /// Where the bearing μ come from.
+    #[serde(default)]
+    pub bearing_mu_source: Option<String>,
     /// Where the data come from.
     pub source: String,
 }
