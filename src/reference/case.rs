@@ -230,7 +230,11 @@ impl Case {
         if points.is_empty() && f.trend.is_empty() && f.range.is_empty() {
             return Err(bad("no reference points, trend or range checks".into()));
         }
-        if let Some(t) = f.trend.iter().find(|t| !t.exclude.is_empty() && t.exclude_reason.is_none()) {
+        if let Some(t) = f
+            .trend
+            .iter()
+            .find(|t| !t.exclude.is_empty() && t.exclude_reason.is_none())
+        {
             return Err(bad(format!("trend {}: exclude needs exclude_reason", t.point)));
         }
         if let Some(r) = f

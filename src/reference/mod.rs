@@ -147,13 +147,25 @@ fn run_choice(
     }
     for r in &c.ranges {
         let predicted = eval(&r.gear, r.speed_rpm, r.torque_nm, r.oil_temp_c)?;
-        rows.push(row(&r.point, r.speed_rpm, predicted, predicted.clamp(r.low, r.high), c.kind));
+        rows.push(row(
+            &r.point,
+            r.speed_rpm,
+            predicted,
+            predicted.clamp(r.low, r.high),
+            c.kind,
+        ));
     }
     for t in c.trends.iter().filter(|t| !t.exclude.iter().any(|e| e == label)) {
         let pa = eval(&t.gear, t.speed_a_rpm, t.torque_nm, t.oil_temp_c)?;
         let pb = eval(&t.gear, t.speed_b_rpm, t.torque_nm, t.oil_temp_c)?;
         let predicted = t.metric.value(pa, pb, t.speed_a_rpm, t.speed_b_rpm);
-        rows.push(row(&t.point, t.speed_b_rpm, predicted, predicted.clamp(t.low, t.high), Kind::Trend));
+        rows.push(row(
+            &t.point,
+            t.speed_b_rpm,
+            predicted,
+            predicted.clamp(t.low, t.high),
+            Kind::Trend,
+        ));
     }
     Ok(rows)
 }

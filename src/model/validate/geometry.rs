@@ -26,7 +26,16 @@ pub(super) fn mating_tip_roots(file: &ModelFile) -> Vec<Option<f64>> {
         let (Some(i1), Some(i2)) = (ix(n1), ix(n2)) else {
             continue;
         };
-        if m.kind == Some(MeshKindSpec::Internal) || file.gears[i1].internal || file.gears[i2].internal {
+        let (a, b) = (&file.gears[i1], &file.gears[i2]);
+        let same = |x: Option<f64>, y: Option<f64>, d: f64| (x.unwrap_or(d) - y.unwrap_or(d)).abs() <= 1e-9;
+        // Only a consistent external pair (a mismatch is reported by the mesh check).
+        if m.kind == Some(MeshKindSpec::Internal)
+            || a.internal
+            || b.internal
+            || (a.module_mm - b.module_mm).abs() > 1e-9 * a.module_mm
+            || !same(a.pressure_angle_deg, b.pressure_angle_deg, 20.0)
+            || !same(a.helix_angle_deg, b.helix_angle_deg, 0.0)
+        {
             continue;
         }
         for (i, mate) in [(i1, i2), (i2, i1)] {
