@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use crate::solve::validation::{Row, SummaryRow};
+use crate::reference::{Row, SummaryRow};
 
 fn num(v: f64) -> String {
     if v.is_finite() {
