@@ -15,7 +15,7 @@ use crate::physics::thermal::{
     thermostat_opening, FluidProperties, HTable, AIR_50C, OIL_CONDUCTIVITY, OIL_SPECIFIC_HEAT,
 };
 
-use super::losses::{DefaultHeat, LossItem};
+use super::items::{DefaultHeat, LossItem};
 
 /// Endpoint of a compiled link: a state (capacity node) or a boundary.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
