@@ -24,6 +24,7 @@ pub mod heatmap;
 pub mod index;
 pub mod losses;
 pub mod map_index;
+pub mod panel;
 pub mod study;
 pub mod style;
 pub mod temperatures;
