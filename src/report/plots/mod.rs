@@ -17,6 +17,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use tempfile::NamedTempFile;
 
+use crate::report::files::user_path;
+
 pub mod data;
 pub mod efficiency;
 pub mod energy;
@@ -34,26 +36,28 @@ pub mod work_precision;
 #[cfg(test)]
 mod tests;
 
-/// Errors of the plot reports. Every variant names the file concerned.
+/// Errors of the plot reports. Every variant names the file concerned, as the user knows it
+/// (a file in a transaction's temporary directory by its place in the target:
+/// [`user_path`]).
 #[derive(Debug, thiserror::Error)]
 pub enum PlotError {
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {source}", user_path(path).display())]
     Io {
         path: PathBuf,
         #[source]
         source: std::io::Error,
     },
-    #[error("{}: malformed CSV: {msg}", path.display())]
+    #[error("{}: malformed CSV: {msg}", user_path(path).display())]
     Csv { path: PathBuf, msg: String },
-    #[error("{}: malformed JSON: {source}", path.display())]
+    #[error("{}: malformed JSON: {source}", user_path(path).display())]
     Json {
         path: PathBuf,
         #[source]
         source: serde_json::Error,
     },
-    #[error("{}: {what}", path.display())]
+    #[error("{}: {what}", user_path(path).display())]
     Data { path: PathBuf, what: String },
-    #[error("{}: drawing failed: {msg}", path.display())]
+    #[error("{}: drawing failed: {msg}", user_path(path).display())]
     Draw { path: PathBuf, msg: String },
     #[error("the embedded DejaVu Sans font could not be loaded")]
     Font,
