@@ -44,6 +44,12 @@ LAYERS = {
     "python": 8,
 }
 
+# File circles in folders another change was reworking when this check was added; each entry
+# goes when its circle is broken (the check fails on an entry that is no circle any more).
+ALLOWED_CIRCLES = {
+    frozenset({"src/model/thermal.rs", "src/model/wall_mesh.rs"}): "model/: another change",
+}
+
 ROOTS = ("lib.rs", "main.rs", "mod.rs")
 PATH_IN_CODE = re.compile(r"(?<![\w$:])((?:crate|geartherm|super|self)(?:\s*::\s*(?:\w+|\{))+)")
 USE = re.compile(r"\buse\s+([^;]+);")
@@ -211,6 +217,71 @@ def circles(nodes, edges):
     return sorted(out)
 
 
+def print_folders(crates, arrows):
+    """Print the folders, their arrows and the arrows up the layer order; return the folder
+    arrows ({A: {B: files of A that use B}}) and whether an arrow points up."""
+    folders = sorted({folder_of(p) for c in crates for p in c.module_of} - {"(crate root)"})
+    known = sorted((f for f in folders if f in LAYERS), key=lambda f: (LAYERS[f], f))
+    unknown = [f for f in folders if f not in LAYERS]
+    print("folders, up the layer order: " + " | ".join(known))
+    if unknown:
+        print("folders not in the layer order (listed, not judged): " + ", ".join(unknown))
+    folder_edges = defaultdict(lambda: defaultdict(set))
+    for src, used in arrows.items():
+        for dst in used:
+            a, b = folder_of(src), folder_of(dst)
+            if a != b and "(crate root)" not in (a, b):
+                folder_edges[a][b].add(src)
+    order = lambda f: (LAYERS.get(f, 99), f)
+    print("\nfolder arrows (A -> B: how many files of A use B):")
+    for a in sorted(folder_edges, key=order):
+        targets = sorted(folder_edges[a], key=order)
+        print(f"  {a} -> " + ", ".join(f"{b} ({len(folder_edges[a][b])})" for b in targets))
+    print("\narrows up the layer order:")
+    up = sorted(
+        (a, b)
+        for a in folder_edges
+        for b in folder_edges[a]
+        if a in LAYERS and b in LAYERS and LAYERS[b] > LAYERS[a]
+    )
+    for a, b in up:
+        print(f"  {a} -> {b}: " + ", ".join(sorted(folder_edges[a][b])))
+    if not up:
+        print("  none")
+    return folder_edges, bool(up)
+
+
+def print_circles(folder_edges, arrows):
+    """Print the circles of folders and of files; return whether one is not in ALLOWED_CIRCLES
+    or an entry of ALLOWED_CIRCLES is no circle any more."""
+    failed = False
+    print("\ncircles of folders:")
+    folder_circles = circles(sorted(folder_edges), {a: set(b) for a, b in folder_edges.items()})
+    for c in folder_circles:
+        failed = True
+        print("  " + " <-> ".join(c))
+    if not folder_circles:
+        print("  none")
+    print("\ncircles of files (file -> file: the names it takes):")
+    file_circles = circles(sorted(arrows), {a: set(b) for a, b in arrows.items()})
+    for c in file_circles:
+        allowed = frozenset(c) in ALLOWED_CIRCLES
+        failed |= not allowed
+        folders = ", ".join(sorted({folder_of(f) for f in c}))
+        print(f"  {len(c)} files in {folders}{'  [allowed]' if allowed else ''}:")
+        for a in c:
+            for b in c:
+                if b in arrows.get(a, {}):
+                    print(f"    {a} -> {b}: {', '.join(sorted(arrows[a][b]))}")
+    if not file_circles:
+        print("  none")
+    for entry in ALLOWED_CIRCLES:
+        if sorted(entry) not in file_circles:
+            failed = True
+            print(f"  ALLOWED_CIRCLES entry is no circle, remove it: {', '.join(sorted(entry))}")
+    return failed
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--files", action="store_true", help="print every file arrow too")
@@ -225,58 +296,8 @@ def main():
             module = crate.module_of.pop(path)
             crate.file_of.pop(module, None)
     arrows = file_arrows(crates, lib)
-
-    folders = sorted({folder_of(p) for c in crates for p in c.module_of} - {"(crate root)"})
-    known = sorted((f for f in folders if f in LAYERS), key=lambda f: (LAYERS[f], f))
-    unknown = [f for f in folders if f not in LAYERS]
-    print("folders, up the layer order: " + " | ".join(known))
-    if unknown:
-        print("folders not in the layer order (listed, not judged): " + ", ".join(unknown))
-
-    folder_edges = defaultdict(lambda: defaultdict(set))
-    for src, used in arrows.items():
-        for dst in used:
-            a, b = folder_of(src), folder_of(dst)
-            if a != b and "(crate root)" not in (a, b):
-                folder_edges[a][b].add(src)
-    failed = False
-    print("\nfolder arrows (A -> B: how many files of A use B):")
-    for a in sorted(folder_edges, key=lambda f: (LAYERS.get(f, 99), f)):
-        targets = sorted(folder_edges[a], key=lambda f: (LAYERS.get(f, 99), f))
-        print(f"  {a} -> " + ", ".join(f"{b} ({len(folder_edges[a][b])})" for b in targets))
-    print("\narrows up the layer order:")
-    up = [
-        (a, b)
-        for a in folder_edges
-        for b in folder_edges[a]
-        if a in LAYERS and b in LAYERS and LAYERS[b] > LAYERS[a]
-    ]
-    for a, b in sorted(up):
-        failed = True
-        print(f"  {a} -> {b}: " + ", ".join(sorted(folder_edges[a][b])))
-    if not up:
-        print("  none")
-
-    print("\ncircles of folders:")
-    folder_circles = circles(sorted(folder_edges), {a: set(b) for a, b in folder_edges.items()})
-    for c in folder_circles:
-        failed = True
-        print("  " + " <-> ".join(c))
-    if not folder_circles:
-        print("  none")
-
-    print("\ncircles of files (file -> file: the names it takes):")
-    file_circles = circles(sorted(arrows), {a: set(b) for a, b in arrows.items()})
-    for c in file_circles:
-        failed = True
-        print(f"  {len(c)} files in {', '.join(sorted({folder_of(f) for f in c}))}:")
-        for a in c:
-            for b in c:
-                if b in arrows.get(a, {}):
-                    print(f"    {a} -> {b}: {', '.join(sorted(arrows[a][b]))}")
-    if not file_circles:
-        print("  none")
-
+    folder_edges, upward = print_folders(crates, arrows)
+    failed = print_circles(folder_edges, arrows) or upward
     if args.files:
         print("\nfile arrows:")
         for a in sorted(arrows):
