@@ -10,7 +10,7 @@ use plotters::prelude::*;
 use super::style;
 use super::DrawResult;
 
-/// A chart with f64 axes on a figure's canvas (see [`super::Canvas`]).
+/// A chart with f64 axes on a figure's canvas.
 pub type Chart<'b> = ChartContext<'b, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// The grid lines of a panel.
