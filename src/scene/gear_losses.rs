@@ -17,7 +17,8 @@ use super::usage::{Needs, Usage};
 use super::warning::{above_oil_warning, RangeWarning};
 
 /// Helical pockets: the exact infinitely-many-slices limit of the connected-slice model (one spur
-/// pocket history summed over phases; was 48 discrete slices, 0.5 % off and 0.35 s per AT6 compile).
+/// pocket history summed over phases; 48 discrete slices are 0.5 % off and cost 0.35 s per AT6
+/// compile).
 pub const HELIX_POCKET_SLICES: Option<usize> = None;
 
 /// Kinematic factors of one gear state (per unit input speed / torque).

@@ -134,7 +134,7 @@ pub struct TransientOptions {
     /// Dense or sparse linear algebra (default: by size).
     pub linear_algebra: LinearAlgebra,
     /// Assemble the Jacobian entry by entry (default). Off: one Jacobian–vector product per
-    /// column, as before issue 15 (dense only; for measuring the difference).
+    /// column (dense only; for measuring the difference).
     pub assembled_jacobian: bool,
 }
 
