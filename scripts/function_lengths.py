@@ -165,7 +165,8 @@ def main():
         allowed = name in ALLOWED
         failed |= not allowed
         print(f"  {length:5} {nesting:3}  {name}  ({where}){'  [allowed]' if allowed else ''}")
-    for name in sorted(ALLOWED):
+    scanned = [os.path.normpath(f) + os.sep for f in args.folders]
+    for name in sorted(n for n in ALLOWED if any(n.startswith(f) for f in scanned)):
         if name not in {r[2] for r in over}:
             failed = True
             gone = "" if name in keys else " (no such function)"
