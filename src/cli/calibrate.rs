@@ -33,7 +33,7 @@ pub struct CalibrateArgs {
     #[arg(long, default_value_t = calibrate::DEFAULT_RTOL)]
     pub rtol: f64,
     /// Absolute tolerance, K (1e-14 … 1).
-    #[arg(long, default_value_t = geartherm::solve::transient::DEFAULT_ATOL)]
+    #[arg(long, default_value_t = geartherm::job::run::DEFAULT_ATOL)]
     pub atol: f64,
     /// Step budget of one integration.
     #[arg(long, default_value_t = geartherm::job::run::DEFAULT_MAX_STEPS)]
