@@ -274,7 +274,9 @@ pub fn schedule_with_launch(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cycle::vehicle::tests::{at6, at6_gears, spec, AT6_TOML};
+    use crate::cycle::parse::KMH;
+    use crate::cycle::vehicle::tests::{at6, at6_gears};
+    use crate::cycle::vehicle::RoadLoad;
     use approx::assert_relative_eq;
 
     fn wltc() -> DriveCycle {
@@ -429,13 +431,21 @@ mod tests {
     #[test]
     fn interval_values_by_hand() {
         // one interval 36 → 54 km/h in 2 s, in the only gear (ratio 2), transmit.
-        let s = spec(
-            "[vehicle]\nmass_kg = 1000.0\nrotating_mass_factor = 0.0\nwheel_radius_m = 0.5\n\
-             final_drive_ratio = 4.0\noverrun = \"transmit\"\n\
-             road_load = { f0_n = 100.0, f1_n_per_mps = 0.0, f2_n_per_mps2 = 0.0 }\n",
-        );
         let gears = GearTable::new(vec![("D".into(), 2.0)]);
-        let v = s.validate(&gears).unwrap();
+        let v = Vehicle {
+            mass: 1000.0,
+            effective_mass: 1000.0,
+            wheel_radius: 0.5,
+            final_drive_ratio: 4.0,
+            road_load: RoadLoad {
+                f0: 100.0,
+                f1: 0.0,
+                f2: 0.0,
+            },
+            overrun: Overrun::Transmit,
+            standstill_speed: 0.1 * KMH,
+            shift: None,
+        };
         let c = DriveCycle::parse("time_s,speed_kmh\n0,36\n2,54\n", "x").unwrap();
         let sch = schedule(&c, Some(&v), &gears).unwrap();
         let i = sch.intervals[0];
@@ -586,7 +596,7 @@ mod tests {
         let s = schedule(&c, Some(&v), &one).unwrap();
         assert!(s.intervals.iter().all(|i| i.gear == 0) && s.shift_count() == 0);
         // a strategy naming states the table lacks
-        let v = spec(AT6_TOML).validate(&at6_gears()).unwrap();
+        let v = at6();
         let e = schedule(&c, Some(&v), &one).unwrap_err();
         assert_eq!(e.kind, CycleErrorKind::Config);
         let bad = GearTable::new(vec![("1".into(), 0.0)]);

@@ -1,12 +1,10 @@
 //! The automatic transmission's own loss parts in the model file: `[[clutch_packs]]` (the
 //! friction packs of shift elements, whose drag counts while the element is open), `[pump]`
-//! (the fixed-displacement oil pump) — and the validation of `[launch]` (the torque converter,
-//! whose checked form lives in the cycle layer, [`crate::cycle::LaunchDevice`]).
+//! (the fixed-displacement oil pump).
 
 use serde::{Deserialize, Serialize};
 
 use super::problems::Problems;
-use crate::cycle::{GearTable, LaunchDevice, LaunchSpec};
 use crate::physics::losses::clutch_drag::ClutchPack;
 use crate::physics::losses::curve::Curve;
 use crate::physics::losses::pump::Pump;
@@ -241,21 +239,4 @@ pub fn validate_pump(s: &PumpSpec, members: &[&str], problems: &mut Problems) ->
         },
         drive: drive?,
     })
-}
-
-/// Check `[launch]` against the gear table.
-pub fn validate_launch(
-    table: &toml::Table,
-    gears: &GearTable,
-    problems: &mut Problems,
-) -> Option<LaunchDevice> {
-    match LaunchSpec::from_table(table).and_then(|s| s.validate(gears)) {
-        Ok(l) => Some(l),
-        Err(list) => {
-            for p in list {
-                problems.push(p.path, p.value, p.allowed);
-            }
-            None
-        }
-    }
 }

@@ -12,6 +12,7 @@ pub mod overrides;
 pub mod parse;
 pub mod problems;
 pub mod schema;
+pub mod sections;
 pub mod source;
 pub mod thermal;
 pub mod validate;

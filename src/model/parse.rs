@@ -256,10 +256,10 @@ pub fn parse_table(mut table: Table, problems: &mut Problems) -> Option<ModelFil
     let lubrication = section::<LubricationSpec>(&mut table, "lubrication", true, problems);
     let losses = section::<LossesSpec>(&mut table, "losses", false, problems);
     let thermal = section::<super::thermal::ThermalSpec>(&mut table, "thermal", false, problems);
-    let vehicle = section::<Table>(&mut table, "vehicle", false, problems);
+    let vehicle = section::<super::sections::vehicle::VehicleSpec>(&mut table, "vehicle", false, problems);
     let clutch_packs = array::<super::automatic::ClutchPackSpec>(&mut table, "clutch_packs", false, problems);
     let pump = section::<super::automatic::PumpSpec>(&mut table, "pump", false, problems);
-    let launch = section::<Table>(&mut table, "launch", false, problems);
+    let launch = section::<super::sections::launch::LaunchSpec>(&mut table, "launch", false, problems);
     let bearings = array::<super::bearings::BearingSpec>(&mut table, "bearings", false, problems);
     let seals = array::<super::bearings::SealSpec>(&mut table, "seals", false, problems);
     if problems.len() > before || !problems.is_empty() {

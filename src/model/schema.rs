@@ -357,18 +357,18 @@ pub struct ModelFile {
     /// `[thermal]`: the lumped thermal network.
     #[serde(default)]
     pub thermal: Option<super::thermal::ThermalSpec>,
-    /// `[vehicle]` (reserved: vehicle and shift strategy; read by the transient issue).
+    /// `[vehicle]`: the vehicle and its shift strategy.
     #[serde(default)]
-    pub vehicle: Option<toml::Table>,
+    pub vehicle: Option<super::sections::vehicle::VehicleSpec>,
     /// `[[clutch_packs]]`: friction packs of shift elements (open-clutch drag).
     #[serde(default)]
     pub clutch_packs: Vec<super::automatic::ClutchPackSpec>,
     /// `[pump]`: the transmission oil pump.
     #[serde(default)]
     pub pump: Option<super::automatic::PumpSpec>,
-    /// `[launch]`: torque converter between engine and gearbox input (checked by the cycle layer).
+    /// `[launch]`: torque converter between engine and gearbox input.
     #[serde(default)]
-    pub launch: Option<toml::Table>,
+    pub launch: Option<super::sections::launch::LaunchSpec>,
     /// `[[bearings]]`.
     #[serde(default)]
     pub bearings: Vec<super::bearings::BearingSpec>,

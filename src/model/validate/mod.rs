@@ -12,9 +12,10 @@ use std::collections::HashMap;
 use super::gearbox::*;
 use super::problems::Problems;
 use super::schema::*;
+use super::sections::{launch::validate_launch, vehicle::validate_vehicle};
 use super::source::Source;
 use super::thermal::{validate_thermal, GearInfo, LossItemNames, ThermalNetwork};
-use crate::cycle::{GearTable as RatioTable, Vehicle, VehicleSpec};
+use crate::cycle::GearTable as RatioTable;
 
 mod bearings;
 mod common;
@@ -138,10 +139,11 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         .pump
         .as_ref()
         .and_then(|p| super::automatic::validate_pump(p, &member_names, problems));
-    let launch = file.launch.as_ref().and_then(|t| {
-        let gt = RatioTable::new(gear_states.iter().map(|g| (g.name.clone(), g.ratio())).collect());
-        super::automatic::validate_launch(t, &gt, problems)
-    });
+    let ratios = RatioTable::new(gear_states.iter().map(|g| (g.name.clone(), g.ratio())).collect());
+    let launch = file
+        .launch
+        .as_ref()
+        .and_then(|spec| validate_launch(spec, &ratios, problems));
     let auto_names = AutoNames {
         packs: clutch_packs.iter().map(|c| c.name.as_str()).collect(),
         pump: file.pump.is_some(),
@@ -154,7 +156,7 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
     let vehicle = file
         .vehicle
         .as_ref()
-        .and_then(|table| vehicle(table, &gear_states, problems));
+        .and_then(|spec| validate_vehicle(spec, &ratios, problems));
 
     if problems.len() > start {
         return None;
@@ -228,19 +230,4 @@ fn thermal(
     names.set(Source::Bearing, bearings.iter().map(|b| b.name.as_str()));
     names.set(Source::Seal, seals.iter().map(|s| s.name.as_str()));
     validate_thermal(spec, &infos, &names, problems)
-}
-
-/// `[vehicle]` against the gear-state ratios.
-fn vehicle(table: &toml::Table, gear_states: &[GearState], problems: &mut Problems) -> Option<Vehicle> {
-    let gt = RatioTable::new(gear_states.iter().map(|g| (g.name.clone(), g.ratio())).collect());
-    let checked = VehicleSpec::from_table(table).and_then(|spec| spec.validate(&gt));
-    match checked {
-        Ok(v) => Some(v),
-        Err(list) => {
-            for p in list {
-                problems.push(p.path, p.value, p.allowed);
-            }
-            None
-        }
-    }
 }
