@@ -1,79 +1,113 @@
-//! `[[bearings]]` and `[[seals]]`: mounts, catalogue designations, friction models with their
+//! `[[bearings]]`: rolling bearings: mounts, catalogue designations, friction models with their
 //! constants, statics (at most two bearings per member or planet, one locating), heat targets.
 
 use std::collections::{BTreeMap, BTreeSet};
 
+use serde::{Deserialize, Serialize};
+
+use super::bearing_friction::*;
 use super::common::*;
-use super::Ctx;
-use crate::model::bearings::*;
-use crate::model::gearbox::{Gear, GearMount, PlanetarySet};
+use super::gears::{Gear, GearMount};
+use super::parts::Parts;
+use crate::model::bearing_catalogue::{catalogue, BearingType};
 use crate::model::problems::Problems;
 use crate::physics::losses::bearings::skf::{Lubrication, SkfInput};
 use crate::physics::losses::bearings::{BearingFriction, BearingSize, Palmgren, Skf, SkfConstants, SkfKind};
-use crate::physics::losses::seals::{LipSeal, SealLaw};
 
-/// μ_bl of the SKF sliding term (both peers of docs/physics.md §Bearings).
-const MU_BL: f64 = 0.12;
-/// μ_EHL for mineral oils (the SKF online calculator's value, as the MATLAB peer notes; the SKF
-/// catalogue text gives 0.05 for mineral oils, "other bearings").
-const MU_EHL: f64 = 0.05;
-/// μ_EHL of cylindrical roller bearings (SKF catalogue friction chapter, as shown at
-/// yumpu.com/en/document/view/55668573/skf-rolling-bearings/105; the same in peer [P5]).
-const MU_EHL_CYLINDRICAL: f64 = 0.02;
-/// μ_EHL of tapered roller bearings (same source).
-const MU_EHL_TAPERED: f64 = 0.002;
-/// V_M of the roller drag term against H/d_m: SKF's diagram as digitised by peer [P5]
-/// (`drag.py`, "graph digitization" — numbers read from a figure), linear in between, constant
-/// beyond 1.2.
-const DRAG_VM_ROLLER: [(f64, f64); 14] = [
-    (0.0, 0.0),
-    (0.025, 5e-6),
-    (0.05, 3.0e-5),
-    (0.075, 6.0e-5),
-    (0.10, 1.0e-4),
-    (0.125, 1.5e-4),
-    (0.15, 2.1e-4),
-    (0.175, 2.6e-4),
-    (0.20, 3.0e-4),
-    (0.30, 4.8e-4),
-    (0.50, 6.8e-4),
-    (0.80, 1.0e-3),
-    (1.00, 1.25e-3),
-    (1.20, 1.5e-3),
-];
-
-/// V_M of a roller bearing at oil height `h_over_dm` (H/d_m).
-fn drag_vm_roller(h_over_dm: f64) -> f64 {
-    let x = h_over_dm.clamp(0.0, 1.2);
-    DRAG_VM_ROLLER
-        .windows(2)
-        .find(|w| x <= w[1].0)
-        .map_or(DRAG_VM_ROLLER[13].1, |w| {
-            w[0].1 + (w[1].1 - w[0].1) * (x - w[0].0) / (w[1].0 - w[0].0)
-        })
+/// Friction model choice of a bearing.
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum BearingModelChoice {
+    /// SKF (2004) (every type with a catalogue row: all but needle roller bearings).
+    Skf,
+    /// Palmgren.
+    Palmgren,
 }
-/// V_M of the SKF drag term, read from the SKF diagram at full immersion by the Python
-/// deep-groove peer (a number read from a figure), used for any immersion depth.
-const DRAG_VM: f64 = 0.0012;
 
-/// SKF seal constants (K_S1, K_S2, β) by type and outside diameter D (mm): SKF, as listed by
-/// thermca `bearing.seal_heat_loss` [SKF06] (the 62 < D ≤ 80 mm row agrees with the
-/// eMotres catalogue).
-fn seal_constants(kind: BearingType, outside_mm: f64) -> Option<(f64, f64, f64)> {
-    match kind {
-        BearingType::DeepGrooveBall => Some(if outside_mm <= 62.0 {
-            (0.023, 2.0, 2.25)
-        } else if outside_mm <= 80.0 {
-            (0.018, 20.0, 2.25)
-        } else if outside_mm <= 100.0 {
-            (0.018, 15.0, 2.25)
-        } else {
-            (0.018, 0.0, 2.25)
-        }),
-        BearingType::AngularContactBall => Some((0.014, 10.0, 2.0)),
-        BearingType::CylindricalRoller => Some((0.032, 50.0, 2.0)),
-        _ => None,
-    }
+/// `[[bearings]]` as written.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BearingSpec {
+    /// Unique name.
+    pub name: String,
+    /// Member whose shaft runs in the bearing (inner ring); exclusive with `planet`.
+    #[serde(default)]
+    pub member: Option<String>,
+    /// Planet gear the bearing supports on its carrier pin (one bearing per planet).
+    #[serde(default)]
+    pub planet: Option<String>,
+    /// Member holding the outer ring (default: the housing).
+    #[serde(default)]
+    pub outer: Option<String>,
+    /// Catalogue designation.
+    pub designation: String,
+    /// Axial position along the member, mm (the member's axis; gears have `position_mm` too).
+    #[serde(default)]
+    pub position_mm: f64,
+    /// This bearing takes the member's axial load (default: the first bearing of the member).
+    #[serde(default)]
+    pub locating: Option<bool>,
+    /// Friction model (default: `skf` where the type has an SKF row, else `palmgren`).
+    #[serde(default)]
+    pub model: Option<BearingModelChoice>,
+    /// Constant radial load added to the gear loads (e.g. weight), N.
+    #[serde(default)]
+    pub radial_preload_n: f64,
+    /// Constant axial load added to the gear loads (e.g. a preload), N.
+    #[serde(default)]
+    pub axial_preload_n: f64,
+    /// Integral contact seals (SKF seal term; deep-groove ball bearings `-2RS`): `true` uses the
+    /// SKF constants by outside diameter.
+    #[serde(default)]
+    pub sealed: bool,
+    /// Lubrication: `oil_bath` (default; K_rs 3e-8) or `grease` (K_rs 6e-8, no drag).
+    #[serde(default)]
+    pub lubrication: Option<String>,
+    /// Thermal nodes that receive the heat with fractions (default: the member's or planet's
+    /// body node, else the oil).
+    #[serde(default)]
+    pub heat_to: Option<Vec<(String, f64)>>,
+    /// Where the entry's choices come from (free text, shown by `geartherm info`).
+    #[serde(default)]
+    pub source: Option<String>,
+}
+
+/// Where a bearing sits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BearingMount {
+    /// On a member (inner ring), outer ring in the housing or on another member.
+    Member {
+        /// Member index.
+        member: usize,
+        /// Outer-ring member (None: housing).
+        outer: Option<usize>,
+    },
+    /// On a planet's pin: one bearing per planet of the set.
+    Planet {
+        /// Planet gear index.
+        gear: usize,
+    },
+}
+
+/// A checked bearing.
+#[derive(Debug, Clone)]
+pub struct Bearing {
+    /// Name.
+    pub name: String,
+    /// Designation.
+    pub designation: String,
+    /// Mount.
+    pub mount: BearingMount,
+    /// Axial position on its member, m.
+    pub position: f64,
+    /// Takes the axial load of its member.
+    pub locating: bool,
+    /// Friction model with everything constant precomputed.
+    pub friction: BearingFriction,
+    /// Constant radial and axial loads, N.
+    pub preload: (f64, f64),
+    /// Heat destinations named in the file.
+    pub heat_to: Option<Vec<(String, f64)>>,
 }
 
 fn normalise(s: &str) -> String {
@@ -81,40 +115,6 @@ fn normalise(s: &str) -> String {
         .filter(|c| !c.is_whitespace())
         .collect::<String>()
         .to_uppercase()
-}
-
-/// Check a `heat_to` list against the thermal node names.
-fn heat_to(
-    list: &Option<Vec<(String, f64)>>,
-    nodes: &BTreeSet<&str>,
-    path: &str,
-    problems: &mut Problems,
-) -> Option<Vec<(String, f64)>> {
-    let l = list.as_ref()?;
-    let mut sum = 0.0;
-    for (k, (n, f)) in l.iter().enumerate() {
-        if !nodes.contains(n.as_str()) {
-            problems.push(
-                format!("{path}[{k}]"),
-                q(n),
-                format!("unknown thermal node; nodes: {}", list_str(nodes)),
-            );
-        }
-        problems.in_range(&format!("{path}[{k}]"), *f, 0.0, 1.0, "");
-        sum += f;
-    }
-    if (sum - 1.0).abs() > 1e-9 {
-        problems.push(path, sum, "fractions must sum to 1");
-    }
-    Some(l.clone())
-}
-
-fn list_str(s: &BTreeSet<&str>) -> String {
-    if s.is_empty() {
-        "(none: the model has no [thermal] nodes)".into()
-    } else {
-        s.iter().copied().collect::<Vec<_>>().join(", ")
-    }
 }
 
 /// Axis height of a member: the centre height of one of its (non-planet) gears.
@@ -128,27 +128,25 @@ fn member_height(gears: &[Gear], member: usize) -> Option<f64> {
 /// Bearings per body (0 member / 1 planet, index): (bearing index, `locating` as given).
 type BodyBearings = BTreeMap<(u8, usize), Vec<(usize, Option<bool>)>>;
 
-/// Validate `[[bearings]]` and `[[seals]]`.
-pub(super) fn validate_bearings(
-    ctx: &Ctx<'_>,
+/// Check `[[bearings]]`: names, mounts, catalogue designations, friction models with their
+/// constants, heat targets (`nodes`: the thermal node names), and the statics (at most two
+/// bearings per member or planet, one locating).
+pub(crate) fn validate_bearings(
+    specs: &[BearingSpec],
+    nodes: &BTreeSet<&str>,
+    parts: &Parts<'_>,
     gears: &[Gear],
-    sets: &[PlanetarySet],
     oil_level: f64,
     problems: &mut Problems,
-) -> (Vec<Bearing>, Vec<Seal>) {
-    let file = ctx.file;
+) -> Vec<Bearing> {
+    let (gear_specs, members) = (parts.gears.specs, parts.members.specs);
     let (series, catalogue) = catalogue();
-    let nodes: BTreeSet<&str> = file
-        .thermal
-        .as_ref()
-        .map(|t| t.nodes.iter().map(|n| n.name.as_str()).collect())
-        .unwrap_or_default();
     let mut names = BTreeSet::new();
     let mut out = Vec::new();
     let mut per_body: BodyBearings = BTreeMap::new();
-    for (i, b) in file.bearings.iter().enumerate() {
+    for (i, b) in specs.iter().enumerate() {
         let p = format!("bearings[{i}]");
-        if b.name.trim().is_empty() || !b.name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        if !is_identifier(&b.name) {
             problems.push(
                 format!("{p}.name"),
                 q(&b.name),
@@ -159,17 +157,17 @@ pub(super) fn validate_bearings(
         }
         let mount = match (&b.member, &b.planet) {
             (Some(m), None) => {
-                let member = ctx.member(m, format!("{p}.member"), problems);
+                let member = parts.member(m, format!("{p}.member"), problems);
                 let outer = b
                     .outer
                     .as_ref()
-                    .and_then(|o| ctx.member(o, format!("{p}.outer"), problems));
+                    .and_then(|o| parts.member(o, format!("{p}.outer"), problems));
                 member.map(|member| BearingMount::Member { member, outer })
             }
             (None, Some(g)) => {
-                let gear = ctx.gear(g, format!("{p}.planet"), problems);
+                let gear = parts.gear(g, format!("{p}.planet"), problems);
                 match gear {
-                    Some(gi) if ctx.planet_of.contains_key(file.gears[gi].name.as_str()) => {
+                    Some(gi) if parts.is_planet(gi) => {
                         if b.outer.is_some() {
                             problems.push(
                                 format!("{p}.outer"),
@@ -253,7 +251,7 @@ pub(super) fn validate_bearings(
             Some(BearingMount::Member { member, .. }) => member_height(gears, member),
             Some(BearingMount::Planet { gear }) => gears
                 .iter()
-                .find(|g| g.name == file.gears[gear].name)
+                .find(|g| g.name == gear_specs[gear].name)
                 .map(|g| g.centre_height),
             None => None,
         };
@@ -358,7 +356,7 @@ pub(super) fn validate_bearings(
                 }
             }
         };
-        let heat = heat_to(&b.heat_to, &nodes, &format!("{p}.heat_to"), problems);
+        let heat = heat_to(&b.heat_to, nodes, &format!("{p}.heat_to"), problems);
         let Some(mount) = mount else { continue };
         let key = match mount {
             BearingMount::Member { member, .. } => (0u8, member),
@@ -379,9 +377,9 @@ pub(super) fn validate_bearings(
     // Statics: at most two bearings per body, at different positions; one locating.
     for ((kind, idx), list) in &per_body {
         let what = if *kind == 0 {
-            format!("member \"{}\"", file.members[*idx].name)
+            format!("member \"{}\"", members[*idx].name)
         } else {
-            format!("planet \"{}\"", file.gears[*idx].name)
+            format!("planet \"{}\"", gear_specs[*idx].name)
         };
         if list.len() > 2 {
             problems.push(
@@ -405,73 +403,5 @@ pub(super) fn validate_bearings(
             _ => problems.push("bearings", what, "more than one locating bearing"),
         }
     }
-    let _ = sets;
-    let seals = validate_seals(ctx, &nodes, problems);
-    (out, seals)
-}
-
-fn validate_seals(ctx: &Ctx<'_>, nodes: &BTreeSet<&str>, problems: &mut Problems) -> Vec<Seal> {
-    let mut names = BTreeSet::new();
-    let mut out = Vec::new();
-    for (i, s) in ctx.file.seals.iter().enumerate() {
-        let p = format!("seals[{i}]");
-        if s.name.trim().is_empty() || !s.name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
-            problems.push(
-                format!("{p}.name"),
-                q(&s.name),
-                "must be an identifier (letters, digits, _)",
-            );
-        } else if !names.insert(s.name.clone()) {
-            problems.push(format!("{p}.name"), q(&s.name), "duplicate seal name");
-        }
-        let member = ctx.member(&s.member, format!("{p}.member"), problems);
-        let outer = s
-            .outer
-            .as_ref()
-            .and_then(|o| ctx.member(o, format!("{p}.outer"), problems));
-        let ok = problems.in_range(
-            &format!("{p}.shaft_diameter_mm"),
-            s.shaft_diameter_mm,
-            1.0,
-            2000.0,
-            " mm",
-        );
-        let law = match s.torque_nm {
-            Some(t) => {
-                problems.in_range(&format!("{p}.torque_nm"), t, 0.0, 1e4, " N m");
-                SealLaw::Torque(t)
-            }
-            None => SealLaw::Iso14179,
-        };
-        let heat = heat_to(&s.heat_to, nodes, &format!("{p}.heat_to"), problems);
-        if let (Some(member), true) = (member, ok) {
-            out.push(Seal {
-                name: s.name.clone(),
-                member,
-                outer,
-                seal: LipSeal {
-                    shaft_diameter: s.shaft_diameter_mm * MM,
-                    law,
-                },
-                heat_to: heat,
-            });
-        }
-    }
     out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::drag_vm_roller;
-
-    /// The roller V_M curve as the peer P5 interpolates it (its printed values,
-    /// docs/validation.md §Bearings).
-    #[test]
-    fn roller_vm_interpolates_like_the_p5_peer() {
-        for (x, want) in [(0.75, 9.466667e-4), (1.2, 1.5e-3), (10.0 / 46.0, 3.313043e-4)] {
-            assert!((drag_vm_roller(x) / want - 1.0).abs() < 1e-6, "{x}");
-        }
-        assert_eq!(drag_vm_roller(-1.0), 0.0);
-        assert_eq!(drag_vm_roller(5.0), 1.5e-3);
-    }
 }

@@ -3,22 +3,91 @@
 
 use std::collections::HashMap;
 
+use serde::{Deserialize, Serialize};
+
 use super::common::*;
-use super::geometry::mesh_geometry;
-use super::Ctx;
-use crate::model::gearbox::*;
+use super::gears::GearMount;
+use super::meshes::{mesh_geometry, Mesh, MeshLoadPath};
+use super::parts::Parts;
 use crate::model::problems::Problems;
-use crate::model::schema::*;
 use crate::physics::geometry::MeshKind;
-use crate::physics::kinematics::Constraint;
+use crate::physics::kinematics::{planet_spin, ring_pinion_spin, Constraint};
+
+/// Kind of planetary set.
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanetarySetKind {
+    /// Sun – planet – ring.
+    Simple,
+    /// Sun – inner planet – outer planet – ring.
+    DoublePinion,
+    /// Large sun – long planet – ring, plus small sun – short planet – long planet.
+    Ravigneaux,
+}
+
+/// `[[planetary_sets]]` as written: which gears form the set, its carrier and its number of planets.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlanetarySetSpec {
+    /// Unique name.
+    pub name: String,
+    /// `simple`, `double_pinion` or `ravigneaux`.
+    pub kind: PlanetarySetKind,
+    /// Carrier member.
+    pub carrier: String,
+    /// Number of planets (of each planet type).
+    pub planets: i64,
+    /// Ring gear (all kinds).
+    pub ring: String,
+    /// Sun gear (simple, double_pinion).
+    #[serde(default)]
+    pub sun: Option<String>,
+    /// Planet gear (simple).
+    #[serde(default)]
+    pub planet: Option<String>,
+    /// Planet meshing the sun (double_pinion).
+    #[serde(default)]
+    pub inner_planet: Option<String>,
+    /// Planet meshing the ring (double_pinion).
+    #[serde(default)]
+    pub outer_planet: Option<String>,
+    /// Large sun, meshing the long planet (ravigneaux).
+    #[serde(default)]
+    pub large_sun: Option<String>,
+    /// Small sun, meshing the short planet (ravigneaux).
+    #[serde(default)]
+    pub small_sun: Option<String>,
+    /// Long planet: large sun, ring, short planet (ravigneaux).
+    #[serde(default)]
+    pub long_planet: Option<String>,
+    /// Short planet: small sun, long planet (ravigneaux).
+    #[serde(default)]
+    pub short_planet: Option<String>,
+}
+
+/// Gears of a planetary set by role.
+#[derive(Debug, Clone)]
+pub struct PlanetarySet {
+    /// Name.
+    pub name: String,
+    /// Kind.
+    pub kind: PlanetarySetKind,
+    /// Carrier member index.
+    pub carrier: usize,
+    /// Number of planets (of each planet type).
+    pub planets: u32,
+    /// Gear indices in role order: simple `[sun, planet, ring]`, double pinion
+    /// `[sun, inner, outer, ring]`, Ravigneaux `[large_sun, small_sun, long, short, ring]`.
+    pub gears: Vec<usize>,
+}
 
 /// Sets and the mount (and carrier) of every gear.
-pub(super) type Mounts = Vec<(GearMount, Option<usize>)>;
+pub(crate) type Mounts = Vec<(GearMount, Option<usize>)>;
 
 /// Planet roles: gear name → index of the set naming it as a planet.
-pub(super) fn planet_roles(file: &ModelFile) -> HashMap<&str, usize> {
+pub(crate) fn planet_roles(specs: &[PlanetarySetSpec]) -> HashMap<&str, usize> {
     let mut planet_of: HashMap<&str, usize> = HashMap::new();
-    for (si, s) in file.planetary_sets.iter().enumerate() {
+    for (si, s) in specs.iter().enumerate() {
         for p in [
             &s.planet,
             &s.inner_planet,
@@ -37,21 +106,20 @@ pub(super) fn planet_roles(file: &ModelFile) -> HashMap<&str, usize> {
 }
 
 /// Validate `[[planetary_sets]]`: appends their rows to `fixed_rows` and their meshes to `meshes`.
-pub(super) fn validate_sets(
-    ctx: &Ctx<'_>,
+pub(crate) fn validate_sets(
+    specs: &[PlanetarySetSpec],
+    parts: &Parts<'_>,
     meshes: &mut Vec<Mesh>,
     fixed_rows: &mut Vec<Constraint>,
     problems: &mut Problems,
 ) -> (Vec<PlanetarySet>, Mounts) {
-    let file = ctx.file;
-    let (geoms, gear_member) = (&ctx.gears.geoms, &ctx.gears.member);
-    let member = |name: &str, path: String, problems: &mut Problems| ctx.member(name, path, problems);
-    let gear_lookup = |name: &str, path: String, problems: &mut Problems| ctx.gear(name, path, problems);
+    let gear_specs = parts.gears.specs;
+    let (geoms, gear_member) = (&parts.gears.geoms, &parts.gears.member);
     let mut sets: Vec<PlanetarySet> = Vec::new();
-    let mut mounts: Vec<(GearMount, Option<usize>)> = vec![(GearMount::OnMember, None); file.gears.len()];
-    for (si, s) in file.planetary_sets.iter().enumerate() {
+    let mut mounts: Vec<(GearMount, Option<usize>)> = vec![(GearMount::OnMember, None); gear_specs.len()];
+    for (si, s) in specs.iter().enumerate() {
         let p = format!("planetary_sets[{si}]");
-        let carrier = member(&s.carrier, format!("{p}.carrier"), problems);
+        let carrier = parts.member(&s.carrier, format!("{p}.carrier"), problems);
         if !(1..=12).contains(&s.planets) {
             problems.push(format!("{p}.planets"), s.planets, "must be an integer in [1, 12]");
         }
@@ -104,10 +172,10 @@ pub(super) fn validate_sets(
                     );
                     ix.push(None);
                 }
-                Some(name) => ix.push(gear_lookup(name, format!("{p}.{role}"), problems)),
+                Some(name) => ix.push(parts.gear(name, format!("{p}.{role}"), problems)),
             }
         }
-        let ring = gear_lookup(&s.ring, format!("{p}.ring"), problems);
+        let ring = parts.gear(&s.ring, format!("{p}.ring"), problems);
         ix.push(ring);
         if ix.iter().any(Option::is_none) || carrier.is_none() {
             continue;
@@ -121,10 +189,10 @@ pub(super) fn validate_sets(
             let role = if k == nroles { "ring" } else { roles[k].0 };
             let is_planet = role.contains("planet");
             let want_internal = role == "ring";
-            if file.gears[gi].internal != want_internal {
+            if gear_specs[gi].internal != want_internal {
                 problems.push(
                     format!("{p}.{role}"),
-                    q(&file.gears[gi].name),
+                    q(&gear_specs[gi].name),
                     if want_internal {
                         "the ring must be an internal gear (internal = true)"
                     } else {
@@ -137,7 +205,7 @@ pub(super) fn validate_sets(
                 if is_planet && gm != carrier {
                     problems.push(
                         format!("gears[{gi}].member"),
-                        q(&file.gears[gi].member),
+                        q(&gear_specs[gi].member),
                         format!(
                             "planet of set \"{}\": its member must be the carrier \"{}\"",
                             s.name, s.carrier
@@ -148,7 +216,7 @@ pub(super) fn validate_sets(
                 if !is_planet && gm == carrier {
                     problems.push(
                         format!("gears[{gi}].member"),
-                        q(&file.gears[gi].member),
+                        q(&gear_specs[gi].member),
                         "a sun or ring cannot sit on the set's carrier",
                     );
                     ok = false;
@@ -158,7 +226,7 @@ pub(super) fn validate_sets(
         if !ok {
             continue;
         }
-        let z = |gi: usize| file.gears[gi].teeth as f64;
+        let z = |gi: usize| gear_specs[gi].teeth as f64;
         let mem = |gi: usize| gear_member[gi].unwrap_or_default();
         let first_row = fixed_rows.len();
         // Rows, generated meshes (gear1, gear2, kind, load path), and planet mounts.
@@ -259,8 +327,8 @@ pub(super) fn validate_sets(
         let mut centre: HashMap<usize, f64> = HashMap::new();
         let mut gen_ok = true;
         for (g1, g2, mk, rows) in gen {
-            let mp = format!("{p} mesh {}/{}", file.gears[g1].name, file.gears[g2].name);
-            let Some(geo) = mesh_geometry(geoms, g1, g2, mk, None, &mp, file, problems) else {
+            let mp = format!("{p} mesh {}/{}", gear_specs[g1].name, gear_specs[g2].name);
+            let Some(geo) = mesh_geometry(gear_specs, geoms, (g1, g2), mk, None, &mp, problems) else {
                 gen_ok = false;
                 continue;
             };
@@ -277,20 +345,20 @@ pub(super) fn validate_sets(
             });
             if let Some(pg) = planet {
                 if let Some(prev) = centre.insert(pg, geo.a_w) {
-                    if (prev - geo.a_w).abs() > 1e-3 * file.gears[pg].module_mm * MM {
+                    if (prev - geo.a_w).abs() > 1e-3 * gear_specs[pg].module_mm * MM {
                         problems.push(
                             p.to_string(),
                             format!("{:.4} mm vs {:.4} mm", prev / MM, geo.a_w / MM),
                             format!(
                                 "planet \"{}\": its centre distances to the sun and to the ring must be equal (coaxial set); adjust profile shifts or tooth counts",
-                                file.gears[pg].name
+                                gear_specs[pg].name
                             ),
                         );
                     }
                 }
             }
             meshes.push(Mesh {
-                name: format!("{}:{}/{}", s.name, file.gears[g1].name, file.gears[g2].name),
+                name: format!("{}:{}/{}", s.name, gear_specs[g1].name, gear_specs[g2].name),
                 gear1: g1,
                 gear2: g2,
                 geometry: geo,
@@ -310,7 +378,7 @@ pub(super) fn validate_sets(
                             n_pl,
                             format!(
                                 "planets \"{}\" overlap: 2·a·sin(π/N) = {:.2} mm < tip diameter {:.2} mm",
-                                file.gears[pg].name,
+                                gear_specs[pg].name,
                                 (gap + g.d_a) / MM,
                                 g.d_a / MM
                             ),
@@ -349,4 +417,14 @@ fn assembly(problems: &mut Problems, path: &str, what: &str, teeth_sum: f64, n: 
             format!("planets cannot be assembled equally spaced: {what} = {teeth_sum} is not divisible by the number of planets"),
         );
     }
+}
+
+/// Spin factor of a planet meshing the sun.
+pub fn spin_from_sun(z_sun: f64, z_planet: f64) -> f64 {
+    planet_spin(z_sun, z_planet, 1.0, 0.0)
+}
+
+/// Spin factor of a pinion meshing the ring.
+pub fn spin_from_ring(z_ring: f64, z_planet: f64) -> f64 {
+    ring_pinion_spin(z_ring, z_planet, 1.0, 0.0)
 }

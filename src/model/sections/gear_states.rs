@@ -1,99 +1,61 @@
-//! `[[shift_elements]]` and `[[gear_states]]`: elements, and the kinematic solution of every
-//! gear state on the fixed rows of meshes, sets and fixed members.
+//! `[[gear_states]]`: the gears (1st, 2nd, …, R) with their engaged shift elements, and the
+//! kinematic solution of each on the fixed rows of meshes, sets and fixed members.
 
-use std::collections::{BTreeSet, HashMap};
+use std::collections::BTreeSet;
+
+use serde::{Deserialize, Serialize};
 
 use super::common::*;
-use super::Ctx;
-use crate::model::gearbox::*;
+use super::members::MemberSpec;
+use super::shift_elements::{Elements, ShiftElementKind};
 use crate::model::problems::Problems;
-use crate::model::schema::*;
-use crate::physics::kinematics::{Constraint, GearTrain, KinematicsError};
+use crate::physics::kinematics::{Constraint, GearTrain, KinematicsError, StateSolution};
 
-/// Checked shift elements with their name index; `ok` false if any failed.
-pub(super) struct Elements<'a> {
-    pub list: Vec<ShiftElement>,
-    pub ix: HashMap<&'a str, usize>,
-    pub ok: bool,
+/// `[[gear_states]]` as written: a gear (1st, 2nd, ..., R) and the shift elements engaged in it.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct GearStateSpec {
+    /// Name used on the command line and in cycle files ("1", "2", "R").
+    pub name: String,
+    /// Engaged shift elements.
+    #[serde(default)]
+    pub engaged: Vec<String>,
 }
 
-/// Validate `[[shift_elements]]`.
-pub(super) fn validate_shift_elements<'a>(ctx: &Ctx<'a>, problems: &mut Problems) -> Elements<'a> {
-    let file = ctx.file;
-    let member = |name: &str, path: String, problems: &mut Problems| ctx.member(name, path, problems);
-    let mut elem_ix: HashMap<&str, usize> = HashMap::new();
-    let mut elements: Vec<ShiftElement> = Vec::new();
-    let mut elem_ok = true;
-    for (i, e) in file.shift_elements.iter().enumerate() {
-        let p = format!("shift_elements[{i}]");
-        if elem_ix.insert(e.name.as_str(), i).is_some() {
-            problems.push(format!("{p}.name"), q(&e.name), "duplicate shift element name");
-        }
-        let want = match e.kind {
-            ShiftElementKind::Clutch => 2,
-            ShiftElementKind::Brake => 1,
-        };
-        if e.members.len() != want {
-            problems.push(
-                format!("{p}.members"),
-                format!("{:?}", e.members),
-                if want == 2 {
-                    "a clutch joins exactly two members"
-                } else {
-                    "a brake holds exactly one member"
-                },
-            );
-            elem_ok = false;
-            continue;
-        }
-        let ms: Vec<Option<usize>> = e
-            .members
-            .iter()
-            .enumerate()
-            .map(|(k, n)| member(n, format!("{p}.members[{k}]"), problems))
-            .collect();
-        if ms.iter().any(Option::is_none) {
-            elem_ok = false;
-            continue;
-        }
-        let ms: Vec<usize> = ms.into_iter().flatten().collect();
-        if want == 2 && ms[0] == ms[1] {
-            problems.push(
-                format!("{p}.members"),
-                format!("{:?}", e.members),
-                "a clutch must join two different members",
-            );
-            elem_ok = false;
-        }
-        elements.push(ShiftElement {
-            name: e.name.clone(),
-            kind: e.kind,
-            members: ms,
-        });
-    }
+/// A gear state with its solved (lossless) kinematics per unit input speed and torque.
+#[derive(Debug, Clone)]
+pub struct GearState {
+    /// Name ("1", "R").
+    pub name: String,
+    /// Engaged shift elements (indices).
+    pub engaged: Vec<usize>,
+    /// Kinematic solution.
+    pub solution: StateSolution,
+}
 
-    Elements {
-        list: elements,
-        ix: elem_ix,
-        ok: elem_ok,
+impl GearState {
+    /// Ratio ω_in / ω_out (negative in reverse).
+    pub fn ratio(&self) -> f64 {
+        self.solution.ratio()
     }
 }
 
 /// Validate `[[gear_states]]`: the train of `fixed_rows` is built only when the structure had no
 /// problem (`sound`), so one broken mesh is not also reported as an under-determined state.
-pub(super) fn validate_gear_states(
-    ctx: &Ctx<'_>,
+pub(crate) fn validate_gear_states(
+    specs: &[GearStateSpec],
     elements: &Elements<'_>,
+    members: &[MemberSpec],
     fixed_rows: Vec<Constraint>,
     (input, output): (Option<usize>, Option<usize>),
     sound: bool,
     problems: &mut Problems,
 ) -> (Option<GearTrain>, Vec<GearState>) {
-    let file = ctx.file;
-    let (elem_ix, elem_ok, elements) = (&elements.ix, elements.ok, &elements.list);
-    let mut states_spec = file.gear_states.clone();
+    let (elem_ix, elem_ok, element_specs) = (&elements.ix, elements.ok, elements.specs);
+    let elements = &elements.list;
+    let mut states_spec = specs.to_vec();
     if states_spec.is_empty() {
-        if file.shift_elements.is_empty() {
+        if element_specs.is_empty() {
             states_spec.push(GearStateSpec {
                 name: "1".into(),
                 engaged: vec![],
@@ -107,7 +69,7 @@ pub(super) fn validate_gear_states(
         }
     }
     let mut state_names = BTreeSet::new();
-    let member_names: Vec<String> = file.members.iter().map(|m| m.name.clone()).collect();
+    let member_names: Vec<String> = members.iter().map(|m| m.name.clone()).collect();
     // Gear states are solved only on a sound structure, so one broken mesh is not also reported as
     // an under-determined state.
     let train = if sound {
@@ -138,7 +100,7 @@ pub(super) fn validate_gear_states(
                         q(en),
                         format!(
                             "unknown shift element; defined: {}",
-                            list(file.shift_elements.iter().map(|e| &e.name))
+                            list(element_specs.iter().map(|e| &e.name))
                         ),
                     );
                     ok = false;

@@ -1,8 +1,8 @@
 //! `[losses]` → [`LossModels`]: model choices and coefficients, each checked with its key path.
 
-use super::gearbox::{LossModels, PocketingOptions, SlidingChoice};
-use super::problems::Problems;
-use super::schema::LossesSpec;
+use serde::{Deserialize, Serialize};
+
+use crate::model::problems::Problems;
 use crate::physics::losses::churning::{
     changenet::ChangenetParams, seetharaman::CavityTerm, ChurningConfig, ChurningModel,
 };
@@ -11,6 +11,102 @@ use crate::physics::losses::sliding::helical::HelicalDistribution;
 use crate::physics::losses::sliding::load_sharing::LoadSharing;
 use crate::physics::losses::sliding::moment_balance::LossForm;
 use crate::physics::losses::sliding::SlidingOptions;
+
+/// `[losses]` as written: which loss models to use and their coefficients (defaults in docs/model-file.md).
+#[derive(Debug, Clone, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct LossesSpec {
+    /// Churning model: `changenet` (default), `seetharaman`, `stavytskyi` or `off`.
+    #[serde(default)]
+    pub churning: Option<String>,
+    /// Pocketing: `on` (default) or `off`.
+    #[serde(default)]
+    pub pocketing: Option<String>,
+    /// Sliding model: `detailed` (default), `iso14179` (closed form) or `off`.
+    #[serde(default)]
+    pub sliding: Option<String>,
+    /// Friction law of the detailed sliding model: `iso_tc60` (default), `benedict_kelley`,
+    /// `schlenk` or `constant`.
+    #[serde(default)]
+    pub friction: Option<String>,
+    /// μ for `friction = "constant"`.
+    #[serde(default)]
+    pub friction_coefficient: Option<f64>,
+    /// Lubricant factor X_L of the Schlenk / ISO/TR 14179-2 law (1.0 mineral, 0.8 PAO, ...).
+    #[serde(default)]
+    pub lubricant_factor: Option<f64>,
+    /// Spur load sharing: `uniform` (default), `33:67`, `45:55`, `ramp`.
+    #[serde(default)]
+    pub load_sharing: Option<String>,
+    /// Line-load distribution of helical meshes: `niemann_richer` (default) or `uniform`.
+    #[serde(default)]
+    pub helical_distribution: Option<String>,
+    /// `first_order` (default, μ·F·v_g) or `moment_balance` (seed 003).
+    #[serde(default)]
+    pub loss_form: Option<String>,
+    /// Helical meshes: face-width slices (default 50; seed 003 uses 150).
+    #[serde(default)]
+    pub helical_slices: Option<i64>,
+    /// Helical meshes: time samples over one base pitch (default 8).
+    #[serde(default)]
+    pub helical_time_samples: Option<i64>,
+    /// Fraction of a mesh's sliding loss that heats gear 1 (default 0.5).
+    #[serde(default)]
+    pub sliding_heat_to_gear1: Option<f64>,
+    /// Pocketing discharge coefficient C_d (default 0.65).
+    #[serde(default)]
+    pub pocketing_discharge_coefficient: Option<f64>,
+    /// Density of the oil–air mixture pumped by a mesh above the oil level, kg/m³ (no default: unknown, not counted, warned).
+    #[serde(default)]
+    pub pocketing_mixture_density_kg_m3: Option<f64>,
+    /// Seetharaman–Kahraman: face transition Reynolds number (default 5e5).
+    #[serde(default)]
+    pub seetharaman_transition_reynolds: Option<f64>,
+    /// Seetharaman–Kahraman tooth-cavity term: `stokes` (default), `form_drag` or `none`.
+    #[serde(default)]
+    pub seetharaman_cavity: Option<String>,
+    /// Stavytskyi: edge coefficient k_s (0.85 sharp, 0.9 deburred).
+    #[serde(default)]
+    pub stavytskyi_ks: Option<f64>,
+    /// Changenet–Velex low-Re law [factor, exp(h/D), exp(V0/D³), exp(Fr), exp(Re)] [recalled].
+    #[serde(default)]
+    pub changenet_low: Option<[f64; 5]>,
+    /// Changenet–Velex high-Re law [factor, exp(h/D), exp(V0/D³), exp(Fr), exp(b/D)] [recalled].
+    #[serde(default)]
+    pub changenet_high: Option<[f64; 5]>,
+}
+
+/// Pocketing options (resolved from `[losses]`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PocketingOptions {
+    /// Discharge coefficient C_d.
+    pub discharge_coefficient: f64,
+    /// Density pumped by the part of a mesh zone above the oil level, kg/m³; `None` (default):
+    /// unknown, that part is not counted and is reported in `warnings` (docs/validation.md).
+    pub mixture_density: Option<f64>,
+}
+
+/// Sliding-loss model choice.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SlidingChoice {
+    /// No sliding loss.
+    Off,
+    /// Contact-path model (load sharing, local friction law, Niemann–Richer for helical meshes).
+    Detailed(SlidingOptions),
+    /// ISO/TR 14179-2 closed form `P_in μ_mz H_V` with the Schlenk mean friction coefficient.
+    Iso14179(Schlenk, f64),
+}
+
+/// Loss models selected by the model file (`[losses]`), with their coefficients.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LossModels {
+    /// Churning model and coefficients (None: churning off).
+    pub churning: Option<ChurningConfig>,
+    /// Pocketing (None: off).
+    pub pocketing: Option<PocketingOptions>,
+    /// Sliding.
+    pub sliding: SlidingChoice,
+}
 
 /// Default friction law of the detailed sliding model (docs/validation.md, "Defaults").
 pub const DEFAULT_FRICTION: &str = "schlenk";

@@ -1,24 +1,45 @@
-//! `[lubrication]`: oil level, sump volume, gear axis heights, immersion; builds the checked
+//! `[lubrication]`: oil level, sump volume, gear axis heights, immersion; completes the checked
 //! gears.
 
+use serde::{Deserialize, Serialize};
+
 use super::common::*;
-use super::sets::Mounts;
-use super::Ctx;
-use crate::model::gearbox::*;
+use super::gears::{Gear, GearMount};
+use super::meshes::Mesh;
+use super::parts::Parts;
+use super::planetary_sets::{Mounts, PlanetarySet};
 use crate::model::problems::Problems;
 
+/// `[lubrication]` as written: dip lubrication geometry. Heights share one vertical datum (any, e.g. the sump floor).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct LubricationSpec {
+    /// Height of the static oil surface, mm.
+    pub oil_level_mm: f64,
+    /// Height of each non-planet gear's axis, mm, keyed by gear name. Planets orbit: their immersion
+    /// is taken at the lowest position of the orbit (from the sun's axis height).
+    pub centre_height_mm: std::collections::BTreeMap<String, f64>,
+    /// Oil volume in the sump, litres (used by the Changenet–Velex churning model).
+    #[serde(default)]
+    pub sump_volume_l: Option<f64>,
+}
+
 /// Validate `[lubrication]` and build the checked gears; returns them with the oil level (m).
-pub(super) fn validate_lubrication(
-    ctx: &Ctx<'_>,
+pub(crate) fn validate_lubrication(
+    lub: &LubricationSpec,
+    parts: &Parts<'_>,
     sets: &[PlanetarySet],
     meshes: &[Mesh],
     mounts: &Mounts,
     problems: &mut Problems,
 ) -> (Vec<Gear>, f64) {
-    let file = ctx.file;
-    let (gear_ix, planet_of, geoms, gear_member) =
-        (&ctx.gears.ix, &ctx.planet_of, &ctx.gears.geoms, &ctx.gears.member);
-    let lub = &file.lubrication;
+    let gear_specs = parts.gears.specs;
+    let (gear_ix, planet_of, geoms, gear_member) = (
+        &parts.gears.ix,
+        &parts.planet_of,
+        &parts.gears.geoms,
+        &parts.gears.member,
+    );
     if !lub.oil_level_mm.is_finite() {
         problems.push(
             "lubrication.oil_level_mm",
@@ -32,7 +53,7 @@ pub(super) fn validate_lubrication(
     for name in lub.centre_height_mm.keys() {
         match gear_ix.get(name.as_str()) {
             None => problems.push(format!("lubrication.centre_height_mm.{name}"), "", "unknown gear"),
-            Some(&gi) if planet_of.contains_key(file.gears[gi].name.as_str()) => problems.push(
+            Some(&gi) if planet_of.contains_key(gear_specs[gi].name.as_str()) => problems.push(
                 format!("lubrication.centre_height_mm.{name}"),
                 "",
                 "planets orbit: give the centre height of the set's sun instead (planets take the lowest orbit position)",
@@ -40,8 +61,8 @@ pub(super) fn validate_lubrication(
             _ => {}
         }
     }
-    let mut heights: Vec<Option<f64>> = vec![None; file.gears.len()];
-    for (gi, g) in file.gears.iter().enumerate() {
+    let mut heights: Vec<Option<f64>> = vec![None; gear_specs.len()];
+    for (gi, g) in gear_specs.iter().enumerate() {
         if planet_of.contains_key(g.name.as_str()) {
             continue;
         }
@@ -81,7 +102,7 @@ pub(super) fn validate_lubrication(
     }
     let level = lub.oil_level_mm * MM;
     let mut gears = Vec::new();
-    for (gi, g) in file.gears.iter().enumerate() {
+    for (gi, g) in gear_specs.iter().enumerate() {
         let (Some(geo), Some(h), Some(m)) = (geoms[gi].clone(), heights[gi], gear_member[gi]) else {
             continue;
         };
