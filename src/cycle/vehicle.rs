@@ -7,14 +7,11 @@
 //! F_road = m·g·c_rr·cos θ + ½·ρ_air·c_d·A·v² (physical form), plus m·g·sin θ on a grade θ.
 //! Wheel torque T_w = r_w·F_w, gearbox output torque T_out = T_w / i_final.
 
-use serde::{Deserialize, Serialize};
-
 /// Standard gravity, m/s².
 pub const G: f64 = 9.806_65;
 
 /// What the gearbox transmits when the wheels demand negative torque (braking / coasting).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Overrun {
     /// The service brakes take all negative demand; the gearbox transmits zero torque (it still
     /// spins with the wheels, so drag losses remain). Default.

@@ -18,6 +18,7 @@
 
 pub mod bearing_catalogue;
 pub mod catalogue;
+pub mod choice;
 pub mod file;
 pub mod gearbox;
 pub mod overrides;

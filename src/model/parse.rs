@@ -20,9 +20,11 @@ pub fn line_col(text: &str, offset: usize) -> (usize, usize) {
     (line, col)
 }
 
+/// A value as messages show it: strings quoted and escaped (a message stays on one line),
+/// tables and arrays summarised.
 fn describe(v: &Value) -> String {
     match v {
-        Value::String(s) => format!("\"{s}\""),
+        Value::String(s) => format!("{s:?}"),
         Value::Table(_) => "{table}".into(),
         Value::Array(a) => format!("[array of {}]", a.len()),
         other => other.to_string(),

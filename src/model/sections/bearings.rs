@@ -10,18 +10,46 @@ use super::common::*;
 use super::gears::{Gear, GearMount};
 use super::parts::Parts;
 use crate::model::bearing_catalogue::{catalogue, BearingType};
+use crate::model::choice::choice;
 use crate::model::problems::Problems;
 use crate::physics::losses::bearings::skf::{Lubrication, SkfInput};
 use crate::physics::losses::bearings::{BearingFriction, BearingSize, Palmgren, Skf, SkfConstants, SkfKind};
 
 /// Friction model choice of a bearing.
-#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BearingModelChoice {
     /// SKF (2004) (every type with a catalogue row: all but needle roller bearings).
     Skf,
     /// Palmgren.
     Palmgren,
+}
+choice!(BearingModelChoice {
+    Skf = "skf",
+    Palmgren = "palmgren",
+});
+
+/// Lubrication of a bearing.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum LubricationChoice {
+    /// Oil bath, splash or jet: K_rs 3e-8, with the drag term.
+    #[default]
+    OilBath,
+    /// Grease or oil-air: K_rs 6e-8, no drag term.
+    Grease,
+}
+choice!(LubricationChoice {
+    OilBath = "oil_bath",
+    Grease = "grease",
+});
+
+impl LubricationChoice {
+    /// The lubrication method of the SKF model.
+    pub fn method(self) -> Lubrication {
+        match self {
+            LubricationChoice::OilBath => Lubrication::OilBath,
+            LubricationChoice::Grease => Lubrication::Grease,
+        }
+    }
 }
 
 /// `[[bearings]]` as written.
@@ -60,9 +88,9 @@ pub struct BearingSpec {
     /// SKF constants by outside diameter.
     #[serde(default)]
     pub sealed: bool,
-    /// Lubrication: `oil_bath` (default; K_rs 3e-8) or `grease` (K_rs 6e-8, no drag).
+    /// Lubrication (default `oil_bath`).
     #[serde(default)]
-    pub lubrication: Option<String>,
+    pub lubrication: Option<LubricationChoice>,
     /// Thermal nodes that receive the heat with fractions (default: the member's or planet's
     /// body node, else the oil).
     #[serde(default)]
@@ -227,14 +255,7 @@ pub(crate) fn validate_bearings(
             " N",
         );
         problems.in_range(&format!("{p}.axial_preload_n"), b.axial_preload_n, 0.0, 1e7, " N");
-        let lubrication = match b.lubrication.as_deref() {
-            None | Some("oil_bath") => Lubrication::OilBath,
-            Some("grease") => Lubrication::Grease,
-            Some(other) => {
-                problems.push(format!("{p}.lubrication"), q(other), "must be oil_bath or grease");
-                Lubrication::OilBath
-            }
-        };
+        let lubrication = b.lubrication.unwrap_or_default().method();
         let choice = b
             .model
             .unwrap_or(if entry.kind.has_skf() && entry.series.is_some() {

@@ -9,9 +9,10 @@ pub(crate) const MM: f64 = 1e-3;
 /// Degrees → radians.
 pub(crate) const DEG: f64 = std::f64::consts::PI / 180.0;
 
-/// A name in quotes, as messages show it.
+/// A name in quotes, as messages show it (quotes, backslashes and control characters escaped,
+/// so that a message stays on one line).
 pub(crate) fn q(s: &str) -> String {
-    format!("\"{s}\"")
+    format!("{s:?}")
 }
 
 /// Names joined by commas, or `(none)`.

@@ -6,16 +6,19 @@ use serde::{Deserialize, Serialize};
 
 use crate::cycle::parse::{KMH, RPM};
 use crate::cycle::{GearTable, LaunchDevice};
+use crate::model::choice::choice;
 use crate::model::problems::Problems;
 use crate::physics::losses::converter::{Converter, ConverterError};
 
 /// Kind of launch device.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LaunchKind {
     /// Hydrodynamic torque converter (with optional lock-up clutch).
     TorqueConverter,
 }
+choice!(LaunchKind {
+    TorqueConverter = "torque_converter",
+});
 
 /// `[launch.lockup]`: where the lock-up clutch is closed.
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]

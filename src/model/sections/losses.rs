@@ -1,7 +1,9 @@
-//! `[losses]` → [`LossModels`]: model choices and coefficients, each checked with its key path.
+//! `[losses]` → [`LossModels`]: model choices (each an enum, read once with the file) and
+//! coefficients, each checked with its key path.
 
 use serde::{Deserialize, Serialize};
 
+use crate::model::choice::choice;
 use crate::model::problems::Problems;
 use crate::physics::losses::churning::{
     changenet::ChangenetParams, seetharaman::CavityTerm, ChurningConfig, ChurningModel,
@@ -12,38 +14,174 @@ use crate::physics::losses::sliding::load_sharing::LoadSharing;
 use crate::physics::losses::sliding::moment_balance::LossForm;
 use crate::physics::losses::sliding::SlidingOptions;
 
-/// `[losses]` as written: which loss models to use and their coefficients (defaults in docs/model-file.md).
+/// `churning`: the churning model (docs/physics.md §5).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum ChurningChoice {
+    /// Changenet–Velex (the only one fitted to measurements; needs `lubrication.sump_volume_l`).
+    #[default]
+    Changenet,
+    /// Seetharaman–Kahraman.
+    Seetharaman,
+    /// Stavytskyi.
+    Stavytskyi,
+    /// No churning loss.
+    Off,
+}
+choice!(ChurningChoice {
+    Changenet = "changenet",
+    Seetharaman = "seetharaman",
+    Stavytskyi = "stavytskyi",
+    Off = "off",
+});
+
+/// `pocketing`: pocketing of external meshes (docs/physics.md §6) on or off.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum PocketingChoice {
+    /// Counted.
+    #[default]
+    On,
+    /// Not counted.
+    Off,
+}
+choice!(PocketingChoice {
+    On = "on",
+    Off = "off",
+});
+
+/// `sliding`: the sliding-loss model.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum SlidingModelChoice {
+    /// Contact-path model (load sharing, local friction law, helical line-load distribution).
+    #[default]
+    Detailed,
+    /// ISO/TR 14179-2 closed form `P_in μ_mz H_V`.
+    Iso14179,
+    /// No sliding loss.
+    Off,
+}
+choice!(SlidingModelChoice {
+    Detailed = "detailed",
+    Iso14179 = "iso14179",
+    Off = "off",
+});
+
+/// `friction`: the friction law of the detailed sliding model.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum FrictionChoice {
+    /// ISO TC60.
+    IsoTc60,
+    /// Benedict–Kelley.
+    BenedictKelley,
+    /// Schlenk (the default: docs/validation.md, "Defaults").
+    #[default]
+    Schlenk,
+    /// A constant μ (`friction_coefficient`).
+    Constant,
+}
+choice!(FrictionChoice {
+    IsoTc60 = "iso_tc60",
+    BenedictKelley = "benedict_kelley",
+    Schlenk = "schlenk",
+    Constant = "constant",
+});
+
+/// `load_sharing`: load sharing of spur meshes in double contact.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum LoadSharingChoice {
+    /// 50:50.
+    #[default]
+    Uniform,
+    /// 1/3 : 2/3.
+    Share33_67,
+    /// 0.45 : 0.55.
+    Share45_55,
+    /// Linear ramp.
+    Ramp,
+}
+choice!(LoadSharingChoice {
+    Uniform = "uniform",
+    Share33_67 = "33:67",
+    Share45_55 = "45:55",
+    Ramp = "ramp",
+});
+
+/// `helical_distribution`: line load along the contact lines of helical meshes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum HelicalDistributionChoice {
+    /// Niemann–Richer.
+    NiemannRicher,
+    /// Constant load per unit line length (the default: docs/validation.md, "Defaults").
+    #[default]
+    Uniform,
+}
+choice!(HelicalDistributionChoice {
+    NiemannRicher = "niemann_richer",
+    Uniform = "uniform",
+});
+
+/// `loss_form`: how the friction power of a contact element is formed.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum LossFormChoice {
+    /// μ·F·v_g.
+    #[default]
+    FirstOrder,
+    /// Seed 003's moment-balance ratio.
+    MomentBalance,
+}
+choice!(LossFormChoice {
+    FirstOrder = "first_order",
+    MomentBalance = "moment_balance",
+});
+
+/// `seetharaman_cavity`: the tooth-cavity term of the Seetharaman–Kahraman model.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum CavityChoice {
+    /// Lid-driven Stokes cavity.
+    #[default]
+    Stokes,
+    /// Form drag of the immersed teeth (C_D = 1).
+    FormDrag,
+    /// No cavity term.
+    None,
+}
+choice!(CavityChoice {
+    Stokes = "stokes",
+    FormDrag = "form_drag",
+    None = "none",
+});
+
+/// `[losses]` as written: which loss models to use and their coefficients (defaults in
+/// docs/model-file.md).
 #[derive(Debug, Clone, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LossesSpec {
-    /// Churning model: `changenet` (default), `seetharaman`, `stavytskyi` or `off`.
+    /// Churning model (default `changenet`).
     #[serde(default)]
-    pub churning: Option<String>,
-    /// Pocketing: `on` (default) or `off`.
+    pub churning: Option<ChurningChoice>,
+    /// Pocketing (default `on`).
     #[serde(default)]
-    pub pocketing: Option<String>,
-    /// Sliding model: `detailed` (default), `iso14179` (closed form) or `off`.
+    pub pocketing: Option<PocketingChoice>,
+    /// Sliding model (default `detailed`).
     #[serde(default)]
-    pub sliding: Option<String>,
-    /// Friction law of the detailed sliding model: `iso_tc60` (default), `benedict_kelley`,
-    /// `schlenk` or `constant`.
+    pub sliding: Option<SlidingModelChoice>,
+    /// Friction law of the detailed sliding model (default `schlenk`).
     #[serde(default)]
-    pub friction: Option<String>,
+    pub friction: Option<FrictionChoice>,
     /// μ for `friction = "constant"`.
     #[serde(default)]
     pub friction_coefficient: Option<f64>,
     /// Lubricant factor X_L of the Schlenk / ISO/TR 14179-2 law (1.0 mineral, 0.8 PAO, ...).
     #[serde(default)]
     pub lubricant_factor: Option<f64>,
-    /// Spur load sharing: `uniform` (default), `33:67`, `45:55`, `ramp`.
+    /// Spur load sharing (default `uniform`).
     #[serde(default)]
-    pub load_sharing: Option<String>,
-    /// Line-load distribution of helical meshes: `niemann_richer` (default) or `uniform`.
+    pub load_sharing: Option<LoadSharingChoice>,
+    /// Line-load distribution of helical meshes (default `uniform`).
     #[serde(default)]
-    pub helical_distribution: Option<String>,
-    /// `first_order` (default, μ·F·v_g) or `moment_balance` (seed 003).
+    pub helical_distribution: Option<HelicalDistributionChoice>,
+    /// Loss form (default `first_order`).
     #[serde(default)]
-    pub loss_form: Option<String>,
+    pub loss_form: Option<LossFormChoice>,
     /// Helical meshes: face-width slices (default 50; seed 003 uses 150).
     #[serde(default)]
     pub helical_slices: Option<i64>,
@@ -62,9 +200,9 @@ pub struct LossesSpec {
     /// Seetharaman–Kahraman: face transition Reynolds number (default 5e5).
     #[serde(default)]
     pub seetharaman_transition_reynolds: Option<f64>,
-    /// Seetharaman–Kahraman tooth-cavity term: `stokes` (default), `form_drag` or `none`.
+    /// Seetharaman–Kahraman tooth-cavity term (default `stokes`).
     #[serde(default)]
-    pub seetharaman_cavity: Option<String>,
+    pub seetharaman_cavity: Option<CavityChoice>,
     /// Stavytskyi: edge coefficient k_s (0.85 sharp, 0.9 deburred).
     #[serde(default)]
     pub stavytskyi_ks: Option<f64>,
@@ -74,6 +212,51 @@ pub struct LossesSpec {
     /// Changenet–Velex high-Re law [factor, exp(h/D), exp(V0/D³), exp(Fr), exp(b/D)] [recalled].
     #[serde(default)]
     pub changenet_high: Option<[f64; 5]>,
+}
+
+impl LoadSharingChoice {
+    /// The load-sharing model.
+    pub fn law(self) -> LoadSharing {
+        match self {
+            LoadSharingChoice::Uniform => LoadSharing::Uniform,
+            LoadSharingChoice::Share33_67 => LoadSharing::Share33_67,
+            LoadSharingChoice::Share45_55 => LoadSharing::Share45_55,
+            LoadSharingChoice::Ramp => LoadSharing::Ramp,
+        }
+    }
+}
+
+impl HelicalDistributionChoice {
+    /// The line-load distribution (Niemann–Richer with its default coefficient).
+    pub fn law(self) -> HelicalDistribution {
+        match self {
+            HelicalDistributionChoice::NiemannRicher => HelicalDistribution::default(),
+            HelicalDistributionChoice::Uniform => HelicalDistribution::Uniform,
+        }
+    }
+}
+
+impl LossFormChoice {
+    /// The loss form.
+    pub fn law(self) -> LossForm {
+        match self {
+            LossFormChoice::FirstOrder => LossForm::FirstOrder,
+            LossFormChoice::MomentBalance => LossForm::MomentBalance,
+        }
+    }
+}
+
+impl CavityChoice {
+    /// The cavity term (form drag with C_D = 1).
+    pub fn term(self) -> CavityTerm {
+        match self {
+            CavityChoice::Stokes => CavityTerm::default(),
+            CavityChoice::FormDrag => CavityTerm::FormDrag {
+                drag_coefficient: 1.0,
+            },
+            CavityChoice::None => CavityTerm::None,
+        }
+    }
 }
 
 /// Pocketing options (resolved from `[losses]`).
@@ -108,34 +291,8 @@ pub struct LossModels {
     pub sliding: SlidingChoice,
 }
 
-/// Default friction law of the detailed sliding model (docs/validation.md, "Defaults").
-pub const DEFAULT_FRICTION: &str = "schlenk";
-/// Default line-load distribution of helical meshes (docs/validation.md, "Defaults").
-pub const DEFAULT_HELICAL_DISTRIBUTION: &str = "uniform";
-
 /// Default discharge coefficient of pocketing (physics.md §6: 0.6–0.7).
 pub const DEFAULT_DISCHARGE_COEFFICIENT: f64 = 0.65;
-
-fn choice<'a>(
-    problems: &mut Problems,
-    path: &str,
-    v: &'a Option<String>,
-    allowed: &[&'a str],
-    default: &'a str,
-) -> Option<&'a str> {
-    match v.as_deref() {
-        None => Some(default),
-        Some(x) if allowed.contains(&x) => Some(x),
-        Some(x) => {
-            problems.push(
-                path,
-                format!("\"{x}\""),
-                format!("must be one of: {}", allowed.join(", ")),
-            );
-            None
-        }
-    }
-}
 
 /// Resolve and check `[losses]`. `sump_volume_l` feeds the Changenet–Velex model.
 pub fn validate_losses(
@@ -144,35 +301,29 @@ pub fn validate_losses(
     problems: &mut Problems,
 ) -> Option<LossModels> {
     let start = problems.len();
-    // Churning.
-    let churning_model = choice(
-        problems,
-        "losses.churning",
-        &l.churning,
-        &["changenet", "seetharaman", "stavytskyi", "off"],
-        "changenet",
-    );
+    let churning = churning(l, sump_volume_l, problems);
+    let pocketing = pocketing(l, problems);
+    let sliding = sliding(l, problems);
+    if problems.len() > start {
+        return None;
+    }
+    Some(LossModels {
+        churning,
+        pocketing,
+        sliding,
+    })
+}
+
+/// The churning model with its coefficients (None: churning off).
+fn churning(l: &LossesSpec, sump_volume_l: Option<f64>, problems: &mut Problems) -> Option<ChurningConfig> {
+    let model = l.churning.unwrap_or_default();
     let mut cfg = ChurningConfig::default();
     if let Some(re) = l.seetharaman_transition_reynolds {
         if problems.in_range("losses.seetharaman_transition_reynolds", re, 1e3, 1e8, "") {
             cfg.seetharaman.transition_reynolds = re;
         }
     }
-    match choice(
-        problems,
-        "losses.seetharaman_cavity",
-        &l.seetharaman_cavity,
-        &["stokes", "form_drag", "none"],
-        "stokes",
-    ) {
-        Some("form_drag") => {
-            cfg.seetharaman.cavity = CavityTerm::FormDrag {
-                drag_coefficient: 1.0,
-            }
-        }
-        Some("none") => cfg.seetharaman.cavity = CavityTerm::None,
-        _ => {}
-    }
+    cfg.seetharaman.cavity = l.seetharaman_cavity.unwrap_or_default().term();
     if let Some(ks) = l.stavytskyi_ks {
         if problems.in_range("losses.stavytskyi_ks", ks, 0.1, 1.0, "") {
             cfg.stavytskyi.k_s = ks;
@@ -196,36 +347,33 @@ pub fn validate_losses(
     }
     if let Some(v) = sump_volume_l {
         cfg.changenet.sump_oil_volume = v * 1e-3;
-    } else if churning_model == Some("changenet") {
+    } else if model == ChurningChoice::Changenet {
         cfg.changenet.sump_oil_volume = ChangenetParams::default().sump_oil_volume;
-    }
-    let churning = match churning_model {
-        Some("off") | None => None,
-        Some(m) => {
-            cfg.model = match m {
-                "seetharaman" => ChurningModel::Seetharaman,
-                "stavytskyi" => ChurningModel::Stavytskyi,
-                _ => ChurningModel::Changenet,
-            };
-            Some(cfg)
-        }
-    };
-    if churning_model == Some("changenet") && sump_volume_l.is_none() {
         problems.push(
             "lubrication.sump_volume_l",
             "",
             "required by the Changenet–Velex churning model (or choose losses.churning = \"seetharaman\")",
         );
     }
+    cfg.model = match model {
+        ChurningChoice::Changenet => ChurningModel::Changenet,
+        ChurningChoice::Seetharaman => ChurningModel::Seetharaman,
+        ChurningChoice::Stavytskyi => ChurningModel::Stavytskyi,
+        ChurningChoice::Off => return None,
+    };
+    Some(cfg)
+}
 
-    // Pocketing.
-    let pocketing = match choice(problems, "losses.pocketing", &l.pocketing, &["on", "off"], "on") {
-        Some("on") => {
+/// Pocketing options (None: pocketing off).
+fn pocketing(l: &LossesSpec, problems: &mut Problems) -> Option<PocketingOptions> {
+    match l.pocketing.unwrap_or_default() {
+        PocketingChoice::Off => None,
+        PocketingChoice::On => {
             let cd = l
                 .pocketing_discharge_coefficient
                 .unwrap_or(DEFAULT_DISCHARGE_COEFFICIENT);
             problems.in_range("losses.pocketing_discharge_coefficient", cd, 0.1, 1.0, "");
-            // No default: the density a mesh above the oil pumps has no source (issue 14).
+            // No default: the density a mesh above the oil pumps has no source.
             let rho = l.pocketing_mixture_density_kg_m3;
             if let Some(r) = rho {
                 problems.in_range("losses.pocketing_mixture_density_kg_m3", r, 0.0, 1000.0, " kg/m3");
@@ -235,80 +383,23 @@ pub fn validate_losses(
                 mixture_density: rho,
             })
         }
-        _ => None,
-    };
+    }
+}
 
-    // Sliding.
+/// The sliding model with its friction law and options.
+fn sliding(l: &LossesSpec, problems: &mut Problems) -> SlidingChoice {
     let xl = l.lubricant_factor.unwrap_or(1.0);
     problems.in_range("losses.lubricant_factor", xl, 0.3, 2.0, "");
     let schlenk = Schlenk {
         x_l: xl,
         ..Schlenk::default()
     };
-    let friction = match choice(
-        problems,
-        "losses.friction",
-        &l.friction,
-        &["iso_tc60", "benedict_kelley", "schlenk", "constant"],
-        // Chosen by the evidence (docs/validation.md, "Defaults"): within 0.1–3 % of GEARpie on
-        // the held-out FZG pairs, where ISO TC60 is 1.5–1.9× higher.
-        DEFAULT_FRICTION,
-    ) {
-        Some("benedict_kelley") => FrictionLaw::BenedictKelley(BenedictKelley::default()),
-        Some("schlenk") => FrictionLaw::Schlenk(schlenk),
-        Some("constant") => match l.friction_coefficient {
-            Some(mu) if problems.in_range("losses.friction_coefficient", mu, 0.0, 0.5, "") => {
-                FrictionLaw::Constant(mu)
-            }
-            Some(_) => FrictionLaw::Constant(0.0),
-            None => {
-                problems.push(
-                    "losses.friction_coefficient",
-                    "",
-                    "required when losses.friction = \"constant\"",
-                );
-                FrictionLaw::Constant(0.0)
-            }
-        },
-        _ => FrictionLaw::IsoTc60(IsoTc60::default()),
-    };
-    let load_sharing = match choice(
-        problems,
-        "losses.load_sharing",
-        &l.load_sharing,
-        &["uniform", "33:67", "45:55", "ramp"],
-        "uniform",
-    ) {
-        Some("33:67") => LoadSharing::Share33_67,
-        Some("45:55") => LoadSharing::Share45_55,
-        Some("ramp") => LoadSharing::Ramp,
-        _ => LoadSharing::Uniform,
-    };
-    let helical_distribution = match choice(
-        problems,
-        "losses.helical_distribution",
-        &l.helical_distribution,
-        &["niemann_richer", "uniform"],
-        DEFAULT_HELICAL_DISTRIBUTION,
-    ) {
-        Some("niemann_richer") => HelicalDistribution::default(),
-        _ => HelicalDistribution::Uniform,
-    };
-    let loss_form = match choice(
-        problems,
-        "losses.loss_form",
-        &l.loss_form,
-        &["first_order", "moment_balance"],
-        "first_order",
-    ) {
-        Some("moment_balance") => LossForm::MomentBalance,
-        _ => LossForm::FirstOrder,
-    };
+    let friction = friction(l, schlenk, problems);
     let mut opts = SlidingOptions {
         friction,
-        load_sharing,
-        helical_distribution,
-        loss_form,
+        load_sharing: l.load_sharing.unwrap_or_default().law(),
+        helical_distribution: l.helical_distribution.unwrap_or_default().law(),
+        loss_form: l.loss_form.unwrap_or_default().law(),
         slices: 50,
         helical_time_samples: 8,
         ..SlidingOptions::default()
@@ -336,23 +427,32 @@ pub fn validate_losses(
             opts.heat_to_gear1 = f;
         }
     }
-    let sliding = match choice(
-        problems,
-        "losses.sliding",
-        &l.sliding,
-        &["detailed", "iso14179", "off"],
-        "detailed",
-    ) {
-        Some("iso14179") => SlidingChoice::Iso14179(schlenk, opts.heat_to_gear1),
-        Some("off") => SlidingChoice::Off,
-        _ => SlidingChoice::Detailed(opts),
-    };
-    if problems.len() > start {
-        return None;
+    match l.sliding.unwrap_or_default() {
+        SlidingModelChoice::Detailed => SlidingChoice::Detailed(opts),
+        SlidingModelChoice::Iso14179 => SlidingChoice::Iso14179(schlenk, opts.heat_to_gear1),
+        SlidingModelChoice::Off => SlidingChoice::Off,
     }
-    Some(LossModels {
-        churning,
-        pocketing,
-        sliding,
-    })
+}
+
+/// The friction law of the detailed model (`schlenk`: with the file's lubricant factor).
+fn friction(l: &LossesSpec, schlenk: Schlenk, problems: &mut Problems) -> FrictionLaw {
+    match l.friction.unwrap_or_default() {
+        FrictionChoice::IsoTc60 => FrictionLaw::IsoTc60(IsoTc60::default()),
+        FrictionChoice::BenedictKelley => FrictionLaw::BenedictKelley(BenedictKelley::default()),
+        FrictionChoice::Schlenk => FrictionLaw::Schlenk(schlenk),
+        FrictionChoice::Constant => match l.friction_coefficient {
+            Some(mu) if problems.in_range("losses.friction_coefficient", mu, 0.0, 0.5, "") => {
+                FrictionLaw::Constant(mu)
+            }
+            Some(_) => FrictionLaw::Constant(0.0),
+            None => {
+                problems.push(
+                    "losses.friction_coefficient",
+                    "",
+                    "required when losses.friction = \"constant\"",
+                );
+                FrictionLaw::Constant(0.0)
+            }
+        },
+    }
 }

@@ -6,11 +6,11 @@ use std::collections::HashMap;
 use serde::{Deserialize, Serialize};
 
 use super::common::*;
+use crate::model::choice::choice;
 use crate::model::problems::Problems;
 
 /// What kind of rotating member (informational; kinematics treats all alike).
-#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MemberKind {
     /// A shaft.
     Shaft,
@@ -19,6 +19,11 @@ pub enum MemberKind {
     /// A drum or hub (e.g. a clutch drum carrying a ring gear).
     Drum,
 }
+choice!(MemberKind {
+    Shaft = "shaft",
+    Carrier = "carrier",
+    Drum = "drum",
+});
 
 /// `[[members]]` as written.
 #[derive(Debug, Clone, Deserialize, Serialize)]

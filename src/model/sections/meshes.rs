@@ -6,19 +6,23 @@ use serde::{Deserialize, Serialize};
 use super::common::*;
 use super::gears::GearSpecFile;
 use super::parts::Parts;
+use crate::model::choice::choice;
 use crate::model::problems::Problems;
 use crate::physics::geometry::{GearGeometry, MeshGeometry, MeshKind};
 use crate::physics::kinematics::Constraint;
 
 /// External or internal mesh.
-#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MeshKindSpec {
     /// Two external gears.
     External,
     /// An external pinion inside an internal (ring) gear; list the pinion first.
     Internal,
 }
+choice!(MeshKindSpec {
+    External = "external",
+    Internal = "internal",
+});
 
 /// `[[meshes]]` as written: a fixed-axis gear pair (planetary-set meshes are generated from the set).
 #[derive(Debug, Clone, Deserialize, Serialize)]

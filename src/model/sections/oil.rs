@@ -4,6 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use super::common::q;
 use crate::model::catalogue;
+use crate::model::choice::choice;
 use crate::model::problems::Problems;
 use crate::physics::oil::{Oil, WaltherVariant, ALPHA_T_MINERAL, CST};
 
@@ -30,9 +31,15 @@ pub struct OilSpec {
     #[serde(default)]
     pub thermal_expansion_per_k: Option<f64>,
     /// Walther constant: `astm_d341` (0.7, default), `c06` (0.6, seed 001), `c08` (0.8, DIN 51563).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::model::choice::optional")]
     pub walther: Option<WaltherVariant>,
 }
+
+choice!(@names WaltherVariant {
+    AstmD341 = "astm_d341",
+    C06 = "c06",
+    C08 = "c08",
+});
 
 /// Check `[oil]` and build the oil.
 pub(crate) fn validate_oil(o: &OilSpec, problems: &mut Problems) -> Option<Oil> {

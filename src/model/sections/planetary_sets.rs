@@ -9,13 +9,13 @@ use super::common::*;
 use super::gears::GearMount;
 use super::meshes::{mesh_geometry, Mesh, MeshLoadPath};
 use super::parts::Parts;
+use crate::model::choice::{choice, Choice};
 use crate::model::problems::Problems;
 use crate::physics::geometry::MeshKind;
 use crate::physics::kinematics::{planet_spin, ring_pinion_spin, Constraint};
 
 /// Kind of planetary set.
-#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PlanetarySetKind {
     /// Sun – planet – ring.
     Simple,
@@ -24,6 +24,11 @@ pub enum PlanetarySetKind {
     /// Large sun – long planet – ring, plus small sun – short planet – long planet.
     Ravigneaux,
 }
+choice!(PlanetarySetKind {
+    Simple = "simple",
+    DoublePinion = "double_pinion",
+    Ravigneaux = "ravigneaux",
+});
 
 /// `[[planetary_sets]]` as written: which gears form the set, its carrier and its number of planets.
 #[derive(Debug, Clone, Deserialize, Serialize)]
@@ -168,7 +173,7 @@ pub(crate) fn validate_sets(
                     problems.push(
                         format!("{p}.{role}"),
                         "",
-                        format!("required for a {} set", kind_name(s.kind)),
+                        format!("required for a {} set", s.kind.name()),
                     );
                     ix.push(None);
                 }
@@ -397,14 +402,6 @@ pub(crate) fn validate_sets(
     }
 
     (sets, mounts)
-}
-
-fn kind_name(k: PlanetarySetKind) -> &'static str {
-    match k {
-        PlanetarySetKind::Simple => "simple",
-        PlanetarySetKind::DoublePinion => "double_pinion",
-        PlanetarySetKind::Ravigneaux => "ravigneaux",
-    }
 }
 
 /// Equal spacing of N planets needs `teeth_sum / N` to be an integer (standard assembly condition).

@@ -6,17 +6,21 @@ use serde::{Deserialize, Serialize};
 
 use super::common::*;
 use super::members::Members;
+use crate::model::choice::choice;
 use crate::model::problems::Problems;
 
 /// Clutch or brake.
-#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ShiftElementKind {
     /// Joins two members when engaged.
     Clutch,
     /// Holds one member to the housing when engaged.
     Brake,
 }
+choice!(ShiftElementKind {
+    Clutch = "clutch",
+    Brake = "brake",
+});
 
 /// `[[shift_elements]]` as written.
 #[derive(Debug, Clone, Deserialize, Serialize)]

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::cycle::parse::{KMH, RPM};
 use crate::cycle::vehicle::G;
 use crate::cycle::{GearTable, Overrun, RoadLoad, ShiftStrategy, Vehicle};
+use crate::model::choice::choice;
 use crate::model::problems::Problems;
 
 fn default_rotating_mass_factor() -> f64 {
@@ -18,6 +19,11 @@ fn default_standstill_kmh() -> f64 {
 fn default_min_hold_s() -> f64 {
     2.0
 }
+
+choice!(Overrun {
+    Zero = "zero",
+    Transmit = "transmit",
+});
 
 /// `[vehicle.road_load]`: either the coast-down coefficients (`f0_n`, `f1_n_per_mps`,
 /// `f2_n_per_mps2`) or the physical parameters (`drag_coefficient`, `frontal_area_m2`,

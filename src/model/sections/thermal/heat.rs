@@ -16,9 +16,9 @@ pub struct HeatSpec {
     /// One item: `churning:<gear>`, `pocketing:<mesh>` or `sliding:<mesh>`.
     #[serde(default)]
     pub item: Option<String>,
-    /// Every item of a source: `churning`, `pocketing` or `sliding`.
+    /// Every item of a source (a [`Source`] name: `churning`, `pocketing`, `sliding`, …).
     #[serde(default)]
-    pub source: Option<String>,
+    pub source: Option<Source>,
     /// Node → fraction (sum 1).
     pub to: BTreeMap<String, f64>,
 }
@@ -26,7 +26,7 @@ pub struct HeatSpec {
 /// What a heat rule applies to.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum HeatTarget {
-    /// All items of a source (`churning`, `pocketing`, `sliding`).
+    /// All items of a source (its name, [`Source::as_str`]).
     Source(String),
     /// One item, `source:name`.
     Item(String),
@@ -75,16 +75,7 @@ fn target(h: &HeatSpec, p: &str, items: &LossItemNames<'_>, problems: &mut Probl
             }
             Some(HeatTarget::Item(item.clone()))
         }
-        (None, Some(s)) => {
-            if Source::parse(s).is_none() {
-                problems.push(
-                    format!("{p}.source"),
-                    s,
-                    format!("must be one of {}", Source::names()),
-                );
-            }
-            Some(HeatTarget::Source(s.clone()))
-        }
+        (None, Some(s)) => Some(HeatTarget::Source(s.as_str().to_string())),
         _ => {
             problems.push(p, "", "give either item or source");
             None

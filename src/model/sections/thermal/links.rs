@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::common::{GearInfo, NodeNames, NodeRef};
+use crate::model::choice::choice;
 use crate::model::problems::Problems;
 use crate::physics::thermal::{HTable, STEFAN_BOLTZMANN};
 
@@ -28,14 +29,17 @@ pub struct HLawSpec {
 }
 
 /// Fluid around a rotating part.
-#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Fluid {
     /// Air at 50 °C.
     Air,
     /// The gearbox oil at the oil node's temperature.
     Oil,
 }
+choice!(Fluid {
+    Air = "air",
+    Oil = "oil",
+});
 
 /// Rotating-disc correlation on a gear.
 #[derive(Debug, Clone, Deserialize, Serialize)]
