@@ -119,70 +119,14 @@ pub fn schedule_with_launch(
     launch: Option<&LaunchDevice>,
 ) -> Result<Schedule, CycleError> {
     let src = cycle.source.as_str();
-    if gears.states.is_empty() {
-        return Err(CycleError::new(
-            CycleErrorKind::Config,
-            src,
-            "the gearbox has no gear state",
-        ));
-    }
-    for (n, r) in &gears.states {
-        if !(r.is_finite() && *r != 0.0) {
-            return Err(CycleError::new(
-                CycleErrorKind::Config,
-                src,
-                format!("gear state {n} has ratio {r}; a finite non-zero ratio is needed"),
-            ));
-        }
-    }
-    // Gear-column lookups, with the file line in the error.
-    let gear_of = |k: usize| -> Result<Option<usize>, CycleError> {
-        let row = &cycle.rows[k];
-        match &row.gear {
-            None => Ok(None),
-            Some(g) => gears.index_of(g).map(Some).ok_or_else(|| {
-                CycleError::new(
-                    CycleErrorKind::UnknownGear,
-                    src,
-                    format!("not a gear state of the model ({})", gears.names().join(", ")),
-                )
-                .at_line(row.line)
-                .at_value("gear", g.clone())
-            }),
-        }
-    };
-
+    check_gear_table(gears, src)?;
     // Every row's gear must exist, the last one included (it only closes the last interval, but
     // a name the model does not know is a mistake in the file either way).
     for k in 0..cycle.rows.len() {
-        gear_of(k)?;
+        gear_of(cycle, k, gears)?;
     }
-    let n = cycle.rows.len().saturating_sub(1);
-    let mut out: Vec<Interval> = Vec::with_capacity(n);
-    match cycle.kind {
-        CycleKind::Rig => {
-            for k in 0..n {
-                let (r0, r1) = (&cycle.rows[k], &cycle.rows[k + 1]);
-                let gear = gear_of(k)?.unwrap_or(0);
-                let (w, t) = (r0.input_speed, r0.input_torque);
-                out.push(Interval {
-                    t0: r0.time,
-                    t1: r1.time,
-                    vehicle_speed: 0.0,
-                    gear,
-                    input_speed: w,
-                    input_torque: t,
-                    output_power: t * w,
-                    standstill: w <= 0.0,
-                    engine_speed: w,
-                    engine_torque: t,
-                    converter_loss: 0.0,
-                    lockup: false,
-                    shift: false,
-                    jump: false,
-                });
-            }
-        }
+    let mut out = match cycle.kind {
+        CycleKind::Rig => rig_intervals(cycle, gears)?,
         CycleKind::Vehicle => {
             let v = vehicle.ok_or_else(|| {
                 CycleError::new(
@@ -192,61 +136,9 @@ pub fn schedule_with_launch(
                      a rig cycle (time_s,input_speed_rpm,input_torque_nm,gear) does not",
                 )
             })?;
-            let bound = match (&v.shift, cycle.has_gear) {
-                (_, true) => None,
-                (Some(s), false) => Some(s.bind(gears, src)?),
-                (None, false) if gears.states.len() == 1 => None,
-                (None, false) => {
-                    return Err(CycleError::new(
-                        CycleErrorKind::Config,
-                        src,
-                        "the cycle has no gear column and the model has no [vehicle.shift] strategy \
-                         (needed when the gearbox has more than one gear state)",
-                    ));
-                }
-            };
-            let mut shifter = bound.as_ref().map(Shifter::new);
-            for k in 0..n {
-                let (r0, r1) = (&cycle.rows[k], &cycle.rows[k + 1]);
-                let (v0, v1) = (r0.vehicle_speed, r1.vehicle_speed);
-                let dt = r1.time - r0.time;
-                let standstill = v0 <= v.standstill_speed && v1 <= v.standstill_speed;
-                let d = v.demand(v0, v1, dt);
-                let w_out = v.output_speed(d.mean_speed);
-                let gear = match (&mut shifter, &bound) {
-                    (Some(s), Some(b)) => b.index[s.step(r0.time, w_out, standstill)],
-                    _ => gear_of(k)?.unwrap_or(0),
-                };
-                let ratio = gears.states[gear].1.abs();
-                let (w_in, torque, power) = if standstill {
-                    (0.0, 0.0, 0.0)
-                } else {
-                    let p = match v.overrun {
-                        Overrun::Zero => d.mean_power.max(0.0),
-                        Overrun::Transmit => d.mean_power,
-                    };
-                    let w_in = w_out * ratio;
-                    (w_in, p / w_in, p)
-                };
-                out.push(Interval {
-                    t0: r0.time,
-                    t1: r1.time,
-                    vehicle_speed: d.mean_speed,
-                    gear,
-                    input_speed: w_in,
-                    input_torque: torque,
-                    output_power: power,
-                    standstill,
-                    engine_speed: w_in,
-                    engine_torque: torque,
-                    converter_loss: 0.0,
-                    lockup: false,
-                    shift: false,
-                    jump: false,
-                });
-            }
+            vehicle_intervals(cycle, v, gears)?
         }
-    }
+    };
     if let Some(l) = launch {
         for i in &mut out {
             // Rig cycles have no vehicle speed; with a vehicle it follows from the input speed.
@@ -269,6 +161,135 @@ pub fn schedule_with_launch(
         out[k].jump = a.gear != b.gear || a.input_speed != b.input_speed || a.input_torque != b.input_torque;
     }
     Ok(Schedule { intervals: out })
+}
+
+/// At least one gear state, each with a finite non-zero ratio.
+fn check_gear_table(gears: &GearTable, src: &str) -> Result<(), CycleError> {
+    if gears.states.is_empty() {
+        return Err(CycleError::new(
+            CycleErrorKind::Config,
+            src,
+            "the gearbox has no gear state",
+        ));
+    }
+    for (n, r) in &gears.states {
+        if !(r.is_finite() && *r != 0.0) {
+            return Err(CycleError::new(
+                CycleErrorKind::Config,
+                src,
+                format!("gear state {n} has ratio {r}; a finite non-zero ratio is needed"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The gear-table index of row `k`'s gear column (None without one), with the file line in the
+/// error.
+fn gear_of(cycle: &DriveCycle, k: usize, gears: &GearTable) -> Result<Option<usize>, CycleError> {
+    let row = &cycle.rows[k];
+    match &row.gear {
+        None => Ok(None),
+        Some(g) => gears.index_of(g).map(Some).ok_or_else(|| {
+            CycleError::new(
+                CycleErrorKind::UnknownGear,
+                &cycle.source,
+                format!("not a gear state of the model ({})", gears.names().join(", ")),
+            )
+            .at_line(row.line)
+            .at_value("gear", g.clone())
+        }),
+    }
+}
+
+/// An interval whose engine side is its gearbox input (no launch device yet).
+fn direct(t0: f64, t1: f64, vehicle_speed: f64, gear: usize, w: f64, torque: f64, power: f64) -> Interval {
+    Interval {
+        t0,
+        t1,
+        vehicle_speed,
+        gear,
+        input_speed: w,
+        input_torque: torque,
+        output_power: power,
+        standstill: false,
+        engine_speed: w,
+        engine_torque: torque,
+        converter_loss: 0.0,
+        lockup: false,
+        shift: false,
+        jump: false,
+    }
+}
+
+/// Rig cycle: each row's input speed, torque and gear held until the next row.
+fn rig_intervals(cycle: &DriveCycle, gears: &GearTable) -> Result<Vec<Interval>, CycleError> {
+    let n = cycle.rows.len().saturating_sub(1);
+    let mut out = Vec::with_capacity(n);
+    for k in 0..n {
+        let (r0, r1) = (&cycle.rows[k], &cycle.rows[k + 1]);
+        let gear = gear_of(cycle, k, gears)?.unwrap_or(0);
+        let (w, t) = (r0.input_speed, r0.input_torque);
+        out.push(Interval {
+            standstill: w <= 0.0,
+            ..direct(r0.time, r1.time, 0.0, gear, w, t, t * w)
+        });
+    }
+    Ok(out)
+}
+
+/// Vehicle cycle: the mean demand of each interval through the gear of the cycle's gear column,
+/// the shift strategy, or the only gear state.
+fn vehicle_intervals(
+    cycle: &DriveCycle,
+    v: &Vehicle,
+    gears: &GearTable,
+) -> Result<Vec<Interval>, CycleError> {
+    let src = cycle.source.as_str();
+    let bound = match (&v.shift, cycle.has_gear) {
+        (_, true) => None,
+        (Some(s), false) => Some(s.bind(gears, src)?),
+        (None, false) if gears.states.len() == 1 => None,
+        (None, false) => {
+            return Err(CycleError::new(
+                CycleErrorKind::Config,
+                src,
+                "the cycle has no gear column and the model has no [vehicle.shift] strategy \
+                 (needed when the gearbox has more than one gear state)",
+            ));
+        }
+    };
+    let mut shifter = bound.as_ref().map(Shifter::new);
+    let n = cycle.rows.len().saturating_sub(1);
+    let mut out = Vec::with_capacity(n);
+    for k in 0..n {
+        let (r0, r1) = (&cycle.rows[k], &cycle.rows[k + 1]);
+        let (v0, v1) = (r0.vehicle_speed, r1.vehicle_speed);
+        let dt = r1.time - r0.time;
+        let standstill = v0 <= v.standstill_speed && v1 <= v.standstill_speed;
+        let d = v.demand(v0, v1, dt);
+        let w_out = v.output_speed(d.mean_speed);
+        let gear = match (&mut shifter, &bound) {
+            (Some(s), Some(b)) => b.index[s.step(r0.time, w_out, standstill)],
+            _ => gear_of(cycle, k, gears)?.unwrap_or(0),
+        };
+        let ratio = gears.states[gear].1.abs();
+        let (w_in, torque, power) = if standstill {
+            (0.0, 0.0, 0.0)
+        } else {
+            let p = match v.overrun {
+                Overrun::Zero => d.mean_power.max(0.0),
+                Overrun::Transmit => d.mean_power,
+            };
+            let w_in = w_out * ratio;
+            (w_in, p / w_in, p)
+        };
+        out.push(Interval {
+            standstill,
+            ..direct(r0.time, r1.time, d.mean_speed, gear, w_in, torque, power)
+        });
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

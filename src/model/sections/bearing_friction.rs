@@ -1,7 +1,12 @@
-//! Constants of the bearing friction models that the catalogue does not carry: SKF's μ values,
-//! the drag-term V_M and the seal constants (sources at each).
+//! The friction model of a catalogue bearing (SKF 2004 or Palmgren) with the constants the
+//! catalogue does not carry: SKF's μ values, the drag-term V_M and the seal constants (sources at
+//! each).
 
-use crate::model::bearing_catalogue::BearingType;
+use super::common::{q, MM};
+use crate::model::bearing_catalogue::{BearingType, CatalogueBearing, SeriesEntry};
+use crate::model::problems::Problems;
+use crate::physics::losses::bearings::skf::{Lubrication, SkfInput};
+use crate::physics::losses::bearings::{BearingFriction, BearingSize, Palmgren, Skf, SkfConstants, SkfKind};
 
 /// μ_bl of the SKF sliding term (both peers of docs/physics.md §Bearings).
 pub(crate) const MU_BL: f64 = 0.12;
@@ -69,6 +74,136 @@ pub(crate) fn seal_constants(kind: BearingType, outside_mm: f64) -> Option<(f64,
         BearingType::AngularContactBall => Some((0.014, 10.0, 2.0)),
         BearingType::CylindricalRoller => Some((0.032, 50.0, 2.0)),
         _ => None,
+    }
+}
+
+/// The SKF form of a bearing type (None: needle roller bearings, which have no SKF row in any
+/// source found).
+pub(crate) fn skf_kind(kind: BearingType) -> Option<SkfKind> {
+    match kind {
+        BearingType::DeepGrooveBall => Some(SkfKind::DeepGrooveBall),
+        BearingType::AngularContactBall => Some(SkfKind::AngularContactBall),
+        BearingType::FourPointContactBall => Some(SkfKind::FourPointContactBall),
+        BearingType::CylindricalRoller => Some(SkfKind::CylindricalRoller),
+        BearingType::TaperedRoller => Some(SkfKind::TaperedRoller),
+        BearingType::NeedleRoller => None,
+    }
+}
+
+/// Bore and outside diameter of a catalogue bearing, m.
+pub(crate) fn size_of(entry: &CatalogueBearing) -> BearingSize {
+    BearingSize {
+        bore: entry.d_mm * MM,
+        outside: entry.outside_mm * MM,
+    }
+}
+
+/// The SKF (2004) model of catalogue bearing `entry` at key path `p`: its series row, μ values,
+/// drag term at oil height `oil_above` (m above the bearing's lowest point), seal term when
+/// `sealed`. None after a problem.
+pub(crate) fn skf(
+    entry: &CatalogueBearing,
+    series: &[SeriesEntry],
+    sealed: bool,
+    lubrication: Lubrication,
+    oil_above: f64,
+    p: &str,
+    problems: &mut Problems,
+) -> Option<BearingFriction> {
+    let row = entry
+        .series
+        .as_ref()
+        .and_then(|s| series.iter().find(|r| &r.series == s && r.kind == entry.kind));
+    let (Some(row), Some(kind)) = (row, skf_kind(entry.kind)) else {
+        problems.push(
+            format!("{p}.model"),
+            "skf",
+            format!(
+                "{} ({:?}): no SKF geometry constants for this bearing in the catalogue (needle roller \
+                 bearings have no SKF row in any source found; other types need a `series` row); use model = \"palmgren\"",
+                entry.designation, entry.kind
+            ),
+        );
+        return None;
+    };
+    let seal = if sealed {
+        seal_constants(entry.kind, entry.outside_mm).map(|(k1, k2, beta)| {
+            // Seal counterface d_s ≈ d + 0.25(D − d) (eMotres catalogue estimate).
+            (
+                k1,
+                k2,
+                beta,
+                (entry.d_mm + 0.25 * (entry.outside_mm - entry.d_mm)) * MM,
+            )
+        })
+    } else {
+        None
+    };
+    let size = size_of(entry);
+    let (mu_ehl, drag_vm) = match kind {
+        SkfKind::CylindricalRoller => (MU_EHL_CYLINDRICAL, drag_vm_roller(oil_above / size.mean())),
+        SkfKind::TaperedRoller => (MU_EHL_TAPERED, drag_vm_roller(oil_above / size.mean())),
+        SkfKind::DeepGrooveBall | SkfKind::AngularContactBall | SkfKind::FourPointContactBall => {
+            (MU_EHL, DRAG_VM)
+        }
+    };
+    let input = SkfInput {
+        kind,
+        constants: SkfConstants {
+            r1: row.r1,
+            r2: row.r2,
+            r3: row.r3,
+            s1: row.s1,
+            s2: row.s2,
+            s3: row.s3,
+            k_z: row.k_z,
+            k_l: row.k_l,
+        },
+        size,
+        c0: entry.c0_kn * 1e3,
+        lubrication,
+        mu_bl: MU_BL,
+        mu_ehl,
+        seal,
+        oil_level: oil_above,
+        drag_vm,
+        rows: entry.rows.unwrap_or(1.0),
+        width: entry.b_mm * MM,
+        axial_factor_y: entry.y.unwrap_or(0.0),
+    };
+    match Skf::new(&input) {
+        Ok(m) => Some(BearingFriction::Skf(m)),
+        Err(e) => {
+            problems.push(p, q(&entry.designation), e.to_string());
+            None
+        }
+    }
+}
+
+/// The Palmgren model of catalogue bearing `entry` at key path `p` (its type's factors; no seal
+/// term). None after a problem.
+pub(crate) fn palmgren(
+    entry: &CatalogueBearing,
+    sealed: bool,
+    p: &str,
+    problems: &mut Problems,
+) -> Option<BearingFriction> {
+    if sealed {
+        problems.push(
+            format!("{p}.sealed"),
+            "true",
+            "integral seals are modelled by the SKF seal term only: use model = \"skf\" or a [[seals]] entry",
+        );
+    }
+    let (f0_bath, f1, ka, kr) = entry.kind.palmgren_defaults();
+    // Grease: f0 of thermca's grease column is not carried; oil bath is the gearbox case.
+    let f0 = f0_bath;
+    match Palmgren::new(size_of(entry), f0, f1, ka, kr) {
+        Ok(m) => Some(BearingFriction::Palmgren(m)),
+        Err(e) => {
+            problems.push(p, q(&entry.designation), e.to_string());
+            None
+        }
     }
 }
 

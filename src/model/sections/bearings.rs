@@ -9,11 +9,11 @@ use super::bearing_friction::*;
 use super::common::*;
 use super::gears::{Gear, GearMount};
 use super::parts::Parts;
-use crate::model::bearing_catalogue::{catalogue, BearingType};
+use crate::model::bearing_catalogue::{catalogue, CatalogueBearing, SeriesEntry};
 use crate::model::choice::choice;
 use crate::model::problems::Problems;
-use crate::physics::losses::bearings::skf::{Lubrication, SkfInput};
-use crate::physics::losses::bearings::{BearingFriction, BearingSize, Palmgren, Skf, SkfConstants, SkfKind};
+use crate::physics::losses::bearings::skf::Lubrication;
+use crate::physics::losses::bearings::BearingFriction;
 
 /// Friction model choice of a bearing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -167,7 +167,6 @@ pub(crate) fn validate_bearings(
     oil_level: f64,
     problems: &mut Problems,
 ) -> Vec<Bearing> {
-    let (gear_specs, members) = (parts.gears.specs, parts.members.specs);
     let (series, catalogue) = catalogue();
     let mut names = BTreeSet::new();
     let mut out = Vec::new();
@@ -183,61 +182,8 @@ pub(crate) fn validate_bearings(
         } else if !names.insert(b.name.clone()) {
             problems.push(format!("{p}.name"), q(&b.name), "duplicate bearing name");
         }
-        let mount = match (&b.member, &b.planet) {
-            (Some(m), None) => {
-                let member = parts.member(m, format!("{p}.member"), problems);
-                let outer = b
-                    .outer
-                    .as_ref()
-                    .and_then(|o| parts.member(o, format!("{p}.outer"), problems));
-                member.map(|member| BearingMount::Member { member, outer })
-            }
-            (None, Some(g)) => {
-                let gear = parts.gear(g, format!("{p}.planet"), problems);
-                match gear {
-                    Some(gi) if parts.is_planet(gi) => {
-                        if b.outer.is_some() {
-                            problems.push(
-                                format!("{p}.outer"),
-                                "",
-                                "a planet bearing runs on its carrier pin: leave outer out",
-                            );
-                        }
-                        Some(BearingMount::Planet { gear: gi })
-                    }
-                    Some(_) => {
-                        problems.push(
-                            format!("{p}.planet"),
-                            q(g),
-                            "not a planet of a [[planetary_sets]] entry",
-                        );
-                        None
-                    }
-                    None => None,
-                }
-            }
-            _ => {
-                problems.push(
-                    &p,
-                    "",
-                    "give exactly one of member (a shaft bearing) or planet (a planet-pin bearing)",
-                );
-                None
-            }
-        };
-        let entry = catalogue
-            .iter()
-            .find(|c| normalise(&c.designation) == normalise(&b.designation));
-        let Some(entry) = entry else {
-            let keys: Vec<&str> = catalogue.iter().map(|c| c.designation.as_str()).collect();
-            problems.push(
-                format!("{p}.designation"),
-                q(&b.designation),
-                format!(
-                    "not in the bearing catalogue models/bearings.toml; designations: {}",
-                    keys.join(", ")
-                ),
-            );
+        let mount = mount(b, &p, parts, problems);
+        let Some(entry) = catalogue_entry(&b.designation, &catalogue, &p, problems) else {
             continue;
         };
         if !b.position_mm.is_finite() {
@@ -255,127 +201,9 @@ pub(crate) fn validate_bearings(
             " N",
         );
         problems.in_range(&format!("{p}.axial_preload_n"), b.axial_preload_n, 0.0, 1e7, " N");
-        let lubrication = b.lubrication.unwrap_or_default().method();
-        let choice = b
-            .model
-            .unwrap_or(if entry.kind.has_skf() && entry.series.is_some() {
-                BearingModelChoice::Skf
-            } else {
-                BearingModelChoice::Palmgren
-            });
-        let size = BearingSize {
-            bore: entry.d_mm * MM,
-            outside: entry.outside_mm * MM,
-        };
-        // Height of the oil above the bearing's lowest point (SKF's H), for the drag term.
-        let axis = match mount {
-            Some(BearingMount::Member { member, .. }) => member_height(gears, member),
-            Some(BearingMount::Planet { gear }) => gears
-                .iter()
-                .find(|g| g.name == gear_specs[gear].name)
-                .map(|g| g.centre_height),
-            None => None,
-        };
-        let oil_above = match (axis, lubrication) {
-            (Some(h), Lubrication::OilBath) => oil_level - (h - 0.5 * size.outside),
-            _ => 0.0,
-        };
-        let friction = match choice {
-            BearingModelChoice::Skf => {
-                let row = entry
-                    .series
-                    .as_ref()
-                    .and_then(|s| series.iter().find(|r| &r.series == s && r.kind == entry.kind));
-                let (Some(row), true) = (row, entry.kind.has_skf()) else {
-                    problems.push(
-                        format!("{p}.model"),
-                        "skf",
-                        format!(
-                            "{} ({:?}): no SKF geometry constants for this bearing in the catalogue (needle roller \
-                             bearings have no SKF row in any source found; other types need a `series` row); use model = \"palmgren\"",
-                            entry.designation, entry.kind
-                        ),
-                    );
-                    continue;
-                };
-                let seal = if b.sealed {
-                    seal_constants(entry.kind, entry.outside_mm).map(|(k1, k2, beta)| {
-                        // Seal counterface d_s ≈ d + 0.25(D − d) (eMotres catalogue estimate).
-                        (
-                            k1,
-                            k2,
-                            beta,
-                            (entry.d_mm + 0.25 * (entry.outside_mm - entry.d_mm)) * MM,
-                        )
-                    })
-                } else {
-                    None
-                };
-                let kind = match entry.kind {
-                    BearingType::AngularContactBall => SkfKind::AngularContactBall,
-                    BearingType::FourPointContactBall => SkfKind::FourPointContactBall,
-                    BearingType::CylindricalRoller => SkfKind::CylindricalRoller,
-                    BearingType::TaperedRoller => SkfKind::TaperedRoller,
-                    _ => SkfKind::DeepGrooveBall,
-                };
-                let (mu_ehl, drag_vm) = match entry.kind {
-                    BearingType::CylindricalRoller | BearingType::TaperedRoller => (
-                        if entry.kind == BearingType::TaperedRoller {
-                            MU_EHL_TAPERED
-                        } else {
-                            MU_EHL_CYLINDRICAL
-                        },
-                        drag_vm_roller(oil_above / size.mean()),
-                    ),
-                    _ => (MU_EHL, DRAG_VM),
-                };
-                let input = SkfInput {
-                    kind,
-                    constants: SkfConstants {
-                        r1: row.r1,
-                        r2: row.r2,
-                        r3: row.r3,
-                        s1: row.s1,
-                        s2: row.s2,
-                        s3: row.s3,
-                        k_z: row.k_z,
-                        k_l: row.k_l,
-                    },
-                    size,
-                    c0: entry.c0_kn * 1e3,
-                    lubrication,
-                    mu_bl: MU_BL,
-                    mu_ehl,
-                    seal,
-                    oil_level: oil_above,
-                    drag_vm,
-                    rows: entry.rows.unwrap_or(1.0),
-                    width: entry.b_mm * MM,
-                    axial_factor_y: entry.y.unwrap_or(0.0),
-                };
-                match Skf::new(&input) {
-                    Ok(m) => BearingFriction::Skf(m),
-                    Err(e) => {
-                        problems.push(&p, q(&entry.designation), e.to_string());
-                        continue;
-                    }
-                }
-            }
-            BearingModelChoice::Palmgren => {
-                if b.sealed {
-                    problems.push(format!("{p}.sealed"), "true", "integral seals are modelled by the SKF seal term only: use model = \"skf\" or a [[seals]] entry");
-                }
-                let (f0_bath, f1, ka, kr) = entry.kind.palmgren_defaults();
-                // Grease: f0 of thermca's grease column is not carried; oil bath is the gearbox case.
-                let f0 = f0_bath;
-                match Palmgren::new(size, f0, f1, ka, kr) {
-                    Ok(m) => BearingFriction::Palmgren(m),
-                    Err(e) => {
-                        problems.push(&p, q(&entry.designation), e.to_string());
-                        continue;
-                    }
-                }
-            }
+        let axis = mount.and_then(|m| axis_height(m, parts, gears));
+        let Some(friction) = friction(b, entry, &series, axis, oil_level, &p, problems) else {
+            continue;
         };
         let heat = heat_to(&b.heat_to, nodes, &format!("{p}.heat_to"), problems);
         let Some(mount) = mount else { continue };
@@ -395,12 +223,125 @@ pub(crate) fn validate_bearings(
             heat_to: heat,
         });
     }
-    // Statics: at most two bearings per body, at different positions; one locating.
-    for ((kind, idx), list) in &per_body {
-        let what = if *kind == 0 {
-            format!("member \"{}\"", members[*idx].name)
+    check_statics(&per_body, parts, &mut out, problems);
+    out
+}
+
+/// Where bearing `b` sits: on a member (outer ring in the housing or on another member), or on
+/// a planet's pin.
+fn mount(b: &BearingSpec, p: &str, parts: &Parts<'_>, problems: &mut Problems) -> Option<BearingMount> {
+    match (&b.member, &b.planet) {
+        (Some(m), None) => {
+            let member = parts.member(m, format!("{p}.member"), problems);
+            let outer = b
+                .outer
+                .as_ref()
+                .and_then(|o| parts.member(o, format!("{p}.outer"), problems));
+            member.map(|member| BearingMount::Member { member, outer })
+        }
+        (None, Some(g)) => {
+            let gi = parts.gear(g, format!("{p}.planet"), problems)?;
+            if !parts.is_planet(gi) {
+                problems.push(
+                    format!("{p}.planet"),
+                    q(g),
+                    "not a planet of a [[planetary_sets]] entry",
+                );
+                return None;
+            }
+            if b.outer.is_some() {
+                problems.push(
+                    format!("{p}.outer"),
+                    "",
+                    "a planet bearing runs on its carrier pin: leave outer out",
+                );
+            }
+            Some(BearingMount::Planet { gear: gi })
+        }
+        _ => {
+            problems.push(
+                p,
+                "",
+                "give exactly one of member (a shaft bearing) or planet (a planet-pin bearing)",
+            );
+            None
+        }
+    }
+}
+
+/// The catalogue bearing of `designation` (spaces and case ignored).
+fn catalogue_entry<'c>(
+    designation: &str,
+    catalogue: &'c [CatalogueBearing],
+    p: &str,
+    problems: &mut Problems,
+) -> Option<&'c CatalogueBearing> {
+    let entry = catalogue
+        .iter()
+        .find(|c| normalise(&c.designation) == normalise(designation));
+    if entry.is_none() {
+        let keys: Vec<&str> = catalogue.iter().map(|c| c.designation.as_str()).collect();
+        problems.push(
+            format!("{p}.designation"),
+            q(designation),
+            format!(
+                "not in the bearing catalogue models/bearings.toml; designations: {}",
+                keys.join(", ")
+            ),
+        );
+    }
+    entry
+}
+
+/// Axis height of a bearing: its member's (a non-planet gear on it), or its planet's (the lowest
+/// point of the orbit).
+fn axis_height(mount: BearingMount, parts: &Parts<'_>, gears: &[Gear]) -> Option<f64> {
+    match mount {
+        BearingMount::Member { member, .. } => member_height(gears, member),
+        BearingMount::Planet { gear } => gears
+            .iter()
+            .find(|g| g.name == parts.gears.specs[gear].name)
+            .map(|g| g.centre_height),
+    }
+}
+
+/// The friction model of bearing `b` (`model`, default SKF where the catalogue has its row),
+/// with the oil height above its lowest point (SKF's H) for the drag term.
+fn friction(
+    b: &BearingSpec,
+    entry: &CatalogueBearing,
+    series: &[SeriesEntry],
+    axis: Option<f64>,
+    oil_level: f64,
+    p: &str,
+    problems: &mut Problems,
+) -> Option<BearingFriction> {
+    let lubrication = b.lubrication.unwrap_or_default().method();
+    let choice = b
+        .model
+        .unwrap_or(if entry.kind.has_skf() && entry.series.is_some() {
+            BearingModelChoice::Skf
         } else {
-            format!("planet \"{}\"", gear_specs[*idx].name)
+            BearingModelChoice::Palmgren
+        });
+    let oil_above = match (axis, lubrication) {
+        (Some(h), Lubrication::OilBath) => oil_level - (h - 0.5 * size_of(entry).outside),
+        _ => 0.0,
+    };
+    match choice {
+        BearingModelChoice::Skf => skf(entry, series, b.sealed, lubrication, oil_above, p, problems),
+        BearingModelChoice::Palmgren => palmgren(entry, b.sealed, p, problems),
+    }
+}
+
+/// Statics: at most two bearings per body, at different positions; one locating (the one marked,
+/// else the first).
+fn check_statics(per_body: &BodyBearings, parts: &Parts<'_>, out: &mut [Bearing], problems: &mut Problems) {
+    for ((kind, idx), list) in per_body {
+        let what = if *kind == 0 {
+            format!("member \"{}\"", parts.members.specs[*idx].name)
+        } else {
+            format!("planet \"{}\"", parts.gears.specs[*idx].name)
         };
         if list.len() > 2 {
             problems.push(
@@ -424,5 +365,4 @@ pub(crate) fn validate_bearings(
             _ => problems.push("bearings", what, "more than one locating bearing"),
         }
     }
-    out
 }
