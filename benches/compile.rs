@@ -1,12 +1,11 @@
-//! Criterion benches of the scene compile (issue 15): the loss scene and the full scene of every
-//! example model, and the pocket integral K of one AT6 helical mesh family, exact helical limit
-//! (the default) vs the former 48 discrete slices.
+//! Criterion benches of the scene compile: the loss scene and the full scene of every example
+//! model, and the pocket integral K of one AT6 helical mesh family, exact helical limit (what the
+//! scene uses) vs 48 discrete slices.
 //!
-//! Since the pocket model reads its tooth outline from `physics::geometry::ToothProfile`
-//! (issue 15, one tooth profile), also: the pocket teeth of one gear (geometry build + the space
-//! bottom integral along the generated fillet) and the loss scene with every external mesh's
-//! pocketing counted (`pocketing_mixture_density_kg_m3` set: by default the AT6, helical and PT6
-//! meshes run above the oil and build no pocket table).
+//! Also: the pocket teeth of one gear (geometry build from `physics::geometry::ToothProfile` +
+//! the space bottom integral along the generated fillet) and the loss scene with every external
+//! mesh's pocketing counted (`pocketing_mixture_density_kg_m3` set: by default the AT6, helical
+//! and PT6 meshes run above the oil and build no pocket table).
 //!
 //! Run: `cargo bench --bench compile`. Figures are recorded in docs/performance.md.
 

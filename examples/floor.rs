@@ -1,4 +1,4 @@
-//! The integration floor of issue 15 per example model: samples × (one cached RHS + one LU of
+//! The integration floor per example model: samples × (one cached RHS + one LU of
 //! the iteration matrix's size), against the WLTC integration as `geartherm run` does it
 //! (per-item energies, losses recorded per row) and as `run --summary-only` does it.
 //!
@@ -12,7 +12,7 @@
 //!
 //! `ratio_prep_in_floor`: the same against a floor whose RHS includes building its per-sample
 //! cache (speed- and load-dependent loss terms) once per sample whose inputs change, which any
-//! integrator, a one-RHS-per-sample one included, has to pay. Shown beside the issue's ratio,
+//! integrator, a one-RHS-per-sample one included, has to pay. Shown beside `ratio`,
 //! not instead of it. It uses `prepare_cycle_us`: the preparation per prepared sample measured
 //! over the cycle's samples in order (`prepare_us` alternates between two mid-cycle samples and
 //! misses e.g. the converter's open-state solve at launches).

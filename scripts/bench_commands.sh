@@ -1,5 +1,5 @@
 #!/usr/bin/env sh
-# Whole-command timings of geartherm (issue 15): median wall time of repeated runs, with
+# Whole-command timings of geartherm: median wall time of repeated runs, with
 # hyperfine (Debian: `apt-get install -y hyperfine`). Usage, from the repository root after
 # `cargo build --release`:
 #   scripts/bench_commands.sh [RUNS]          (default 30 runs after 3 warm-ups)

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Hostile-input campaign (issue 16): generated invalid or extreme inputs through `check`,
+"""Hostile-input campaign: generated invalid or extreme inputs through `check`,
 `info`, `losses`, `steady`, `map` and `run`, counting what must never happen.
 
     python3 scripts/hostile_campaign.py --cases 100000 --jobs 2 [--bin target/release/geartherm]

@@ -1,6 +1,8 @@
 //! The `geartherm` command-line binary: parse, run, print, exit code.
 mod cli;
 
+use std::io::Write;
+
 use clap::Parser;
 
 fn main() {
@@ -14,9 +16,9 @@ fn main() {
         }
     };
     if let Err(f) = cli::run(args) {
-        eprint!("{}", f.message);
-        if !f.message.ends_with('\n') {
-            eprintln!();
+        if !f.message.is_empty() {
+            let newline = if f.message.ends_with('\n') { "" } else { "\n" };
+            let _ = write!(std::io::stderr(), "{}{newline}", f.message);
         }
         std::process::exit(f.code);
     }

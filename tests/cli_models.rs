@@ -180,7 +180,7 @@ fn info_text_lists_states_meshes_and_gears() {
 
 #[test]
 fn missing_model_file_is_an_io_error() {
-    // README: exit 3 for I/O (issue 16: a missing model file exited 1).
+    // README: exit 3 for I/O, a missing model file included.
     let out = run(&["check", "models/does_not_exist.toml"], &root());
     assert_eq!(out.status.code(), Some(3));
     assert!(String::from_utf8_lossy(&out.stderr).contains("does_not_exist.toml"));

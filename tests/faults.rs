@@ -87,7 +87,7 @@ fn a_run_killed_at_any_moment_leaves_the_previous_result_whole_and_the_next_run_
         assert_whole(&out);
         let now = std::fs::read(out.join("summary.json")).unwrap();
         if !st.success() && now != before {
-            // Killed after its commit and before its exit (a run takes about 0.1 s now): the
+            // Killed after its commit and before its exit (a run takes about 0.1 s): the
             // new set, whole (checked above) — never a mix. Otherwise the previous set, byte
             // for byte.
             eprintln!("killed after {delay_ms} ms, after its commit");

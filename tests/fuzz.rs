@@ -3,7 +3,7 @@
 //! documented limits. Bounded for CI: a fixed number of cases per property (override with
 //! `PROPTEST_CASES`), seconds in total in release mode.
 //!
-//! The override parser (`model/overrides.rs`, issue 17): random `PATH = VALUE` texts and
+//! The override parser (`model/overrides.rs`): random `PATH = VALUE` texts and
 //! hostile values at real key paths never panic, and a model accepted with overrides has plain
 //! part names and compiles.
 

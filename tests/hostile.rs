@@ -1,5 +1,6 @@
-//! Hostile input: each defect class of issue 16, reproduced on the release binary of the main
-//! branch before the fix, as a regression test (exit code, message, what is written).
+//! Hostile input: each defect class the hostile-input review and its campaigns found, as a
+//! regression test on the release binary (exit code, message, what is written); each fails on a
+//! build without its fix (docs/robustness.md).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -68,8 +69,8 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
-/// Hang: a 1e100 km/h cycle was integrated at full CPU for 90 s and more under
-/// `--max-steps 100`. Now refused at the edge with line and allowed range, quickly.
+/// Hang: a 1e100 km/h cycle would be integrated at full CPU for 90 s and more under
+/// `--max-steps 100`. It is refused at the edge with line and allowed range, quickly.
 #[test]
 fn an_impossible_vehicle_speed_is_refused_with_its_line() {
     let d = tempfile::tempdir().unwrap();
@@ -257,7 +258,8 @@ fn report_on_malformed_or_non_finite_inputs_exits_1_and_keeps_the_directory() {
     assert_eq!(names(&dir), before);
 }
 
-/// Stale files: a `--summary-only` run after a full one left the old timeseries.csv and PNGs.
+/// Stale files: a `--summary-only` run after a full one must not leave the old timeseries.csv
+/// and PNGs.
 #[test]
 fn a_rerun_replaces_the_whole_result_set() {
     let d = tempfile::tempdir().unwrap();
@@ -472,9 +474,9 @@ fn a_second_writer_is_refused_while_the_first_writes() {
     );
 }
 
-/// Campaign of issue 16 (seed 23, case 79658): a cycle of 1e-308 / 1e-300 rpm on the AT6 kept
-/// `run --max-steps 100000` busy for ever (a NaN bearing drag gave a NaN first step size, which
-/// never becomes "too small"), and `losses` at such speeds failed with exit 2 on three models.
+/// Hostile-input campaign, seed 23, case 79658: a cycle of 1e-308 / 1e-300 rpm on the AT6. A NaN
+/// bearing drag there would give a NaN first step size, which never becomes "too small" and keeps
+/// `run --max-steps 100000` busy for ever; `losses` at such speeds must not fail either.
 /// Vanishing speeds are standstill: exit 0, finite numbers, at once.
 #[test]
 fn vanishing_speeds_are_standstill_not_failures() {

@@ -1,8 +1,9 @@
 //! Every value of every model-file section (a number, a string, an array, a table, a whole
 //! section), written with the wrong type, is reported at its full key path
 //! (`launch.lockup.slip_rpm`, `thermal.links[2].h_law.h1`, `gears[3]`, `vehicle.road_load`), with
-//! the value found. The walk covers the AT6 model, to which the keys no bundled model uses are added
-//! ([[meshes]], inline oil data, every [losses] key, [[thermal.heat]], [thermal.wall_mesh]).
+//! the value found. The walk covers the AT6 model, to which the keys no bundled model uses are
+//! added ([[meshes]], inline oil data, every [losses] key, a bearing with every key,
+//! [[thermal.heat]], [thermal.wall_mesh]).
 
 use geartherm::model::file::SECTIONS;
 use geartherm::model::parse::parse_table;
@@ -21,6 +22,8 @@ nu100_cst = 7.0
 rho15_kg_m3 = 850.0
 thermal_expansion_per_k = -6.5e-4
 walther = "c08"
+base = "pao"
+lubricant_factor = 0.8
 
 [[meshes]]
 name = "extra"
@@ -35,6 +38,7 @@ sliding = "detailed"
 friction = "constant"
 friction_coefficient = 0.05
 lubricant_factor = 1.0
+contact_line_load = "face_width"
 load_sharing = "33:67"
 helical_distribution = "niemann_richer"
 loss_form = "moment_balance"
@@ -48,6 +52,24 @@ seetharaman_cavity = "form_drag"
 stavytskyi_ks = 0.85
 changenet_low = [1.0, 0.45, 0.1, -0.6, -0.21]
 changenet_high = [1.0, 0.45, 0.1, -0.6, -0.21]
+
+[[bearings]]
+name = "extra"
+planet = "s1_planet"
+designation = "6208"
+position_mm = 10.0
+locating = true
+model = "skf"
+radial_preload_n = 10.0
+axial_preload_n = 5.0
+sealed = true
+lubrication = "grease"
+mu_bl = 0.1
+mu_ehl = 0.05
+drag_form = "skf_older"
+drag_vm = 0.001
+heat_to = [["sump", 1.0]]
+source = "test"
 
 [[thermal.heat]]
 source = "sliding"
@@ -234,6 +256,15 @@ fn a_bad_choice_lists_the_allowed_names_at_its_key_path() {
         ),
         ("vehicle.overrun", "must be one of: zero, transmit"),
         ("oil.walther", "must be one of: astm_d341, c06, c08"),
+        (
+            "oil.base",
+            "must be one of: mineral, pao, ester, pag, pag_water_soluble, phosphate_ester, traction_fluid",
+        ),
+        (
+            "losses.contact_line_load",
+            "must be one of: contact_line, face_width",
+        ),
+        ("bearings[11].drag_form", "must be one of: skf_current, skf_older"),
     ] {
         let mut doc = full_document();
         let slot = if path == "vehicle.overrun" {

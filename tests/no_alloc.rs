@@ -91,7 +91,7 @@ fn sample_switch_right_hand_side_and_jacobian_product_allocate_nothing() {
                 v[j] = 1.0;
                 scene.jvp(k as f64, &y, &v, &mut work, &mut jv);
             }
-            // The assembled Jacobian (issue 15) too.
+            // The assembled Jacobian too.
             scene.jacobian_values(k as f64, &y, &mut work, &mut jac);
             // And what ROS3 evaluates per step: loss slopes, the Jacobian from them, ∂f/∂t.
             scene.loss_slopes(k as f64, &y, &mut work, &mut slopes);

@@ -2,9 +2,9 @@
 //! infinitely-many-slices limit of the helical connected-slice model, 8-node Gauss–Legendre per
 //! smooth sub-interval), against a high-resolution reference: the same integrand by adaptive
 //! 24-node Gauss–Legendre to 1e-13 on a pocket table whose phase end and gap-kind switches were
-//! located with an 8× finer scan. Issue 15 criterion: within 1e-6 relative. Both sides use the
+//! located with an 8× finer scan. Criterion: within 1e-6 relative. Both sides use the
 //! same pocket geometry: the teeth of `physics::geometry::ToothProfile` (involute + generated
-//! trochoid root), the pocket model's only tooth outline since issue 15.
+//! trochoid root), the pocket model's only tooth outline.
 
 use std::path::PathBuf;
 

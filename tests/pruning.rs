@@ -1,4 +1,4 @@
-//! Scene pruning and the per-sample loss cache (issue 7): what the compile step leaves out and
+//! Scene pruning and the per-sample loss cache: what the compile step leaves out and
 //! caches must not change any result beyond rounding.
 
 mod common;
@@ -145,7 +145,7 @@ fn pruned_scene_gives_the_full_scenes_temperatures_and_energies() {
     .unwrap();
     // What gear 3 leaves idle: all four RAV sliding meshes, the two Ravigneaux planet-pin
     // bearings (the locked set's pinions do not spin) and the drag of the engaged clutches A and B.
-    // The external planetary pockets are above the ATF: unknown, not items in any scene (issue 14).
+    // The external planetary pockets are above the ATF: unknown, not items in any scene.
     assert_eq!(all.items() - pruned.items(), 8, "{:?}", pruned.skipped);
     for mesh in ["RAV:large_sun/long_pinion", "RAV:short_pinion/long_pinion"] {
         let what = format!("sliding of mesh {mesh}");
@@ -370,7 +370,7 @@ fn per_state_idle_items_of_the_at6() {
     }
     let count = |n: &str| idle_by_state.iter().find(|(s, _)| s == n).map(|x| x.1);
     // 3rd: the 4 Ravigneaux sliding meshes, the 2 Ravigneaux planet bearings and the drag of the
-    // engaged clutches A and B (the planetary pockets are above the ATF: never items, issue 14).
+    // engaged clutches A and B (the planetary pockets are above the ATF: never items).
     assert_eq!(count("3"), Some(8));
     // 2nd holds the large sun: its bearing stands still, and the engaged A and C have no drag.
     assert_eq!(count("2"), Some(3));

@@ -114,7 +114,7 @@ fn learnt_loss_slopes_hold_the_error_and_tighter_tolerances_difference_them() {
 #[test]
 fn at6_wltc_with_a_coolant_warm_up_stays_near_the_reference() {
     // The AT6's coolant boundary warms 23 → 90 °C: the ∂f/∂t path on a full model (without it the
-    // sump error was 1.2e-2 K).
+    // sump error is 1.2e-2 K).
     let (scene, segs) = wltc("models/at6_lepelletier.toml");
     let (refr, _) = reference(&scene, &segs, 1e-12).unwrap();
     let traj = run(&scene, &segs, &TransientOptions::default());

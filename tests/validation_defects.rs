@@ -1,4 +1,4 @@
-//! Issue 14 defects: planet churning averaged over the carrier turn, pocketing of meshes above the
+//! Validation defects: planet churning averaged over the carrier turn, pocketing of meshes above the
 //! oil not silently small, churning models used outside their range reported.
 
 use std::path::PathBuf;
@@ -28,7 +28,7 @@ fn at6_planets_dip_over_part_of_the_carrier_turn() {
     };
     let (s1, long) = (share("s1_planet"), share("long_pinion"));
     println!("wet share of a carrier turn: s1_planet {s1:.3}, long_pinion {long:.3}");
-    // Tip circle below the static level: 18 % and 28 % of a turn (the issue quoted 14 % and 26 %).
+    // Tip circle below the static level: 18 % and 28 % of a turn.
     assert!((0.15..0.21).contains(&s1), "{s1}");
     assert!((0.25..0.31).contains(&long), "{long}");
 }
@@ -91,7 +91,7 @@ fn at6_planet_churning_is_the_orbit_average_of_every_planet() {
             it.name,
             out[k]
         );
-        // Before the fix the item was one planet at its deepest immersion all the time.
+        // One planet at its deepest immersion all the time is more than 20 % off.
         assert!((out[k] / deepest - 1.0).abs() > 0.2, "{}", it.name);
         let (_, share) = (
             r,

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Peer comparison (issue 7, part 2): geartherm vs an independent scipy solve_ivp implementation of
+"""Peer comparison: geartherm vs an independent scipy solve_ivp implementation of
 the FZG C scene over WLTC. Run from the repository root:
 
     pip install --user numpy scipy
@@ -88,7 +88,7 @@ def main():
 
 
 def _main(root, exe, reps, quick, tmp):
-    # the FZG C model without its bearings and seals (issue 12), which the peer does not model:
+    # the FZG C model without its bearings and seals, which the peer does not model:
     # both tools integrate this same network
     model = peer.peer_model(os.path.join(root, "models", "fzg_c.toml"),
                                   os.path.join(tmp, "fzg_c.toml"))

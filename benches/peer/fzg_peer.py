@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Independent Python/scipy peer of geartherm's FZG C scene (issue 7, "Peer comparison").
+"""Independent Python/scipy peer of geartherm's FZG C scene (docs/numerics.md "Peer comparison").
 
 Same physics as `geartherm run models/fzg_c.toml --cycle wltc`, written again from the equations
 (each block cites the Rust file it mirrors), integrated with scipy.integrate.solve_ivp
@@ -162,16 +162,15 @@ class Changenet:
 #   f = wet share of the band ±2.25 m_n around the pitch point.
 # K itself is NOT recomputed here: it is geartherm's compiled number, recovered from one call of
 # `geartherm losses` (the P ∝ ρ ω³ law and the density mix are then checked at other points).
-# physics.md §3/6 lists K = 1.7398e-9 + 1.5726e-9 m⁵ for this mesh at C_d = 0.65 (fallback;
-# 1.6929e-9 + 1.6731e-9 before issue 15 unified the tooth profile).
+# physics.md §3/6 lists K = 1.7398e-9 + 1.5726e-9 m⁵ for this mesh at C_d = 0.65 (fallback).
 # --------------------------------------------------------------------------------------------
 POCKET_K_DOC = 1.7398e-9 + 1.5726e-9
 
 
 def peer_model(src: str, dst: str) -> str:
-    """Copy a model file without its [[bearings]] and [[seals]] tables (issue 12; the peer does
-    not model them) and with the friction law the peer implements pinned in [losses]
-    (geartherm's default became Schlenk in issue 14); both tools then run the same network and
+    """Copy a model file without its [[bearings]] and [[seals]] tables (the peer does not model
+    them) and with the friction law the peer implements pinned in [losses] (geartherm's default
+    is Schlenk); both tools then run the same network and
     the same equations from `dst`."""
     out, skip = [], False
     with open(src) as f:
@@ -286,7 +285,7 @@ class Scene:
         self.model_path = model_path
         with open(model_path, "rb") as f:
             md = tomllib.load(f)
-        # rolling bearings and seals (issue 12) are not modelled here: compare.py runs both tools
+        # rolling bearings and seals are not modelled here: compare.py runs both tools
         # on a copy of models/fzg_c.toml without them (see peer_model)
         assert not md.get("bearings") and not md.get("seals"), \
             "peer models no bearings/seals: use peer_model(models/fzg_c.toml)"

@@ -1,5 +1,6 @@
 //! `geartherm._native`: the PyO3 binding of the geartherm library. It sits beside the CLI and
-//! calls the same library functions (`model`, `study::job`, `study`). Results cross the boundary
+//! calls the same use-case layer (`geartherm::job`) and study runner (`geartherm::study`): every
+//! option is checked there, once, for every front end. Results cross the boundary
 //! as JSON or CSV text that the Python package (`pysrc/geartherm/`) turns into dicts and pandas
 //! DataFrames. Every solve runs with the GIL released.
 
@@ -7,12 +8,12 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
-use geartherm::model::{self, Gearbox, ModelError as RsModelError, Override};
-use geartherm::study::job::{self, JobError, Point, RunOptions};
+use geartherm::job::{self, ErrorKind, JobError, LossesOptions, MapOptions, RunOptions, SteadyOptions};
+use geartherm::model::Override;
 use geartherm::study::spec::StudySpec;
 use geartherm::study::{CaseRow, Study, StudyError};
 use pyo3::create_exception;
-use pyo3::exceptions::{PyException, PyOSError};
+use pyo3::exceptions::{PyException, PyFileNotFoundError, PyOSError};
 use pyo3::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -41,35 +42,44 @@ create_exception!(
     "A numerical failure (the message names time, node or loss item)."
 );
 
-fn model_error(e: &RsModelError) -> PyErr {
-    let problems: Vec<(String, String, String)> = match e {
-        RsModelError::Invalid { problems, .. } => problems
-            .iter()
-            .map(|p| (p.path.clone(), p.value.clone(), p.allowed.clone()))
-            .collect(),
-        RsModelError::Io { .. } => return PyOSError::new_err(e.to_string()),
+/// A job's error as the Python exception of its kind: an invalid model or override is a
+/// `ModelError` (`.problems`, `.path`), another invalid input an `InputError` (with `.path`,
+/// `.value`, `.allowed` of the option), a numerical failure a `SolveError`, a missing file
+/// `FileNotFoundError`, other I/O `OSError`.
+fn job_error(e: JobError) -> PyErr {
+    let problems: Vec<(String, String, String)> = e
+        .problems
+        .iter()
+        .map(|p| (p.path.clone(), p.value.clone(), p.allowed.clone()))
+        .collect();
+    let err = match e.kind {
+        ErrorKind::Io if e.io_kind == Some(std::io::ErrorKind::NotFound) => {
+            return PyFileNotFoundError::new_err(e.message)
+        }
+        ErrorKind::Io => return PyOSError::new_err(e.message),
+        ErrorKind::Numerical => return SolveError::new_err(e.message),
+        ErrorKind::Model => ModelError::new_err(e.message),
+        ErrorKind::Option | ErrorKind::Invalid => InputError::new_err(e.message),
     };
-    let path = problems.first().map(|p| p.0.clone());
-    let err = ModelError::new_err(e.report().trim_end().to_string());
+    let first = problems.first().cloned();
     Python::attach(|py| {
         let v = err.value(py);
         let _ = v.setattr("problems", problems);
-        let _ = v.setattr("path", path);
+        let _ = v.setattr("path", first.as_ref().map(|p| p.0.clone()));
+        let _ = v.setattr("value", first.as_ref().map(|p| p.1.clone()));
+        let _ = v.setattr("allowed", first.as_ref().map(|p| p.2.clone()));
     });
     err
 }
 
-fn job_error(e: JobError) -> PyErr {
-    match e {
-        JobError::Invalid(m) => InputError::new_err(m),
-        JobError::Numerical(m) => SolveError::new_err(m),
-    }
-}
-
 fn study_error(e: StudyError) -> PyErr {
     match e {
+        StudyError::Io { ref source, .. } if source.kind() == std::io::ErrorKind::NotFound => {
+            PyFileNotFoundError::new_err(e.to_string())
+        }
         StudyError::Io { .. } => PyOSError::new_err(e.to_string()),
         StudyError::Invalid(m) => InputError::new_err(m),
+        StudyError::Job(j) => job_error(j),
     }
 }
 
@@ -94,32 +104,38 @@ struct State {
 #[pyclass(module = "geartherm._native", frozen)]
 struct Model {
     state: State,
-    gb: Arc<Gearbox>,
+    m: Arc<job::Model>,
 }
 
 fn build(state: State) -> PyResult<Model> {
     let file = PathBuf::from(&state.file);
     let mut ovs = Vec::with_capacity(state.overrides.len());
     for s in &state.overrides {
-        match s.parse::<Override>() {
-            Ok(o) => ovs.push(o),
-            Err(msg) => {
-                let path = s.split('=').next().unwrap_or("").trim().to_string();
-                let err = ModelError::new_err(msg.clone());
-                Python::attach(|py| {
-                    let v = err.value(py);
-                    let _ = v.setattr("problems", vec![(path.clone(), String::new(), msg)]);
-                    let _ = v.setattr("path", path);
-                });
-                return Err(err);
-            }
-        }
+        let o: Override = s.parse().map_err(|msg: String| {
+            let path = s.split('=').next().unwrap_or("").trim().to_string();
+            job_error(JobError {
+                kind: ErrorKind::Model,
+                problems: vec![geartherm::model::Problem {
+                    path,
+                    value: s.clone(),
+                    allowed: msg.clone(),
+                }],
+                ..JobError::invalid(msg)
+            })
+        })?;
+        ovs.push(o);
     }
-    let gb = model::from_str_with(&state.text, &file, &ovs).map_err(|e| model_error(&e))?;
+    let m = job::Model::from_text(&state.text, &file, &ovs).map_err(job_error)?;
     Ok(Model {
         state,
-        gb: Arc::new(gb),
+        m: Arc::new(m),
     })
+}
+
+/// A job's options from a Python mapping (floats pass as they are, NaN and infinities
+/// included, so that the job layer checks them as it does for the CLI).
+fn options<T: serde::de::DeserializeOwned>(what: &str, mapping: &Bound<'_, PyAny>) -> PyResult<T> {
+    pythonize::depythonize(mapping).map_err(|e| InputError::new_err(format!("{what}: {e}")))
 }
 
 #[pymethods]
@@ -127,8 +143,13 @@ impl Model {
     /// Read and check a model file.
     #[staticmethod]
     fn load(path: PathBuf) -> PyResult<Model> {
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| PyOSError::new_err(format!("{}: cannot read: {e}", path.display())))?;
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            let msg = format!("{}: cannot read: {e}", path.display());
+            match e.kind() {
+                std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(msg),
+                _ => PyOSError::new_err(msg),
+            }
+        })?;
         build(State {
             text,
             file: path.display().to_string(),
@@ -171,12 +192,12 @@ impl Model {
 
     #[getter]
     fn name(&self) -> &str {
-        &self.gb.name
+        &self.m.gearbox.name
     }
 
     /// Counts of the checked model (JSON).
     fn check(&self) -> PyResult<String> {
-        let gb = &self.gb;
+        let gb = &self.m.gearbox;
         to_json(&serde_json::json!({
             "model": gb.name,
             "gears": gb.gears.len(),
@@ -189,53 +210,41 @@ impl Model {
 
     /// The `geartherm info --json` report.
     fn info(&self) -> PyResult<String> {
-        to_json(&geartherm::report::info::info(&self.gb))
+        to_json(&geartherm::report::info::info(&self.m.gearbox))
     }
 
-    /// The `geartherm losses --json` report.
-    fn losses(
-        &self,
-        py: Python<'_>,
-        gear: &str,
-        speed_rpm: f64,
-        torque_nm: f64,
-        oil_temp_c: f64,
-    ) -> PyResult<String> {
-        let gb = self.gb.clone();
+    /// The `geartherm losses --json` report (a mapping of `job::LossesOptions` in).
+    fn losses(&self, py: Python<'_>, options: &Bound<'_, PyAny>) -> PyResult<String> {
+        let o: LossesOptions = self::options("losses", options)?;
+        let m = self.m.clone();
+        let r = py.detach(|| job::losses::losses(&m, &o)).map_err(job_error)?;
+        to_json(&r)
+    }
+
+    /// An equilibrium (a mapping of `job::SteadyOptions` in, `job::SteadyResult` out).
+    fn steady(&self, py: Python<'_>, options: &Bound<'_, PyAny>) -> PyResult<String> {
+        let o: SteadyOptions = self::options("steady", options)?;
+        let m = self.m.clone();
+        let r = py.detach(|| job::steady::steady(&m, &o)).map_err(job_error)?;
+        to_json(&r)
+    }
+
+    /// Equilibria over a speed × torque grid (a mapping of `job::MapOptions` in): `map.csv` text.
+    fn map(&self, py: Python<'_>, options: &Bound<'_, PyAny>) -> PyResult<String> {
+        let o: MapOptions = self::options("map", options)?;
+        let m = self.m.clone();
+        let r = py.detach(|| job::map::map(&m, &o, &|| {})).map_err(job_error)?;
+        Ok(r.csv)
+    }
+
+    /// A drive-cycle run (a mapping of `job::RunOptions` in): (`summary.json` text, `timeseries.csv`
+    /// text or None).
+    fn run(&self, py: Python<'_>, options: &Bound<'_, PyAny>) -> PyResult<(String, Option<String>)> {
+        let o: RunOptions = self::options("run", options)?;
+        let m = self.m.clone();
         let r = py
-            .detach(|| job::losses_at(&gb, gear, speed_rpm, torque_nm, oil_temp_c))
+            .detach(|| job::run::run(&m, &o, &mut |_, _| {}))
             .map_err(job_error)?;
-        to_json(&r)
-    }
-
-    /// An equilibrium at a point (JSON of `study::job::Point` in, `SteadyResult` out).
-    fn steady(&self, py: Python<'_>, point: &str) -> PyResult<String> {
-        let p: Point = serde_json::from_str(point).map_err(|e| json_error("steady", e))?;
-        let gb = self.gb.clone();
-        let r = py.detach(|| job::steady_point(&gb, &p)).map_err(job_error)?;
-        to_json(&r)
-    }
-
-    /// Equilibria over a speed × torque grid: `map.csv` text.
-    fn map(
-        &self,
-        py: Python<'_>,
-        point: &str,
-        speeds_rpm: Vec<f64>,
-        torques_nm: Vec<f64>,
-    ) -> PyResult<String> {
-        let p: Point = serde_json::from_str(point).map_err(|e| json_error("map", e))?;
-        let gb = self.gb.clone();
-        py.detach(|| job::map_csv(&gb, &p, &speeds_rpm, &torques_nm))
-            .map_err(job_error)
-    }
-
-    /// A drive-cycle run (JSON of `RunOptions` in): (`summary.json` text, `timeseries.csv` text
-    /// or None).
-    fn run(&self, py: Python<'_>, options: &str) -> PyResult<(String, Option<String>)> {
-        let o: RunOptions = serde_json::from_str(options).map_err(|e| json_error("run", e))?;
-        let gb = self.gb.clone();
-        let r = py.detach(|| job::run_cycle(&gb, &o)).map_err(job_error)?;
         Ok((to_json(&r.summary)?, r.timeseries_csv))
     }
 
@@ -254,7 +263,7 @@ impl Model {
     fn __repr__(&self) -> String {
         format!(
             "Model({:?} from {:?}, {} override(s))",
-            self.gb.name,
+            self.m.gearbox.name,
             self.state.file,
             self.state.overrides.len()
         )

@@ -102,7 +102,7 @@ def test_models_and_results_pickle(at6):
 
 
 def test_the_gil_is_released_during_a_solve(at6, tmp_path):
-    # Six WLTCs back to back (10 800 s): one WLTC at rtol 1e-11 now integrates in ~0.04 s, too
+    # Six WLTCs back to back (10 800 s): one WLTC at rtol 1e-11 integrates in ~0.04 s, too
     # short for the counter below to be measured against.
     rows = (ROOT / "models" / "cycles" / "wltc_class3b.csv").read_text().splitlines()[1:]
     wltc = [tuple(float(v) for v in r.split(",")) for r in rows if r.strip()]

@@ -2,7 +2,6 @@
 //! `geartherm::study`, journals each finished case, compacts `study.csv` / `study.parquet` and
 //! the figures at the end, prints the tally.
 
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::sync::Mutex;
 use std::time::Instant;
@@ -13,7 +12,7 @@ use geartherm::report::study::{
 };
 use geartherm::study::{Case, Study, StudyError};
 
-use super::{invalid, Failure, EXIT_IO};
+use super::output::{emit, invalid, progress_bar, warn, Failure, EXIT_INVALID, EXIT_IO};
 
 /// Arguments of `study`.
 #[derive(clap::Args, Debug)]
@@ -40,7 +39,7 @@ fn io(dir: &std::path::Path) -> impl Fn(std::io::Error) -> Failure + '_ {
     move |e| Failure {
         // A directory holding another study's journal is a usage error, not an I/O failure.
         code: if e.kind() == std::io::ErrorKind::InvalidInput {
-            super::EXIT_INVALID
+            EXIT_INVALID
         } else {
             EXIT_IO
         },
@@ -61,26 +60,41 @@ fn parse_shard(s: &str) -> Result<(usize, usize), Failure> {
     Ok((i, n))
 }
 
-fn bar(n: usize, quiet: bool) -> Option<indicatif::ProgressBar> {
-    (!quiet && std::io::stderr().is_terminal()).then(|| {
-        let b = indicatif::ProgressBar::new(n as u64);
-        if let Ok(st) = indicatif::ProgressStyle::with_template(
-            "{msg} [{bar:40}] {pos}/{len} cases, {per_sec}, ETA {eta}",
-        ) {
-            b.set_style(st.progress_chars("=> "));
+/// Each case's id and stand-alone command line, one per line, written as they are rendered (a
+/// closed pipe ends the listing quietly).
+fn list(study: &Study, cases: &[Case]) -> Result<(), Failure> {
+    use std::io::Write;
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    for c in cases {
+        writeln!(out, "{}\t{}", study.case_id(c), study.command_line(c)).map_err(|e| stdout_error(&e))?;
+    }
+    out.flush().map_err(|e| stdout_error(&e))
+}
+
+fn stdout_error(e: &std::io::Error) -> Failure {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        Failure {
+            code: super::output::EXIT_BROKEN_PIPE,
+            message: String::new(),
         }
-        b
-    })
+    } else {
+        Failure {
+            code: EXIT_IO,
+            message: format!("cannot write to standard output: {e}"),
+        }
+    }
 }
 
 /// Run `study`.
 pub fn study(a: &StudyArgs) -> Result<(), Failure> {
     let study = Study::from_file(&a.study).map_err(|e| match e {
+        // A study or model file that cannot be read is I/O, as for every other command.
         StudyError::Io { .. } => Failure {
-            code: super::EXIT_INVALID,
+            code: EXIT_IO,
             message: e.to_string(),
         },
         StudyError::Invalid(m) => invalid(m),
+        StudyError::Job(j) => j.into(),
     })?;
     let shard = a.shard.as_deref().map(parse_shard).transpose()?;
     let cases = match shard {
@@ -88,10 +102,7 @@ pub fn study(a: &StudyArgs) -> Result<(), Failure> {
         None => study.cases(),
     };
     if a.list {
-        for c in &cases {
-            println!("{}\t{}", study.case_id(c), study.command_line(c));
-        }
-        return Ok(());
+        return list(&study, &cases);
     }
     let dir = a
         .out
@@ -111,10 +122,12 @@ pub fn study(a: &StudyArgs) -> Result<(), Failure> {
         .collect();
     let journal = Journal::open(&dir, &journal_name(shard), &study.fingerprint).map_err(io(&dir))?;
     let per_case = study.spec.outputs.per_case;
-    let b = bar(todo.len(), a.quiet);
-    if let Some(b) = &b {
-        b.set_message(study.spec.study.name.clone());
-    }
+    let b = progress_bar(
+        todo.len(),
+        "{msg} [{bar:40}] {pos}/{len} cases, {per_sec}, ETA {eta}",
+        study.spec.study.name.clone(),
+        a.quiet,
+    );
     let write_error: Mutex<Option<String>> = Mutex::new(None);
     let start = Instant::now();
     study.run(&todo, per_case, &|row: CaseRow, files| {
@@ -143,20 +156,19 @@ pub fn study(a: &StudyArgs) -> Result<(), Failure> {
             message: e,
         });
     }
-    println!(
-        "{} cases solved in {wall:.2} s ({:.2} cases/s on {} threads), {} already done",
+    emit(&format!(
+        "{} cases solved in {wall:.2} s ({:.2} cases/s on {} threads), {} already done\n",
         todo.len(),
         todo.len() as f64 / wall.max(1e-9),
         rayon::current_num_threads(),
         cases.len() - todo.len()
-    );
+    ))?;
     if let Some((i, n)) = shard {
-        println!(
-            "shard {i}/{n} done; run `geartherm study {} --out {}` once every shard finished to merge them",
+        return emit(&format!(
+            "shard {i}/{n} done; run `geartherm study {} --out {}` once every shard finished to merge them\n",
             a.study.display(),
             dir.display()
-        );
-        return Ok(());
+        ));
     }
     compact(&study, &dir)
 }
@@ -171,7 +183,10 @@ fn compact(study: &Study, dir: &std::path::Path) -> Result<(), Failure> {
         .collect();
     let failed: Vec<&CaseRow> = rows.iter().filter(|r| r.status != "ok").collect();
     for r in failed.iter().take(20) {
-        eprintln!("case {} ({}): {}: {}", r.case, r.job, r.status, r.message);
+        warn(&format!(
+            "case {} ({}): {}: {}",
+            r.case, r.job, r.status, r.message
+        ));
     }
     let table = Table::new(rows.clone());
     let csv = study_csv(&table).map_err(|e| Failure {
@@ -193,14 +208,6 @@ fn compact(study: &Study, dir: &std::path::Path) -> Result<(), Failure> {
         let e = default_effects(&table);
         (e.len() >= 2).then(|| [e[0].clone(), e[e.len() - 1].clone()])
     });
-    for name in effects.iter().chain(pareto.iter().flatten()) {
-        if !table.outputs.contains(name) && !table.rows.iter().all(|r| r.status != "ok") {
-            return Err(invalid(format!(
-                "outputs: no output column `{name}`; the table has: {}",
-                table.outputs.join(", ")
-            )));
-        }
-    }
     geartherm::report::plots::study::render(
         dir,
         &table,
@@ -212,16 +219,15 @@ fn compact(study: &Study, dir: &std::path::Path) -> Result<(), Failure> {
         code: EXIT_IO,
         message: format!("study figures: {e}"),
     })?;
-    println!(
-        "{} of {} cases in {} ({} ok, {} failed or invalid): study.csv, study.parquet, main_effects.png{}",
+    emit(&format!(
+        "{} of {} cases in {} ({} ok, {} failed or invalid): study.csv, study.parquet, main_effects.png{}\n",
         rows.len(),
         study.cases().len(),
         dir.display(),
         rows.len() - failed.len(),
         failed.len(),
         if pareto.is_some() { ", pareto.png" } else { "" }
-    );
-    Ok(())
+    ))
 }
 
 /// Default outputs of the figures: total loss energy (or power), efficiency, and the highest

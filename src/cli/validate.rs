@@ -4,11 +4,14 @@
 
 use std::path::PathBuf;
 
-use geartherm::report::files::OutputDir;
-use geartherm::report::validation::{rows_csv, summary_csv, summary_markdown, ValidationReport};
-use geartherm::solve::validation::{run_all, summarise};
+use geartherm::job::validate::{validate as run_validate, ValidateOptions};
+use geartherm::report::files::{write_all_atomic, OutputDir};
+use geartherm::report::validation::{
+    doc_block, rows_csv, splice_doc, summary_csv, summary_markdown, ValidationReport,
+};
 
-use super::{invalid, print_json, Failure, EXIT_IO};
+use super::output::{emit, emit_json, invalid, io_failure};
+use super::Failure;
 
 /// Arguments of `validate`.
 #[derive(clap::Args, Debug)]
@@ -22,54 +25,69 @@ pub struct ValidateArgs {
     /// Print rows and summary as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Also write the summary tables into this Markdown file, between its
+    /// `<!-- geartherm validate: begin -->` and `<!-- geartherm validate: end -->` markers
+    /// (docs/validation.md).
+    #[arg(long)]
+    pub doc: Option<PathBuf>,
+}
+
+/// The Markdown file `path` with its generated block replaced, written in place atomically.
+fn write_doc(path: &std::path::Path, block: &str) -> Result<(), Failure> {
+    let text =
+        std::fs::read_to_string(path).map_err(|e| io_failure(format!("--doc {}: {e}", path.display())))?;
+    let new = splice_doc(&text, block).map_err(|e| invalid(format!("--doc {}: {e}", path.display())))?;
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    write_all_atomic(dir, &[(&name, new.as_bytes())])
+        .map_err(|e| io_failure(format!("--doc {}: {e}", path.display())))?;
+    Ok(())
+}
+
+impl ValidateArgs {
+    /// The job's options.
+    pub fn options(&self) -> ValidateOptions {
+        ValidateOptions {
+            dir: self.dir.clone(),
+        }
+    }
 }
 
 /// Run `validate`.
 pub fn validate(a: &ValidateArgs) -> Result<(), Failure> {
-    if !a.dir.is_dir() {
-        return Err(invalid(format!("validate: {}: not a directory", a.dir.display())));
-    }
     // Lock the output directory before the work (a second writer is refused now) and write the
     // result set as one transaction: the previous set stays whole until the commit.
     let out = OutputDir::begin(&a.out)?;
-    let rows = run_all(&a.dir).map_err(|e| invalid(format!("validate: {e}")))?;
-    if rows.is_empty() {
-        return Err(invalid(format!(
-            "validate: {}: no case.toml found",
-            a.dir.display()
-        )));
-    }
-    if let Some(r) = rows
-        .iter()
-        .find(|r| !(r.predicted.is_finite() && r.relative_error.is_finite()))
-    {
-        return Err(Failure {
-            code: super::EXIT_NUMERICAL,
-            message: format!(
-                "validate: case {} point {} model {}: non-finite result",
-                r.case, r.point, r.model
-            ),
-        });
-    }
-    let sum = summarise(&rows);
+    let r = run_validate(&a.options())?;
     let texts = [
-        ("validation.csv", rows_csv(&rows)),
-        ("validation_summary.csv", summary_csv(&sum)),
-        ("validation.md", summary_markdown(&sum)),
+        ("validation.csv", rows_csv(&r.rows)),
+        ("validation_summary.csv", summary_csv(&r.summary)),
+        ("validation.md", summary_markdown(&r.summary)),
     ];
-    geartherm::report::plots::render_validation(out.path(), &rows, &texts).map_err(|e| Failure {
-        code: EXIT_IO,
-        message: format!("validate: {e}"),
-    })?;
-    let target = out.commit()?;
-    if a.json {
-        print_json(&ValidationReport {
-            rows: &rows,
-            summary: &sum,
-        })
-    } else {
-        print!("{}", summary_markdown(&sum));
-        println!("\n{} rows written to {}", rows.len(), target.display());
-        Ok(())
+    geartherm::report::plots::render_validation(out.path(), &r.rows, &texts)
+        .map_err(|e| io_failure(format!("validate: {e}")))?;
+    if let Some(doc) = &a.doc {
+        write_doc(doc, &doc_block(&r.rows, &r.summary))?;
     }
+    if a.json {
+        emit_json(&ValidationReport {
+            rows: &r.rows,
+            summary: &r.summary,
+        })?;
+    } else {
+        emit(&format!(
+            "{}\n{} rows written to {}\n",
+            summary_markdown(&r.summary),
+            r.rows.len(),
+            out.target().display()
+        ))?;
+    }
+    out.commit()?;
+    Ok(())
 }

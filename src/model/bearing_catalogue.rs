@@ -26,8 +26,8 @@ pub enum BearingType {
 
 impl BearingType {
     /// Palmgren factors (f0 oil bath, f1, load factors of P1 = max(F_r, a·F_a + r·F_r)) of this
-    /// type. Source: thermca `bearing.heat_loss` (Palmgren model after [Jun10], load formulas
-    /// after [Sch13]), github.com/thermca (see docs/physics.md §Bearings); f1 "for 10 % dynamic
+    /// type. Source: thermca `bearing.heat_loss` (Palmgren model after \[Jun10\], load formulas
+    /// after \[Sch13\]), github.com/thermca (see docs/physics.md §Bearings); f1 "for 10 % dynamic
     /// load".
     pub fn palmgren_defaults(self) -> (f64, f64, f64, f64) {
         match self {

@@ -159,17 +159,7 @@ fn check_names(value: &Value, path: &str, problems: &mut Problems) {
             for (k, v) in t {
                 let p = join(k);
                 if k == "name" && p != "model.name" && p != "oil.name" {
-                    if let Value::String(s) = v {
-                        if !is_plain_name(s) {
-                            problems.push(
-                                p,
-                                describe(v),
-                                format!(
-                                    "must be a plain name: 1–{MAX_NAME_LEN} characters, no control characters, none of , \" ' | \\ ; `, no leading or trailing space"
-                                ),
-                            );
-                        }
-                    }
+                    check_name(v, p, problems);
                 } else {
                     check_names(v, &p, problems);
                 }
@@ -181,6 +171,21 @@ fn check_names(value: &Value, path: &str, problems: &mut Problems) {
             }
         }
         _ => {}
+    }
+}
+
+/// A `name` value at `path` that is a string must be a plain name (other types are the typed
+/// reading's to report).
+fn check_name(v: &Value, path: String, problems: &mut Problems) {
+    let Value::String(s) = v else { return };
+    if !is_plain_name(s) {
+        problems.push(
+            path,
+            describe(v),
+            format!(
+                "must be a plain name: 1–{MAX_NAME_LEN} characters, no control characters, none of , \" ' | \\ ; `, no leading or trailing space"
+            ),
+        );
     }
 }
 

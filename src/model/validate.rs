@@ -8,6 +8,7 @@
 
 use std::collections::BTreeSet;
 
+use super::catalogue;
 use super::file::ModelFile;
 use super::gearbox::Gearbox;
 use super::problems::Problems;
@@ -40,13 +41,19 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         .as_ref()
         .map(|t| t.nodes.iter().map(|n| n.name.as_str()).collect())
         .unwrap_or_default();
-    let bearings =
-        bearings::validate_bearings(&file.bearings, &nodes, &parts, &s.gears, s.oil_level, problems);
+    let catalogue_oil = file.oil.catalogue.as_deref().and_then(catalogue::find);
+    let bath = bearings::OilBath {
+        level: s.oil_level,
+        catalogue: catalogue_oil.as_ref(),
+    };
+    let bearings = bearings::validate_bearings(&file.bearings, &nodes, &parts, &s.gears, &bath, problems);
     let seals = seals::validate_seals(&file.seals, &parts.members, &nodes, problems);
     let lub = &file.lubrication;
+    let oil_x_l = oil.as_ref().map_or(1.0, |o| o.lubricant_factor_or_default().0);
     let losses = losses::validate_losses(
         &file.losses.clone().unwrap_or_default(),
         lub.sump_volume_l,
+        oil_x_l,
         problems,
     );
     let element_names: Vec<&str> = file.shift_elements.iter().map(|e| e.name.as_str()).collect();
@@ -120,7 +127,8 @@ fn structure<'a>(file: &'a ModelFile, problems: &mut Problems) -> (Structure, pa
     let structure_start = problems.len();
     let members = members::validate_members(&file.members, problems);
     let planet_of = planetary_sets::planet_roles(&file.planetary_sets);
-    let gears = gears::validate_gears(&file.gears, &members, problems);
+    let roots = meshes::mating_tip_roots(&file.gears, &file.meshes);
+    let gears = gears::validate_gears(&file.gears, &members, &roots, problems);
     let parts = parts::Parts {
         members,
         gears,

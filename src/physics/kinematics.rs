@@ -85,35 +85,66 @@ const TORQUE_RESIDUAL_TOL: f64 = 1e-8;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Constraint {
     /// Fixed-axis external mesh: `za·ωa + zb·ωb = 0`.
-    ExternalMesh { a: usize, b: usize, za: f64, zb: f64 },
+    ExternalMesh {
+        /// Member carrying the first gear.
+        a: usize,
+        /// Member carrying the second gear.
+        b: usize,
+        /// Tooth count of the first gear.
+        za: f64,
+        /// Tooth count of the second gear.
+        zb: f64,
+    },
     /// Fixed-axis internal mesh (pinion inside a ring): `zp·ωp − zr·ωr = 0`.
     InternalMesh {
+        /// Member carrying the external pinion.
         pinion: usize,
+        /// Member carrying the internal ring gear.
         ring: usize,
+        /// Tooth count of the pinion.
         zp: f64,
+        /// Tooth count of the ring gear.
         zr: f64,
     },
     /// Simple planetary set (sun – planets – ring): `zs(ωs − ωc) + zr(ωr − ωc) = 0`.
     SimpleSet {
+        /// Sun gear member.
         sun: usize,
+        /// Ring gear member.
         ring: usize,
+        /// Planet carrier member.
         carrier: usize,
+        /// Tooth count of the sun.
         zs: f64,
+        /// Tooth count of the ring.
         zr: f64,
     },
     /// Double-pinion planetary set (sun – inner pinion – outer pinion – ring):
     /// `zs(ωs − ωc) − zr(ωr − ωc) = 0`.
     DoublePinionSet {
+        /// Sun gear member.
         sun: usize,
+        /// Ring gear member.
         ring: usize,
+        /// Planet carrier member.
         carrier: usize,
+        /// Tooth count of the sun.
         zs: f64,
+        /// Tooth count of the ring.
         zr: f64,
     },
     /// Engaged clutch: `ωa − ωb = 0`.
-    Clutch { a: usize, b: usize },
+    Clutch {
+        /// One member the clutch couples.
+        a: usize,
+        /// The other member.
+        b: usize,
+    },
     /// Engaged brake (member held by the housing): `ω = 0`.
-    Brake { member: usize },
+    Brake {
+        /// The member held at rest.
+        member: usize,
+    },
 }
 
 impl Constraint {
@@ -272,15 +303,32 @@ pub struct ElementRef {
 #[derive(Debug, Clone, PartialEq)]
 pub enum KinematicsError {
     /// A train needs at least two members (an input and an output).
-    TooFewMembers { n_members: usize },
+    TooFewMembers {
+        /// Number of members the train has.
+        n_members: usize,
+    },
     /// A constraint, the input or the output names a member index `>= n_members`.
-    InvalidMember { index: usize, n_members: usize },
+    InvalidMember {
+        /// The member index named.
+        index: usize,
+        /// Number of members the train has.
+        n_members: usize,
+    },
     /// A tooth count is not finite and positive.
-    InvalidToothCount { value: f64 },
+    InvalidToothCount {
+        /// The tooth count given.
+        value: f64,
+    },
     /// The rank tolerance is not finite and positive.
-    InvalidTolerance { value: f64 },
+    InvalidTolerance {
+        /// The relative tolerance given.
+        value: f64,
+    },
     /// Input and output are the same member.
-    InputIsOutput { member: String },
+    InputIsOutput {
+        /// Name of that member.
+        member: String,
+    },
     /// More than one degree of freedom: with the input held, the listed members can still move.
     UnderDetermined {
         /// Members whose speed is not fixed by the input speed.
@@ -298,9 +346,15 @@ pub enum KinematicsError {
         removable_elements: Vec<ElementRef>,
     },
     /// One degree of freedom, but the output is held: no torque can be transmitted.
-    OutputAtRest { output: String },
+    OutputAtRest {
+        /// Name of the output member.
+        output: String,
+    },
     /// The SVD did not converge or the torque solve left a residual (should not happen).
-    Numerical { what: &'static str },
+    Numerical {
+        /// Which computation failed.
+        what: &'static str,
+    },
 }
 
 impl fmt::Display for KinematicsError {
@@ -365,8 +419,11 @@ impl std::error::Error for KinematicsError {}
 /// sign convention of the module (torque applied TO the member).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SetTorques {
+    /// Torque on the sun, N·m per N·m of input torque.
     pub sun: f64,
+    /// Torque on the ring, N·m per N·m of input torque.
     pub ring: f64,
+    /// Torque on the carrier, N·m per N·m of input torque.
     pub carrier: f64,
 }
 

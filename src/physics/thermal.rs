@@ -21,7 +21,7 @@ pub fn radiation_derivative(sigma_eps_area: f64, t: f64) -> f64 {
 
 /// Convection coefficient against vehicle speed, `h = h0 + h1·v^0.8` (W/m²K, v in m/s).
 ///
-/// [recalled] The exponent 0.8 is that of turbulent forced convection over a plate
+/// \[recalled\] The exponent 0.8 is that of turbulent forced convection over a plate
 /// (Nu ∝ Re^0.8, Incropera eq. 7.36); h0 covers natural convection and radiation at rest.
 pub fn h_power_law(h0: f64, h1: f64, speed: f64) -> f64 {
     h0 + h1 * speed.max(0.0).powf(0.8)
@@ -88,10 +88,10 @@ pub const OIL_SPECIFIC_HEAT: f64 = 2000.0;
 /// Mean heat-transfer coefficient of a disc of radius `r` (m) rotating at `omega` (rad/s) in a
 /// fluid, W/m²K.
 ///
-/// [recalled] Free rotating disc, mean Nusselt number Nu = h·r/k: laminar
+/// \[recalled\] Free rotating disc, mean Nusselt number Nu = h·r/k: laminar
 /// Nu_l = 0.36·Re^0.5 (Cobb & Saunders 1956, Re < 2.4e5), turbulent Nu_t = 0.015·Re^0.8
 /// (same source), Re = ω·r²/ν, with a Prandtl factor Pr^(1/3) (exact for air, an extension for
-/// oil). [derived] The two branches are blended as Nu = (Nu_l⁴ + Nu_t⁴)^(1/4) so that h is smooth
+/// oil). \[derived\] The two branches are blended as Nu = (Nu_l⁴ + Nu_t⁴)^(1/4) so that h is smooth
 /// in speed (no step at the transition; a discontinuous h would stall the stiff solver). At rest
 /// the correlation gives 0: natural convection is left to a fixed conductance in parallel.
 pub fn rotating_disc_h(omega: f64, radius: f64, fluid: &FluidProperties) -> f64 {
@@ -102,7 +102,7 @@ pub fn rotating_disc_h(omega: f64, radius: f64, fluid: &FluidProperties) -> f64 
 /// logarithmic slopes d ln ν/dT (`dln_nu`) and d ln Pr/dT (`dln_pr`); h is bitwise that of
 /// [`rotating_disc_h`].
 ///
-/// [derived] from the correlation above at fixed ω, r and k: Re ∝ 1/ν, so
+/// \[derived\] from the correlation above at fixed ω, r and k: Re ∝ 1/ν, so
 /// d ln h/dT = −ε·d ln ν/dT + (1/3)·d ln Pr/dT with the local Reynolds exponent of the blend
 /// ε = d ln Nu/d ln Re = (0.5·Nu_l⁴ + 0.8·Nu_t⁴)/(Nu_l⁴ + Nu_t⁴).
 pub fn rotating_disc_h_slope(
@@ -136,7 +136,7 @@ fn disc_h_and_re_exponent(omega: f64, radius: f64, fluid: &FluidProperties) -> (
 /// Opening of a thermostat valve at temperature `t` (K): 0 below `t_open`, 1 above `t_full`,
 /// and the C¹ smoothstep 3s² − 2s³ in between (s = (t − t_open)/(t_full − t_open)).
 ///
-/// [derived] A smooth ramp instead of a switch: the cooler's heat flow and its derivative stay
+/// \[derived\] A smooth ramp instead of a switch: the cooler's heat flow and its derivative stay
 /// continuous, so the implicit solver's Newton iteration sees no step (physics.md §8).
 /// Returns (opening, d opening / dT).
 pub fn thermostat_opening(t: f64, t_open: f64, t_full: f64) -> (f64, f64) {

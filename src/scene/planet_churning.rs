@@ -1,4 +1,4 @@
-//! Churning of planets averaged over the carrier revolution (issue 14).
+//! Churning of planets averaged over the carrier revolution.
 //!
 //! A planet's axis orbits the set axis at radius R. With the carrier angle φ measured from the
 //! lowest orbit position, the planet's immersion is `h(φ) = h_max − R(1 − cos φ)` (h_max: the
@@ -6,7 +6,7 @@
 //! dips only while `cos φ > 1 − h_max/R`, over the wet arc |φ| < φ_w. The churning of the set's
 //! N planets, averaged over a carrier turn, is
 //!
-//! `P̄ = N · (1/2π) ∮ P(h(φ)) dφ = N · (1/π) ∫₀^φ_w P(h(φ)) dφ` [derived],
+//! `P̄ = N · (1/2π) ∮ P(h(φ)) dφ = N · (1/π) ∫₀^φ_w P(h(φ)) dφ` \[derived\],
 //!
 //! integrated here by Gauss–Legendre quadrature on [0, φ_w] with [`ORBIT_NODES`] nodes, one
 //! precomputed churning model per node. The orbital motion of the planet through the oil is not

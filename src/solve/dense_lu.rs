@@ -5,7 +5,7 @@
 //! diffsol's nalgebra LU goes through nalgebra's generic views (one `icamax`, one column swap and
 //! one rank-1 update per pivot, each through a view): measured on the 14-state FZG C scene, its
 //! three triangular solves per Rosenbrock step took 14 % of a WLTC and its factorisation 10 %
-//! (`perf`, docs/performance.md). Algorithm: Golub & Van Loan, *Matrix Computations*, 4th ed.,
+//! (`perf`). Algorithm: Golub & Van Loan, *Matrix Computations*, 4th ed.,
 //! Alg. 3.4.1 (Gaussian elimination with partial pivoting, kji form) and §3.1 (triangular
 //! solves).
 

@@ -332,7 +332,7 @@ impl LinearSolver<FaerSparseMat<f64>> for NetworkSparseLu {
 
 /// Rest-block size from which faer's supernodal numeric LU is used instead of its simplicial one.
 /// faer's own flop-ratio choice picked simplicial for the 1000-patch AT6 wall; measured over the
-/// WLTC (TR-BDF2, CPU time of two runs each, docs/performance.md "Sparse networks"): 513 states
+/// WLTC (TR-BDF2, CPU time of two runs each, docs/performance.md "Large networks"): 513 states
 /// simplicial 0.39–0.41 s vs supernodal 0.43–0.47 s; 1013 states simplicial 0.94–0.99 s vs
 /// supernodal 0.77–0.81 s.
 pub const SUPERNODAL_FROM: usize = 750;

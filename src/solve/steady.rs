@@ -159,20 +159,32 @@ pub enum SteadyError {
          beyond its {which} bound {bound_k:.3} K (heat balance keeps pushing it out)"
     )]
     NoEquilibriumInRange {
+        /// Index of the node driven out of its range.
         node: usize,
+        /// Temperature the last step wanted for that node, K.
         temperature_k: f64,
+        /// The range limit it crossed, K.
         bound_k: f64,
+        /// Whether that limit is the lower or the upper one.
         which: BoundSide,
     },
     /// The Jacobian is singular (typically a node or group of nodes with no thermal path to a
     /// boundary). `nodes` are the nodes carrying the null space, largest component first.
     #[error("singular heat balance: node(s) {nodes:?} have no thermal path to a boundary (the Jacobian has a null space on them)")]
-    Singular { nodes: Vec<usize> },
+    Singular {
+        /// Indices of the nodes carrying the null space, largest component first.
+        nodes: Vec<usize>,
+    },
     /// Iteration limits reached.
     #[error(
         "steady solver did not converge after {iterations} iterations (max |residual| = {residual_w:.3e} W)"
     )]
-    NotConverged { iterations: usize, residual_w: f64 },
+    NotConverged {
+        /// Iterations done.
+        iterations: usize,
+        /// Largest heat-balance residual over the nodes at the last iterate, W.
+        residual_w: f64,
+    },
     /// Error reported by the model ([`HeatBalance::residual`] / [`HeatBalance::jacobian`]).
     #[error("thermal model error: {0}")]
     Model(String),

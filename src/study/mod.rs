@@ -3,11 +3,11 @@
 //! cycle or operating point; each yields one [`CaseRow`] (parameters, energy per source,
 //! efficiency, final and max temperature per node, or the failure with its message).
 //!
-//! This module sits beside the CLI and the Python binding, above `report`: it orchestrates the
-//! library (model → scene → solve → report summaries) and does no writing itself; the caller
+//! This module sits beside the CLI and the Python binding, above the use-case layer
+//! ([`crate::job`]): a case is a job on the base model with the sample's overrides, solved by
+//! the same job functions as `geartherm run` / `steady`. It does no writing itself; the caller
 //! receives each finished case through a callback (the CLI journals it, Python collects it).
 
-pub mod job;
 pub mod plan;
 pub mod spec;
 
@@ -16,9 +16,10 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 use toml::Value;
 
+use crate::job::command::{command_line, join};
+use crate::job::{self, JobError, RunOptions, SteadyOptions};
 use crate::model::{self, overrides, KeyPath, Override};
 pub use crate::report::study::{CaseRow, ParamValue};
-use job::{JobError, Point, RunOptions};
 use spec::{JobSpec, StudySpec};
 
 /// A study that cannot start: unreadable or invalid study file, invalid base model, bad
@@ -36,6 +37,9 @@ pub enum StudyError {
     /// Invalid study (the message names the file and key path).
     #[error("{0}")]
     Invalid(String),
+    /// A job option, cycle or model that the job layer refuses (its kind sets the exit code).
+    #[error("{0}")]
+    Job(JobError),
 }
 
 /// What one case solves.
@@ -44,7 +48,7 @@ pub enum Job {
     /// A drive cycle with these options.
     Run(RunOptions),
     /// A steady operating point.
-    Point(Point),
+    Steady(SteadyOptions),
 }
 
 impl Job {
@@ -52,7 +56,7 @@ impl Job {
     pub fn label(&self) -> String {
         match self {
             Job::Run(o) => o.cycle.clone(),
-            Job::Point(p) => format!("gear {} @ {} rpm, {} N·m", p.gear, p.speed_rpm, p.torque_nm),
+            Job::Steady(p) => format!("gear {} @ {} rpm, {} N·m", p.gear, p.speed_rpm, p.torque_nm),
         }
     }
 }
@@ -131,7 +135,7 @@ fn jobs_of(spec: &JobSpec) -> Result<Vec<Job>, String> {
                 })
             })
             .collect(),
-        JobSpec::Steady { points } => points.iter().cloned().map(Job::Point).collect(),
+        JobSpec::Steady { points } => points.iter().cloned().map(Job::Steady).collect(),
         JobSpec::Map {
             gear,
             speed_rpm,
@@ -141,7 +145,7 @@ fn jobs_of(spec: &JobSpec) -> Result<Vec<Job>, String> {
             .iter()
             .flat_map(|&s| {
                 torque_nm.iter().map(move |&t| {
-                    Job::Point(Point {
+                    Job::Steady(SteadyOptions {
                         gear: gear.clone(),
                         speed_rpm: s,
                         torque_nm: t,
@@ -156,6 +160,75 @@ fn jobs_of(spec: &JobSpec) -> Result<Vec<Job>, String> {
         return Err("job: no cycles or points".into());
     }
     Ok(jobs)
+}
+
+/// Every job's options checked before any case runs (their ranges, the cycles read, the gear
+/// states known to the base model): a study with a bad option fails at once, not per case. The
+/// message is the job layer's, after the key path of the job in the study file.
+fn check_jobs(spec: &JobSpec, jobs: &[Job], base: &job::Model) -> Result<(), StudyError> {
+    let mut cycles_seen = std::collections::BTreeSet::new();
+    for (k, j) in jobs.iter().enumerate() {
+        match j {
+            Job::Run(o) => {
+                let at = |key: String| move |e: JobError| StudyError::Job(e.prefixed(&key));
+                o.check().map_err(at("job.options".into()))?;
+                if cycles_seen.insert(o.cycle.clone()) {
+                    crate::cycle::DriveCycle::resolve(&o.cycle)
+                        .map_err(|e| at(format!("job.cycles[{k}]"))(e.into()))?;
+                }
+            }
+            Job::Steady(p) => {
+                let key = match spec {
+                    JobSpec::Steady { .. } => format!("job.points[{k}]"),
+                    _ => "job".to_string(),
+                };
+                let at = |e: JobError| StudyError::Job(e.prefixed(&key));
+                p.check().map_err(at)?;
+                base.state(&p.gear).map_err(at)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The table's output columns for `jobs` on the base model (the same names
+/// [`run_outputs`] and [`steady_outputs`] give each row).
+fn output_columns(jobs: &[Job], base: &job::Model) -> Result<Vec<String>, StudyError> {
+    let scene = base
+        .compile(&crate::scene::Needs::default())
+        .map_err(StudyError::Job)?;
+    let nodes = &scene.thermal.names;
+    let sources = crate::scene::Source::ALL.map(|s| s.as_str());
+    let mut cols = Vec::new();
+    if jobs.iter().any(|j| matches!(j, Job::Run(_))) {
+        cols.extend(sources.iter().map(|s| format!("energy_{s}_j")));
+        cols.extend(["energy_total_j", "output_energy_j", "cycle_efficiency"].map(String::from));
+        for n in nodes {
+            cols.push(format!("final_temp_{n}_c"));
+            cols.push(format!("max_temp_{n}_c"));
+        }
+    }
+    if jobs.iter().any(|j| matches!(j, Job::Steady(_))) {
+        cols.extend(sources.iter().map(|s| format!("loss_{s}_w")));
+        cols.extend(["total_loss_w", "efficiency"].map(String::from));
+        cols.extend(nodes.iter().map(|n| format!("temp_{n}_c")));
+    }
+    Ok(cols)
+}
+
+/// Every column `[outputs]` names exists in the table.
+fn check_outputs(o: &spec::OutputSpec, columns: &[String]) -> Result<(), StudyError> {
+    let named = o.effects.iter().flatten().map(|n| ("outputs.effects", n));
+    let pareto = o.pareto.iter().flatten().map(|n| ("outputs.pareto", n));
+    for (key, name) in named.chain(pareto) {
+        if !columns.contains(name) {
+            return Err(StudyError::Invalid(format!(
+                "{key}: no output column `{name}`; the table has: {}",
+                columns.join(", ")
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Scale a number or (nested) array of numbers.
@@ -193,6 +266,7 @@ impl Study {
         let model_text = std::fs::read_to_string(&model_path).map_err(io(&model_path))?;
         Study::new(spec, model_text, model_path).map_err(|e| match e {
             StudyError::Invalid(m) => StudyError::Invalid(format!("{}: {m}", path.display())),
+            StudyError::Job(j) => StudyError::Job(j.prefixed(&path.display().to_string())),
             other => other,
         })
     }
@@ -201,7 +275,8 @@ impl Study {
     /// exist in the model (or be accepted by its schema), the plan must be well formed.
     pub fn new(spec: StudySpec, model_text: String, model_file: PathBuf) -> Result<Study, StudyError> {
         let invalid = StudyError::Invalid;
-        model::from_str(&model_text, &model_file).map_err(|e| invalid(e.report()))?;
+        let base_model =
+            job::Model::from_text(&model_text, &model_file, &[]).map_err(|e| invalid(e.message))?;
         let mut problems = model::Problems::default();
         let base = model::parse::parse_document(&model_text, &mut problems)
             .ok_or_else(|| invalid(format!("{}: not a TOML document", model_file.display())))?;
@@ -243,6 +318,8 @@ impl Study {
             }
         }
         let jobs = jobs_of(&spec.job).map_err(invalid)?;
+        check_jobs(&spec.job, &jobs, &base_model)?;
+        check_outputs(&spec.outputs, &output_columns(&jobs, &base_model)?)?;
         let spec_json = serde_json::to_string(&spec).map_err(|e| invalid(e.to_string()))?;
         let fingerprint = format!("{:016x}", fnv1a(&[spec_json.as_bytes(), model_text.as_bytes()]));
         Ok(Study {
@@ -285,7 +362,7 @@ impl Study {
                     .file_stem()
                     .map_or(&*o.cycle, |s| s.to_str().unwrap_or("cycle")),
             ),
-            Job::Point(_) => format!("p{:04}", c.job),
+            Job::Steady(_) => format!("p{:04}", c.job),
         };
         format!("{:06}-{job}", c.sample)
     }
@@ -329,50 +406,31 @@ impl Study {
         Ok((ovs, used))
     }
 
-    /// The equivalent stand-alone command of a case (for job arrays without Python).
-    pub fn command_line(&self, c: &Case) -> String {
-        let q = |s: &str| format!("'{}'", s.replace('\'', "'\\''"));
-        let model = q(&self.model_file.display().to_string());
-        let mut cmd = match &self.jobs[c.job] {
-            Job::Run(o) => {
-                let mut s = format!(
-                    "geartherm run {model} --cycle {} --solver {} --rtol {} --atol {} --summary-only",
-                    q(&o.cycle),
-                    o.solver,
-                    o.rtol,
-                    o.atol
-                );
-                if let Some(t) = o.initial_temp_c {
-                    s.push_str(&format!(" --initial-temp-c {t}"));
-                }
-                if let Some(t) = o.ambient_c {
-                    s.push_str(&format!(" --ambient-c {t}"));
-                }
-                s
-            }
-            Job::Point(p) => {
-                let mut s = format!(
-                    "geartherm steady {model} --gear {} --speed-rpm {} --torque-nm {} --vehicle-speed-kmh {}",
-                    q(&p.gear),
-                    p.speed_rpm,
-                    p.torque_nm,
-                    p.vehicle_speed_kmh
-                );
-                if let Some(t) = p.ambient_c {
-                    s.push_str(&format!(" --ambient-c {t}"));
-                }
-                s
-            }
-        };
-        match self.overrides(c.sample) {
-            Ok((ovs, _)) => {
-                for o in ovs {
-                    cmd.push_str(&format!(" --set {}", q(&o.to_string())));
-                }
-            }
-            Err(e) => cmd.push_str(&format!("  # {e}")),
+    /// The job a case runs: a run job is summary-only unless per-case files are asked for.
+    fn case_job(&self, c: &Case, per_case: bool) -> Job {
+        match &self.jobs[c.job] {
+            Job::Run(o) => Job::Run(RunOptions {
+                summary_only: !per_case,
+                ..o.clone()
+            }),
+            other => other.clone(),
         }
-        cmd
+    }
+
+    /// The equivalent stand-alone command of a case (for job arrays without Python), rendered
+    /// from the options the case runs with.
+    pub fn command_line(&self, c: &Case) -> String {
+        let per_case = self.spec.outputs.per_case;
+        match self.overrides(c.sample) {
+            Ok((ovs, _)) => match self.case_job(c, per_case) {
+                Job::Run(o) => command_line(&self.model_file, &ovs, &o),
+                Job::Steady(p) => command_line(&self.model_file, &ovs, &p),
+            },
+            Err(e) => format!(
+                "{}  # {e}",
+                join(&["geartherm".into(), self.model_file.display().to_string()])
+            ),
+        }
     }
 
     /// Solve one case. Never fails: a failure is a row with status `invalid` or `failed` and
@@ -395,16 +453,12 @@ impl Study {
                 .cloned()
                 .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
                 .unwrap_or_default();
-            Err(JobError::Numerical(format!("internal error (panic): {what}")))
+            Err(JobError::numerical(format!("internal error (panic): {what}")))
         });
         match outcome {
             Ok(files) => (row, files),
             Err(e) => {
-                row.status = match e {
-                    JobError::Invalid(_) => "invalid",
-                    JobError::Numerical(_) => "failed",
-                }
-                .into();
+                row.status = if e.is_invalid() { "invalid" } else { "failed" }.into();
                 row.message = e.to_string();
                 row.outputs.clear();
                 (row, Vec::new())
@@ -413,38 +467,23 @@ impl Study {
     }
 
     fn solve(&self, c: &Case, per_case: bool, row: &mut CaseRow) -> Result<CaseFiles, JobError> {
-        let (ovs, used) = self.overrides(c.sample).map_err(JobError::Invalid)?;
+        let (ovs, used) = self.overrides(c.sample).map_err(JobError::invalid)?;
         row.params = used;
-        let gb = model::from_str_with(&self.model_text, &self.model_file, &ovs).map_err(|e| {
-            let ModelMessage(m) = ModelMessage::from(&e);
-            JobError::Invalid(m)
-        })?;
-        match &self.jobs[c.job] {
+        let m = job::Model::from_text(&self.model_text, &self.model_file, &ovs)?;
+        match self.case_job(c, per_case) {
             Job::Run(o) => {
-                let o = RunOptions {
-                    summary_only: !per_case,
-                    ..o.clone()
-                };
-                let r = job::run_cycle(&gb, &o)?;
+                let r = job::run::run(&m, &o, &mut |_, _| {})?;
                 row.outputs = run_outputs(&r.summary);
-                let mut files = Vec::new();
-                if per_case {
-                    let json = serde_json::to_vec_pretty(&r.summary)
-                        .map_err(|e| JobError::Numerical(e.to_string()))?;
-                    files.push(("summary.json".to_string(), json));
-                    if let Some(csv) = r.timeseries_csv {
-                        files.push(("timeseries.csv".to_string(), csv.into_bytes()));
-                    }
-                }
-                Ok(files)
+                let files = if per_case { r.files()? } else { Vec::new() };
+                Ok(files.into_iter().map(|(n, b)| (n.to_string(), b)).collect())
             }
-            Job::Point(p) => {
-                let r = job::steady_point(&gb, p)?;
+            Job::Steady(p) => {
+                let r = job::steady::steady(&m, &p)?;
                 row.outputs = steady_outputs(&r);
                 let mut files = Vec::new();
                 if per_case {
-                    let json =
-                        serde_json::to_vec_pretty(&r).map_err(|e| JobError::Numerical(e.to_string()))?;
+                    let json = serde_json::to_vec_pretty(&r)
+                        .map_err(|e| JobError::numerical(format!("cannot serialise steady.json: {e}")))?;
                     files.push(("steady.json".to_string(), json));
                 }
                 Ok(files)
@@ -459,24 +498,6 @@ impl Study {
             let (row, files) = self.run_case(c, per_case);
             on_done(row, files);
         });
-    }
-}
-
-/// A model error as one line: its problems joined.
-struct ModelMessage(String);
-
-impl From<&model::ModelError> for ModelMessage {
-    fn from(e: &model::ModelError) -> Self {
-        match e {
-            model::ModelError::Invalid { problems, .. } => ModelMessage(
-                problems
-                    .iter()
-                    .map(|p| p.to_string())
-                    .collect::<Vec<_>>()
-                    .join("; "),
-            ),
-            other => ModelMessage(other.to_string()),
-        }
     }
 }
 
@@ -500,10 +521,9 @@ pub fn run_outputs(s: &crate::report::run::Summary) -> Vec<(String, Option<f64>)
 
 /// Table outputs of a steady point: loss per source, total, efficiency, temperature per node.
 pub fn steady_outputs(r: &job::SteadyResult) -> Vec<(String, Option<f64>)> {
-    let mut out: Vec<(String, Option<f64>)> = r
-        .by_source_w
+    let mut out: Vec<(String, Option<f64>)> = crate::scene::Source::ALL
         .iter()
-        .map(|(k, v)| (format!("loss_{k}_w"), Some(*v)))
+        .map(|s| (format!("loss_{}_w", s.as_str()), Some(r.by_source_w.get(*s))))
         .collect();
     out.push(("total_loss_w".into(), Some(r.total_loss_w)));
     out.push(("efficiency".into(), r.efficiency));

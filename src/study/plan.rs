@@ -76,10 +76,19 @@ pub fn check_param(p: &ParamSpec) -> Result<(), String> {
             ));
         }
     }
-    if p.levels == Some(0) {
-        return Err(format!("parameter {}: levels must be ≥ 1", p.path));
+    match p.levels {
+        Some(0) => Err(format!("parameter {}: levels must be ≥ 1", p.path)),
+        Some(n) if n > MAX_SAMPLES => Err(format!(
+            "parameter {}: levels = {n}: must lie in [1, {MAX_SAMPLES}]",
+            p.path
+        )),
+        _ => Ok(()),
     }
-    Ok(())
+}
+
+/// How many levels a parameter has on a grid (without building them).
+fn level_count(p: &ParamSpec) -> usize {
+    p.values.as_ref().map_or(p.levels.unwrap_or(3), Vec::len)
 }
 
 fn levels(p: &ParamSpec) -> Vec<ParamValue> {
@@ -102,13 +111,14 @@ fn levels(p: &ParamSpec) -> Vec<ParamValue> {
 
 /// Full factorial over the parameters' levels, the first parameter varying slowest.
 fn grid(params: &[ParamSpec]) -> Result<Vec<Vec<ParamValue>>, String> {
-    let lv: Vec<Vec<ParamValue>> = params.iter().map(levels).collect();
-    let total = lv
+    // The size is checked from the level counts before any level or sample is built.
+    let total = params
         .iter()
-        .try_fold(1usize, |acc, l| {
-            acc.checked_mul(l.len()).filter(|&t| t <= MAX_SAMPLES)
+        .try_fold(1usize, |acc, p| {
+            acc.checked_mul(level_count(p)).filter(|&t| t <= MAX_SAMPLES)
         })
         .ok_or_else(|| format!("the grid has more than {MAX_SAMPLES} cases"))?;
+    let lv: Vec<Vec<ParamValue>> = params.iter().map(levels).collect();
     Ok((0..total)
         .map(|mut k| {
             let mut s = vec![ParamValue::Number(0.0); lv.len()];
@@ -236,6 +246,21 @@ mod tests {
         assert_eq!(s[0], vec![ParamValue::Number(0.0), ParamValue::Text("x".into())]);
         assert_eq!(s[1], vec![ParamValue::Number(0.0), ParamValue::Text("y".into())]);
         assert_eq!(s[5], vec![ParamValue::Number(1.0), ParamValue::Text("y".into())]);
+    }
+
+    #[test]
+    fn a_huge_grid_is_refused_before_it_is_built() {
+        // 1e9 levels would take about 30 GB as samples: refused from the count alone.
+        let mut big = range("a", 0.0, 1.0);
+        big.levels = Some(1_000_000_000);
+        let e = samples(&[big], &Sampling::default()).unwrap_err();
+        assert!(e.contains("levels = 1000000000"), "{e}");
+        let mut a = range("a", 0.0, 1.0);
+        a.levels = Some(5_000);
+        let mut b = range("b", 0.0, 1.0);
+        b.levels = Some(5_000);
+        let e = samples(&[a, b], &Sampling::default()).unwrap_err();
+        assert!(e.contains("more than 10000000 cases"), "{e}");
     }
 
     #[test]

@@ -34,7 +34,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::job::{Point, RunOptions};
+use crate::job::{RunOptions, SteadyOptions};
 
 /// The whole study file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -80,7 +80,7 @@ pub enum JobSpec {
     /// Equilibria at operating points: one case per sample and point.
     Steady {
         /// The points.
-        points: Vec<Point>,
+        points: Vec<SteadyOptions>,
     },
     /// Equilibria over a speed × torque grid in one gear: one case per sample and grid point.
     Map {

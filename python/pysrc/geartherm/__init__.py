@@ -149,7 +149,8 @@ class Model:
 
     def losses(self, gear: str, speed_rpm: float, torque_nm: float, oil_temp_c: float) -> Dict[str, Any]:
         """Every loss item at one operating point (``geartherm losses --json``)."""
-        return json.loads(self._m.losses(str(gear), float(speed_rpm), float(torque_nm), float(oil_temp_c)))
+        o = {"gear": str(gear), "speed_rpm": float(speed_rpm), "torque_nm": float(torque_nm), "oil_temp_c": float(oil_temp_c)}
+        return json.loads(self._m.losses(o))
 
     def steady(
         self,
@@ -161,7 +162,7 @@ class Model:
     ) -> Dict[str, Any]:
         """Equilibrium temperatures (°C), losses (W) and efficiency at one operating point."""
         p = _point(gear, speed_rpm, torque_nm, vehicle_speed_kmh, ambient_c)
-        return json.loads(self._m.steady(json.dumps(p)))
+        return json.loads(self._m.steady(p))
 
     def map(
         self,
@@ -171,10 +172,16 @@ class Model:
         vehicle_speed_kmh: float = 0.0,
         ambient_c: Optional[float] = None,
     ):
-        """Equilibria over speed × torque (``map.csv`` as a DataFrame; NaN where none found)."""
-        p = _point(gear, 0.0, 0.0, vehicle_speed_kmh, ambient_c)
-        csv = self._m.map(json.dumps(p), [float(s) for s in speed_rpm], [float(t) for t in torque_nm])
-        return _frame(csv)
+        """Equilibria over speed × torque (``map.csv`` as a DataFrame), as ``geartherm map``: a
+        point without an equilibrium fails the whole map (:class:`SolveError` naming it)."""
+        o = {
+            "gear": str(gear),
+            "speed_rpm": [float(s) for s in speed_rpm],
+            "torque_nm": [float(t) for t in torque_nm],
+            "vehicle_speed_kmh": float(vehicle_speed_kmh),
+            "ambient_c": None if ambient_c is None else float(ambient_c),
+        }
+        return _frame(self._m.map(o))
 
     def run(
         self,
@@ -187,15 +194,23 @@ class Model:
         ambient_c: Optional[float] = None,
         max_steps: Optional[int] = None,
         summary_only: bool = False,
+        frozen_viscosity_c: Optional[float] = None,
+        evaluate_all: bool = False,
     ) -> RunResult:
         """A drive-cycle transient (bundled cycle name or CSV file), as ``geartherm run``."""
-        o: Dict[str, Any] = {"cycle": os.fspath(cycle), "solver": solver, "summary_only": bool(summary_only)}
+        o: Dict[str, Any] = {
+            "cycle": os.fspath(cycle),
+            "solver": solver,
+            "summary_only": bool(summary_only),
+            "evaluate_all": bool(evaluate_all),
+            "frozen_viscosity_c": None if frozen_viscosity_c is None else float(frozen_viscosity_c),
+        }
         for k, v in (("rtol", rtol), ("atol", atol), ("max_steps", max_steps)):
             if v is not None:
                 o[k] = v
         o["initial_temp_c"] = initial_temp_c
         o["ambient_c"] = ambient_c
-        summary, csv = self._m.run(json.dumps(o))
+        summary, csv = self._m.run(o)
         return RunResult(summary, csv)
 
     def __reduce__(self):

@@ -1,11 +1,11 @@
 //! The friction model of a catalogue bearing (SKF 2004 or Palmgren) with the constants the
-//! catalogue does not carry: SKF's μ values, the drag-term V_M and the seal constants (sources at
-//! each).
+//! catalogue does not carry: SKF's μ values, the drag-term V_M curves and the seal constants
+//! (sources at each).
 
 use super::common::{q, MM};
 use crate::model::bearing_catalogue::{BearingType, CatalogueBearing, SeriesEntry};
 use crate::model::problems::Problems;
-use crate::physics::losses::bearings::skf::{Lubrication, SkfInput};
+use crate::physics::losses::bearings::skf::{DragForm, Lubrication, SkfInput};
 use crate::physics::losses::bearings::{BearingFriction, BearingSize, Palmgren, Skf, SkfConstants, SkfKind};
 
 /// μ_bl of the SKF sliding term (both peers of docs/physics.md §Bearings).
@@ -42,20 +42,42 @@ pub(crate) const DRAG_VM_ROLLER: [(f64, f64); 14] = [
     (1.20, 1.5e-3),
 ];
 
-/// V_M of a roller bearing at oil height `h_over_dm` (H/d_m).
-pub(crate) fn drag_vm_roller(h_over_dm: f64) -> f64 {
+/// V_M of the ball drag term against H/d_m: the same digitised diagram of peer [P5] (its ball
+/// curve; numbers read from a figure), linear in between, constant beyond 1.2.
+pub(crate) const DRAG_VM_BALL: [(f64, f64); 14] = [
+    (0.0, 0.0),
+    (0.025, 2e-6),
+    (0.05, 1.2e-5),
+    (0.075, 3.0e-5),
+    (0.10, 6.5e-5),
+    (0.125, 1.0e-4),
+    (0.15, 1.45e-4),
+    (0.175, 1.95e-4),
+    (0.20, 2.45e-4),
+    (0.30, 3.8e-4),
+    (0.50, 5.5e-4),
+    (0.80, 8.0e-4),
+    (1.00, 1.0e-3),
+    (1.20, 1.25e-3),
+];
+
+/// V_M of the curve `table` at oil height `h_over_dm` (H/d_m).
+fn drag_vm_on(table: &[(f64, f64); 14], h_over_dm: f64) -> f64 {
     let x = h_over_dm.clamp(0.0, 1.2);
-    DRAG_VM_ROLLER
-        .windows(2)
-        .find(|w| x <= w[1].0)
-        .map_or(DRAG_VM_ROLLER[13].1, |w| {
-            w[0].1 + (w[1].1 - w[0].1) * (x - w[0].0) / (w[1].0 - w[0].0)
-        })
+    table.windows(2).find(|w| x <= w[1].0).map_or(table[13].1, |w| {
+        w[0].1 + (w[1].1 - w[0].1) * (x - w[0].0) / (w[1].0 - w[0].0)
+    })
 }
 
-/// V_M of the SKF drag term, read from the SKF diagram at full immersion by the Python
-/// deep-groove peer (a number read from a figure), used for any immersion depth.
-pub(crate) const DRAG_VM: f64 = 0.0012;
+/// V_M of a roller bearing at oil height `h_over_dm` (H/d_m).
+pub(crate) fn drag_vm_roller(h_over_dm: f64) -> f64 {
+    drag_vm_on(&DRAG_VM_ROLLER, h_over_dm)
+}
+
+/// V_M of a ball bearing at oil height `h_over_dm` (H/d_m).
+pub(crate) fn drag_vm_ball(h_over_dm: f64) -> f64 {
+    drag_vm_on(&DRAG_VM_BALL, h_over_dm)
+}
 
 /// SKF seal constants (K_S1, K_S2, β) by type and outside diameter D (mm): SKF, as listed by
 /// thermca `bearing.seal_heat_loss` [SKF06] (the 62 < D ≤ 80 mm row agrees with the
@@ -98,15 +120,33 @@ pub(crate) fn size_of(entry: &CatalogueBearing) -> BearingSize {
     }
 }
 
-/// The SKF (2004) model of catalogue bearing `entry` at key path `p`: its series row, μ values,
-/// drag term at oil height `oil_above` (m above the bearing's lowest point), seal term when
-/// `sealed`. None after a problem.
+/// What a model file sets for the SKF model of one bearing (None: the default).
+pub(crate) struct SkfChoices {
+    /// Integral contact seals.
+    pub sealed: bool,
+    /// Oil bath or grease.
+    pub lubrication: Lubrication,
+    /// Height of the oil above the bearing's lowest point (SKF's H), m.
+    pub oil_above: f64,
+    /// μ_bl.
+    pub mu_bl: Option<f64>,
+    /// μ_EHL.
+    pub mu_ehl: Option<f64>,
+    /// Edition of the drag term.
+    pub drag_form: DragForm,
+    /// V_M of the drag term.
+    pub drag_vm: Option<f64>,
+    /// The catalogue oil's fitted (μ_bl, μ_EHL) for this kind of bearing.
+    pub oil_mu: Option<[f64; 2]>,
+}
+
+/// The SKF (2004) model of catalogue bearing `entry` at key path `p`: its series row; μ_bl and
+/// μ_EHL (the entry's, else the oil's fitted pair, else SKF's constants); the drag term at the
+/// oil height; the seal term when sealed. None after a problem.
 pub(crate) fn skf(
     entry: &CatalogueBearing,
     series: &[SeriesEntry],
-    sealed: bool,
-    lubrication: Lubrication,
-    oil_above: f64,
+    c: &SkfChoices,
     p: &str,
     problems: &mut Problems,
 ) -> Option<BearingFriction> {
@@ -126,7 +166,7 @@ pub(crate) fn skf(
         );
         return None;
     };
-    let seal = if sealed {
+    let seal = if c.sealed {
         seal_constants(entry.kind, entry.outside_mm).map(|(k1, k2, beta)| {
             // Seal counterface d_s ≈ d + 0.25(D − d) (eMotres catalogue estimate).
             (
@@ -140,13 +180,21 @@ pub(crate) fn skf(
         None
     };
     let size = size_of(entry);
+    let h = c.oil_above / size.mean();
     let (mu_ehl, drag_vm) = match kind {
-        SkfKind::CylindricalRoller => (MU_EHL_CYLINDRICAL, drag_vm_roller(oil_above / size.mean())),
-        SkfKind::TaperedRoller => (MU_EHL_TAPERED, drag_vm_roller(oil_above / size.mean())),
+        SkfKind::CylindricalRoller => (MU_EHL_CYLINDRICAL, drag_vm_roller(h)),
+        SkfKind::TaperedRoller => (MU_EHL_TAPERED, drag_vm_roller(h)),
         SkfKind::DeepGrooveBall | SkfKind::AngularContactBall | SkfKind::FourPointContactBall => {
-            (MU_EHL, DRAG_VM)
+            (MU_EHL, drag_vm_ball(h))
         }
     };
+    let mu_bl = c.mu_bl.or(c.oil_mu.map(|m| m[0])).unwrap_or(MU_BL);
+    let mu_ehl = c.mu_ehl.or(c.oil_mu.map(|m| m[1])).unwrap_or(mu_ehl);
+    for (k, v) in [("mu_bl", mu_bl), ("mu_ehl", mu_ehl)] {
+        problems.in_range(&format!("{p}.{k}"), v, 0.0, 0.5, "");
+    }
+    let drag_vm = c.drag_vm.unwrap_or(drag_vm);
+    problems.in_range(&format!("{p}.drag_vm"), drag_vm, 0.0, 0.01, "");
     let input = SkfInput {
         kind,
         constants: SkfConstants {
@@ -161,12 +209,13 @@ pub(crate) fn skf(
         },
         size,
         c0: entry.c0_kn * 1e3,
-        lubrication,
-        mu_bl: MU_BL,
+        lubrication: c.lubrication,
+        mu_bl,
         mu_ehl,
         seal,
-        oil_level: oil_above,
+        oil_level: c.oil_above,
         drag_vm,
+        drag_form: c.drag_form,
         rows: entry.rows.unwrap_or(1.0),
         width: entry.b_mm * MM,
         axial_factor_y: entry.y.unwrap_or(0.0),

@@ -10,9 +10,10 @@ use super::common::*;
 use super::gears::{Gear, GearMount};
 use super::parts::Parts;
 use crate::model::bearing_catalogue::{catalogue, CatalogueBearing, SeriesEntry};
+use crate::model::catalogue::CatalogueOil;
 use crate::model::choice::choice;
 use crate::model::problems::Problems;
-use crate::physics::losses::bearings::skf::Lubrication;
+use crate::physics::losses::bearings::skf::{DragForm, Lubrication};
 use crate::physics::losses::bearings::BearingFriction;
 
 /// Friction model choice of a bearing.
@@ -48,6 +49,30 @@ impl LubricationChoice {
         match self {
             LubricationChoice::OilBath => Lubrication::OilBath,
             LubricationChoice::Grease => Lubrication::Grease,
+        }
+    }
+}
+
+/// `drag_form`: the edition of SKF's oil-bath drag term.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum DragFormChoice {
+    /// The current SKF publication.
+    #[default]
+    Current,
+    /// The older edition, as the FZG group's bearing code writes it.
+    Older,
+}
+choice!(DragFormChoice {
+    Current = "skf_current",
+    Older = "skf_older",
+});
+
+impl DragFormChoice {
+    /// The drag form of the SKF model.
+    pub fn form(self) -> DragForm {
+        match self {
+            DragFormChoice::Current => DragForm::Current,
+            DragFormChoice::Older => DragForm::Older,
         }
     }
 }
@@ -91,6 +116,19 @@ pub struct BearingSpec {
     /// Lubrication (default `oil_bath`).
     #[serde(default)]
     pub lubrication: Option<LubricationChoice>,
+    /// SKF μ_bl (default: the catalogue oil's fitted value for this kind of bearing, else 0.12).
+    #[serde(default)]
+    pub mu_bl: Option<f64>,
+    /// SKF μ_EHL (default: the oil's fitted value, else SKF's by type: 0.05 balls, 0.02
+    /// cylindrical, 0.002 tapered).
+    #[serde(default)]
+    pub mu_ehl: Option<f64>,
+    /// SKF drag term (default `skf_current`; docs/physics.md §Bearings).
+    #[serde(default)]
+    pub drag_form: Option<DragFormChoice>,
+    /// V_M of the drag term (default: SKF's diagram at the bearing's oil height).
+    #[serde(default)]
+    pub drag_vm: Option<f64>,
     /// Thermal nodes that receive the heat with fractions (default: the member's or planet's
     /// body node, else the oil).
     #[serde(default)]
@@ -156,6 +194,14 @@ fn member_height(gears: &[Gear], member: usize) -> Option<f64> {
 /// Bearings per body (0 member / 1 planet, index): (bearing index, `locating` as given).
 type BodyBearings = BTreeMap<(u8, usize), Vec<(usize, Option<bool>)>>;
 
+/// The oil the bearings run in.
+pub(crate) struct OilBath<'a> {
+    /// Static oil level above the datum, m.
+    pub level: f64,
+    /// The model's catalogue oil, if it names one (its fitted bearing μ).
+    pub catalogue: Option<&'a CatalogueOil>,
+}
+
 /// Check `[[bearings]]`: names, mounts, catalogue designations, friction models with their
 /// constants, heat targets (`nodes`: the thermal node names), and the statics (at most two
 /// bearings per member or planet, one locating).
@@ -164,7 +210,7 @@ pub(crate) fn validate_bearings(
     nodes: &BTreeSet<&str>,
     parts: &Parts<'_>,
     gears: &[Gear],
-    oil_level: f64,
+    oil: &OilBath<'_>,
     problems: &mut Problems,
 ) -> Vec<Bearing> {
     let (series, catalogue) = catalogue();
@@ -202,7 +248,7 @@ pub(crate) fn validate_bearings(
         );
         problems.in_range(&format!("{p}.axial_preload_n"), b.axial_preload_n, 0.0, 1e7, " N");
         let axis = mount.and_then(|m| axis_height(m, parts, gears));
-        let Some(friction) = friction(b, entry, &series, axis, oil_level, &p, problems) else {
+        let Some(friction) = friction(b, entry, &series, axis, oil, &p, problems) else {
             continue;
         };
         let heat = heat_to(&b.heat_to, nodes, &format!("{p}.heat_to"), problems);
@@ -312,7 +358,7 @@ fn friction(
     entry: &CatalogueBearing,
     series: &[SeriesEntry],
     axis: Option<f64>,
-    oil_level: f64,
+    oil: &OilBath<'_>,
     p: &str,
     problems: &mut Problems,
 ) -> Option<BearingFriction> {
@@ -325,11 +371,30 @@ fn friction(
             BearingModelChoice::Palmgren
         });
     let oil_above = match (axis, lubrication) {
-        (Some(h), Lubrication::OilBath) => oil_level - (h - 0.5 * size_of(entry).outside),
+        (Some(h), Lubrication::OilBath) => oil.level - (h - 0.5 * size_of(entry).outside),
         _ => 0.0,
     };
     match choice {
-        BearingModelChoice::Skf => skf(entry, series, b.sealed, lubrication, oil_above, p, problems),
+        BearingModelChoice::Skf => {
+            let fitted = oil.catalogue.and_then(|o| {
+                if entry.kind.is_roller() {
+                    o.bearing_mu_roller
+                } else {
+                    o.bearing_mu_ball
+                }
+            });
+            let choices = SkfChoices {
+                sealed: b.sealed,
+                lubrication,
+                oil_above,
+                mu_bl: b.mu_bl,
+                mu_ehl: b.mu_ehl,
+                drag_form: b.drag_form.unwrap_or_default().form(),
+                drag_vm: b.drag_vm,
+                oil_mu: fitted,
+            };
+            skf(entry, series, &choices, p, problems)
+        }
         BearingModelChoice::Palmgren => palmgren(entry, b.sealed, p, problems),
     }
 }

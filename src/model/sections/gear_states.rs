@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use super::common::*;
 use super::members::MemberSpec;
-use super::shift_elements::{Elements, ShiftElementKind};
+use super::shift_elements::Elements;
 use crate::model::problems::Problems;
 use crate::physics::kinematics::{Constraint, GearTrain, KinematicsError, StateSolution};
 
@@ -51,11 +51,9 @@ pub(crate) fn validate_gear_states(
     sound: bool,
     problems: &mut Problems,
 ) -> (Option<GearTrain>, Vec<GearState>) {
-    let (elem_ix, elem_ok, element_specs) = (&elements.ix, elements.ok, elements.specs);
-    let elements = &elements.list;
     let mut states_spec = specs.to_vec();
     if states_spec.is_empty() {
-        if element_specs.is_empty() {
+        if elements.specs.is_empty() {
             states_spec.push(GearStateSpec {
                 name: "1".into(),
                 engaged: vec![],
@@ -69,17 +67,13 @@ pub(crate) fn validate_gear_states(
         }
     }
     let mut state_names = BTreeSet::new();
-    let member_names: Vec<String> = members.iter().map(|m| m.name.clone()).collect();
     // Gear states are solved only on a sound structure, so one broken mesh is not also reported as
     // an under-determined state.
     let train = if sound {
-        match GearTrain::new(member_names, fixed_rows) {
-            Ok(t) => Some(t),
-            Err(e) => {
-                problems.push("members", "", format!("gear train: {e}"));
-                None
-            }
-        }
+        let member_names: Vec<String> = members.iter().map(|m| m.name.clone()).collect();
+        GearTrain::new(member_names, fixed_rows)
+            .map_err(|e| problems.push("members", "", format!("gear train: {e}")))
+            .ok()
     } else {
         None
     };
@@ -89,50 +83,16 @@ pub(crate) fn validate_gear_states(
         if !state_names.insert(st.name.clone()) {
             problems.push(format!("{p}.name"), q(&st.name), "duplicate gear state name");
         }
-        let mut engaged = Vec::new();
-        let mut seen = BTreeSet::new();
-        let mut ok = true;
-        for (k, en) in st.engaged.iter().enumerate() {
-            match elem_ix.get(en.as_str()) {
-                None => {
-                    problems.push(
-                        format!("{p}.engaged[{k}]"),
-                        q(en),
-                        format!(
-                            "unknown shift element; defined: {}",
-                            list(element_specs.iter().map(|e| &e.name))
-                        ),
-                    );
-                    ok = false;
-                }
-                Some(&j) => {
-                    if !seen.insert(j) {
-                        problems.push(format!("{p}.engaged[{k}]"), q(en), "listed twice");
-                        ok = false;
-                    }
-                    engaged.push(j);
-                }
-            }
-        }
-        let (Some(train), Some(inp), Some(out), true, true) = (&train, input, output, ok, elem_ok) else {
+        let engaged = engaged(st, &p, elements, problems);
+        let (Some(train), Some(inp), Some(out), Some(engaged), true) =
+            (&train, input, output, engaged, elements.ok)
+        else {
             continue;
         };
         if input == output {
             continue;
         }
-        let rows: Vec<Constraint> = engaged
-            .iter()
-            .map(|&j| {
-                let e = &elements[j];
-                match e.kind {
-                    ShiftElementKind::Clutch => Constraint::Clutch {
-                        a: e.members[0],
-                        b: e.members[1],
-                    },
-                    ShiftElementKind::Brake => Constraint::Brake { member: e.members[0] },
-                }
-            })
-            .collect();
+        let rows: Vec<Constraint> = engaged.iter().map(|&j| elements.list[j].row()).collect();
         match train.solve_state(&rows, inp, out) {
             Ok(solution) => gear_states.push(GearState {
                 name: st.name.clone(),
@@ -142,8 +102,39 @@ pub(crate) fn validate_gear_states(
             Err(e) => problems.push(p.clone(), q(&st.name), kinematics_message(&e, &st.engaged)),
         }
     }
-
     (train, gear_states)
+}
+
+/// The engaged shift elements of state `st` (indices): known, each once. None after a problem.
+fn engaged(
+    st: &GearStateSpec,
+    p: &str,
+    elements: &Elements<'_>,
+    problems: &mut Problems,
+) -> Option<Vec<usize>> {
+    let mut engaged = Vec::new();
+    let mut seen = BTreeSet::new();
+    let mut ok = true;
+    for (k, en) in st.engaged.iter().enumerate() {
+        let Some(&j) = elements.ix.get(en.as_str()) else {
+            problems.push(
+                format!("{p}.engaged[{k}]"),
+                q(en),
+                format!(
+                    "unknown shift element; defined: {}",
+                    list(elements.specs.iter().map(|e| &e.name))
+                ),
+            );
+            ok = false;
+            continue;
+        };
+        if !seen.insert(j) {
+            problems.push(format!("{p}.engaged[{k}]"), q(en), "listed twice");
+            ok = false;
+        }
+        engaged.push(j);
+    }
+    ok.then_some(engaged)
 }
 
 fn kinematics_message(e: &KinematicsError, engaged: &[String]) -> String {

@@ -139,10 +139,12 @@ impl Gears<'_> {
     }
 }
 
-/// Check `[[gears]]`: unique names, members, geometry.
+/// Check `[[gears]]`: unique names, members, geometry. `roots` (mm, per gear) replaces the
+/// default rack's root where a mating tip needs it ([`super::meshes::mating_tip_roots`]).
 pub(crate) fn validate_gears<'a>(
     specs: &'a [GearSpecFile],
     members: &Members<'_>,
+    roots: &[Option<f64>],
     problems: &mut Problems,
 ) -> Gears<'a> {
     let mut ix: HashMap<&str, usize> = HashMap::new();
@@ -156,7 +158,7 @@ pub(crate) fn validate_gears<'a>(
             problems.push(format!("{p}.name"), q(&g.name), "duplicate gear name");
         }
         member.push(members.lookup(&g.member, format!("{p}.member"), problems));
-        geoms.push(gear_geometry(g, &p, problems));
+        geoms.push(gear_geometry(g, &p, roots[i], problems));
     }
     if specs.is_empty() {
         problems.push("gears", "[]", "at least one [[gears]] entry is required");
@@ -169,8 +171,20 @@ pub(crate) fn validate_gears<'a>(
     }
 }
 
-/// Geometry of one `[[gears]]` entry at key path `p`.
-fn gear_geometry(g: &GearSpecFile, p: &str, problems: &mut Problems) -> Option<GearGeometry> {
+/// Default dedendum factor h_fP of the generating rack, and its addendum h_aP: the basic rack's
+/// bottom clearance is c_P = h_fP − h_aP = 0.25 m_n.
+pub(crate) const RACK_DEDENDUM: f64 = 1.25;
+/// Addendum h_aP of the default generating rack.
+pub(crate) const RACK_ADDENDUM: f64 = 1.0;
+
+/// Geometry of one `[[gears]]` entry at key path `p`; `root_default` (mm) replaces the default
+/// rack's root.
+fn gear_geometry(
+    g: &GearSpecFile,
+    p: &str,
+    root_default: Option<f64>,
+    problems: &mut Problems,
+) -> Option<GearGeometry> {
     let before = problems.len();
     let min_teeth = if g.internal { 20 } else { 5 };
     if g.teeth < min_teeth || g.teeth > 1000 {
@@ -196,7 +210,7 @@ fn gear_geometry(g: &GearSpecFile, p: &str, problems: &mut Problems) -> Option<G
     );
     let ha = g.addendum_factor.unwrap_or(1.0);
     problems.in_range(&format!("{p}.addendum_factor"), ha, 0.5, 1.5, "");
-    let hf = g.dedendum_factor.unwrap_or(1.25);
+    let hf = g.dedendum_factor.unwrap_or(RACK_DEDENDUM);
     problems.in_range(&format!("{p}.dedendum_factor"), hf, 0.8, 1.8, "");
     let rho = g.tool_tip_radius_factor.unwrap_or(0.25);
     problems.in_range(&format!("{p}.tool_tip_radius_factor"), rho, 0.0, 0.5, "");
@@ -225,7 +239,7 @@ fn gear_geometry(g: &GearSpecFile, p: &str, problems: &mut Problems) -> Option<G
     if let Some(d) = g.tip_diameter_mm {
         spec = spec.with_tip_diameter(d * MM);
     }
-    if let Some(d) = g.root_diameter_mm {
+    if let Some(d) = g.root_diameter_mm.or(root_default) {
         spec = spec.with_root_diameter(d * MM);
     }
     match GearGeometry::new(&spec) {

@@ -8,7 +8,9 @@ use crate::model::problems::Problems;
 use crate::physics::losses::churning::{
     changenet::ChangenetParams, seetharaman::CavityTerm, ChurningConfig, ChurningModel,
 };
-use crate::physics::losses::sliding::friction::{BenedictKelley, FrictionLaw, IsoTc60, Schlenk};
+use crate::physics::losses::sliding::friction::{
+    BenedictKelley, ContactLineLoad, FrictionLaw, IsoTc60, Schlenk,
+};
 use crate::physics::losses::sliding::helical::HelicalDistribution;
 use crate::physics::losses::sliding::load_sharing::LoadSharing;
 use crate::physics::losses::sliding::moment_balance::LossForm;
@@ -83,6 +85,21 @@ choice!(FrictionChoice {
     BenedictKelley = "benedict_kelley",
     Schlenk = "schlenk",
     Constant = "constant",
+});
+
+/// `contact_line_load`: the load per length in Schlenk's μ.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum ContactLineLoadChoice {
+    /// F_bn/l_min, the FZG group's form with which their oils' X_L were fitted (the default:
+    /// docs/validation.md, "Contact-line load").
+    #[default]
+    ContactLine,
+    /// F_bt/b, ISO/TR 14179-2.
+    FaceWidth,
+}
+choice!(ContactLineLoadChoice {
+    ContactLine = "contact_line",
+    FaceWidth = "face_width",
 });
 
 /// `load_sharing`: load sharing of spur meshes in double contact.
@@ -170,9 +187,12 @@ pub struct LossesSpec {
     /// μ for `friction = "constant"`.
     #[serde(default)]
     pub friction_coefficient: Option<f64>,
-    /// Lubricant factor X_L of the Schlenk / ISO/TR 14179-2 law (1.0 mineral, 0.8 PAO, ...).
+    /// Lubricant factor X_L of the Schlenk / ISO/TR 14179-2 law (default: the oil's).
     #[serde(default)]
     pub lubricant_factor: Option<f64>,
+    /// Load per length in Schlenk's μ (default `contact_line`).
+    #[serde(default)]
+    pub contact_line_load: Option<ContactLineLoadChoice>,
     /// Spur load sharing (default `uniform`).
     #[serde(default)]
     pub load_sharing: Option<LoadSharingChoice>,
@@ -206,12 +226,22 @@ pub struct LossesSpec {
     /// Stavytskyi: edge coefficient k_s (0.85 sharp, 0.9 deburred).
     #[serde(default)]
     pub stavytskyi_ks: Option<f64>,
-    /// Changenet–Velex low-Re law [factor, exp(h/D), exp(V0/D³), exp(Fr), exp(Re)] [recalled].
+    /// Changenet–Velex low-Re law [factor, exp(h/D), exp(V0/D³), exp(Fr), exp(Re)] \[recalled\].
     #[serde(default)]
     pub changenet_low: Option<[f64; 5]>,
-    /// Changenet–Velex high-Re law [factor, exp(h/D), exp(V0/D³), exp(Fr), exp(b/D)] [recalled].
+    /// Changenet–Velex high-Re law [factor, exp(h/D), exp(V0/D³), exp(Fr), exp(b/D)] \[recalled\].
     #[serde(default)]
     pub changenet_high: Option<[f64; 5]>,
+}
+
+impl ContactLineLoadChoice {
+    /// The load per length.
+    pub fn load(self) -> ContactLineLoad {
+        match self {
+            ContactLineLoadChoice::ContactLine => ContactLineLoad::ContactLine,
+            ContactLineLoadChoice::FaceWidth => ContactLineLoad::FaceWidth,
+        }
+    }
 }
 
 impl LoadSharingChoice {
@@ -294,16 +324,19 @@ pub struct LossModels {
 /// Default discharge coefficient of pocketing (physics.md §6: 0.6–0.7).
 pub const DEFAULT_DISCHARGE_COEFFICIENT: f64 = 0.65;
 
-/// Resolve and check `[losses]`. `sump_volume_l` feeds the Changenet–Velex model.
+/// Resolve and check `[losses]`. `sump_volume_l` feeds the Changenet–Velex model;
+/// `oil_lubricant_factor` is the oil's X_L (its measured value, else its base's), the default of
+/// `lubricant_factor`.
 pub fn validate_losses(
     l: &LossesSpec,
     sump_volume_l: Option<f64>,
+    oil_lubricant_factor: f64,
     problems: &mut Problems,
 ) -> Option<LossModels> {
     let start = problems.len();
     let churning = churning(l, sump_volume_l, problems);
     let pocketing = pocketing(l, problems);
-    let sliding = sliding(l, problems);
+    let sliding = sliding(l, oil_lubricant_factor, problems);
     if problems.len() > start {
         return None;
     }
@@ -387,11 +420,12 @@ fn pocketing(l: &LossesSpec, problems: &mut Problems) -> Option<PocketingOptions
 }
 
 /// The sliding model with its friction law and options.
-fn sliding(l: &LossesSpec, problems: &mut Problems) -> SlidingChoice {
-    let xl = l.lubricant_factor.unwrap_or(1.0);
+fn sliding(l: &LossesSpec, oil_lubricant_factor: f64, problems: &mut Problems) -> SlidingChoice {
+    let xl = l.lubricant_factor.unwrap_or(oil_lubricant_factor);
     problems.in_range("losses.lubricant_factor", xl, 0.3, 2.0, "");
     let schlenk = Schlenk {
         x_l: xl,
+        line_load: l.contact_line_load.unwrap_or_default().load(),
         ..Schlenk::default()
     };
     let friction = friction(l, schlenk, problems);

@@ -33,13 +33,6 @@ pub(crate) fn validate_lubrication(
     mounts: &Mounts,
     problems: &mut Problems,
 ) -> (Vec<Gear>, f64) {
-    let gear_specs = parts.gears.specs;
-    let (gear_ix, planet_of, geoms, gear_member) = (
-        &parts.gears.ix,
-        &parts.planet_of,
-        &parts.gears.geoms,
-        &parts.gears.member,
-    );
     if !lub.oil_level_mm.is_finite() {
         problems.push(
             "lubrication.oil_level_mm",
@@ -50,51 +43,13 @@ pub(crate) fn validate_lubrication(
     if let Some(v) = lub.sump_volume_l {
         problems.positive("lubrication.sump_volume_l", v);
     }
-    for name in lub.centre_height_mm.keys() {
-        match gear_ix.get(name.as_str()) {
-            None => problems.push(format!("lubrication.centre_height_mm.{name}"), "", "unknown gear"),
-            Some(&gi) if planet_of.contains_key(gear_specs[gi].name.as_str()) => problems.push(
-                format!("lubrication.centre_height_mm.{name}"),
-                "",
-                "planets orbit: give the centre height of the set's sun instead (planets take the lowest orbit position)",
-            ),
-            _ => {}
-        }
-    }
-    let mut heights: Vec<Option<f64>> = vec![None; gear_specs.len()];
-    for (gi, g) in gear_specs.iter().enumerate() {
-        if planet_of.contains_key(g.name.as_str()) {
-            continue;
-        }
-        match lub.centre_height_mm.get(&g.name) {
-            Some(h) if h.is_finite() => heights[gi] = Some(h * MM),
-            Some(h) => problems.push(
-                format!("lubrication.centre_height_mm.{}", g.name),
-                h,
-                "must be a finite number",
-            ),
-            None => problems.push(
-                format!("lubrication.centre_height_mm.{}", g.name),
-                "",
-                "missing: every non-planet gear needs its axis height",
-            ),
-        }
-    }
+    let mut heights = axis_heights(lub, parts, problems);
     // Planets: lowest orbit position = axis height of the set (its sun or ring) − orbit radius.
     for s in sets {
         let axis = s.gears.iter().find_map(|&gi| heights[gi]);
         for &gi in &s.gears {
             if let (GearMount::Planet { .. }, Some(axis)) = (mounts[gi].0, axis) {
-                let orbit = meshes
-                    .iter()
-                    .find(|m| {
-                        m.set.is_some()
-                            && (m.gear1 == gi || m.gear2 == gi)
-                            && (mounts[m.gear1].0 == GearMount::OnMember
-                                || mounts[m.gear2].0 == GearMount::OnMember)
-                    })
-                    .map(|m| m.geometry.a_w);
-                if let Some(orbit) = orbit {
+                if let Some(orbit) = orbit_radius(gi, meshes, mounts) {
                     heights[gi] = Some(axis - orbit);
                 }
             }
@@ -102,8 +57,10 @@ pub(crate) fn validate_lubrication(
     }
     let level = lub.oil_level_mm * MM;
     let mut gears = Vec::new();
-    for (gi, g) in gear_specs.iter().enumerate() {
-        let (Some(geo), Some(h), Some(m)) = (geoms[gi].clone(), heights[gi], gear_member[gi]) else {
+    for (gi, g) in parts.gears.specs.iter().enumerate() {
+        let (Some(geo), Some(h), Some(m)) =
+            (parts.gears.geoms[gi].clone(), heights[gi], parts.gears.member[gi])
+        else {
             continue;
         };
         // Lowest point of the gear body: the tip circle of an external gear; for a ring the root circle.
@@ -136,6 +93,48 @@ pub(crate) fn validate_lubrication(
             position: g.position_mm.unwrap_or(0.0) * MM,
         });
     }
-
     (gears, level)
+}
+
+/// `centre_height_mm`: known gears, no planets, every non-planet gear once with a finite height;
+/// the axis height of each non-planet gear (m).
+fn axis_heights(lub: &LubricationSpec, parts: &Parts<'_>, problems: &mut Problems) -> Vec<Option<f64>> {
+    let gear_specs = parts.gears.specs;
+    for name in lub.centre_height_mm.keys() {
+        let path = format!("lubrication.centre_height_mm.{name}");
+        match parts.gears.ix.get(name.as_str()) {
+            None => problems.push(path, "", "unknown gear"),
+            Some(&gi) if parts.is_planet(gi) => problems.push(
+                path,
+                "",
+                "planets orbit: give the centre height of the set's sun instead (planets take the lowest orbit position)",
+            ),
+            _ => {}
+        }
+    }
+    let mut heights: Vec<Option<f64>> = vec![None; gear_specs.len()];
+    for (gi, g) in gear_specs.iter().enumerate() {
+        if parts.is_planet(gi) {
+            continue;
+        }
+        let path = format!("lubrication.centre_height_mm.{}", g.name);
+        match lub.centre_height_mm.get(&g.name) {
+            Some(h) if h.is_finite() => heights[gi] = Some(h * MM),
+            Some(h) => problems.push(path, h, "must be a finite number"),
+            None => problems.push(path, "", "missing: every non-planet gear needs its axis height"),
+        }
+    }
+    heights
+}
+
+/// Distance of planet `gi`'s axis from its set's axis: the centre distance of its mesh with a
+/// sun or the ring.
+fn orbit_radius(gi: usize, meshes: &[Mesh], mounts: &Mounts) -> Option<f64> {
+    let central = |g: usize| mounts[g].0 == GearMount::OnMember;
+    meshes
+        .iter()
+        .find(|m| {
+            m.set.is_some() && (m.gear1 == gi || m.gear2 == gi) && (central(m.gear1) || central(m.gear2))
+        })
+        .map(|m| m.geometry.a_w)
 }

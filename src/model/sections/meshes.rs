@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::common::*;
-use super::gears::GearSpecFile;
+use super::gears::{GearSpecFile, RACK_ADDENDUM, RACK_DEDENDUM};
 use super::parts::Parts;
 use crate::model::choice::choice;
 use crate::model::problems::Problems;
@@ -299,4 +299,52 @@ pub(crate) fn mesh_geometry(
             None
         }
     }
+}
+
+/// Root diameters (mm) that keep the basic rack's bottom clearance c_P·m_n under the mating tip,
+/// per gear, where the default rack's root would leave less [derived]: for an external mesh with
+/// its centre distance a_w and the mating gear's tip diameter d_a2 given, DIN 3960's tip
+/// clearance c = a_w − (d_a2 + d_f1)/2 ≥ c_P·m_n gives d_f1 ≤ 2a_w − d_a2 − 2c_P·m_n. Only gears
+/// whose file gives neither `root_diameter_mm` nor `dedendum_factor` (the rack is then assumed,
+/// not known); a gear in several meshes takes the deepest. `None`: the default rack's root.
+pub(crate) fn mating_tip_roots(gears: &[GearSpecFile], meshes: &[MeshSpec]) -> Vec<Option<f64>> {
+    let mut roots: Vec<Option<f64>> = vec![None; gears.len()];
+    let ix = |n: &str| gears.iter().position(|g| g.name == n);
+    for m in meshes {
+        let (Some(a_w), [n1, n2]) = (m.centre_distance_mm, m.gears.as_slice()) else {
+            continue;
+        };
+        let (Some(i1), Some(i2)) = (ix(n1), ix(n2)) else {
+            continue;
+        };
+        let (a, b) = (&gears[i1], &gears[i2]);
+        let same = |x: Option<f64>, y: Option<f64>, d: f64| (x.unwrap_or(d) - y.unwrap_or(d)).abs() <= 1e-9;
+        // Only a consistent external pair (a mismatch is reported by the mesh check).
+        if m.kind == Some(MeshKindSpec::Internal)
+            || a.internal
+            || b.internal
+            || (a.module_mm - b.module_mm).abs() > 1e-9 * a.module_mm
+            || !same(a.pressure_angle_deg, b.pressure_angle_deg, 20.0)
+            || !same(a.helix_angle_deg, b.helix_angle_deg, 0.0)
+        {
+            continue;
+        }
+        for (i, mate) in [(i1, i2), (i2, i1)] {
+            let (g, o) = (&gears[i], &gears[mate]);
+            let Some(da_mate) = o.tip_diameter_mm else {
+                continue;
+            };
+            if g.root_diameter_mm.is_some() || g.dedendum_factor.is_some() {
+                continue;
+            }
+            let mn = g.module_mm;
+            let d = g.teeth as f64 * mn / (g.helix_angle_deg.unwrap_or(0.0) * DEG).cos();
+            let df_rack = d + 2.0 * mn * (g.profile_shift.unwrap_or(0.0) - RACK_DEDENDUM);
+            let df_clear = 2.0 * a_w - da_mate - 2.0 * (RACK_DEDENDUM - RACK_ADDENDUM) * mn;
+            if df_clear.is_finite() && df_clear > 0.0 && df_clear < df_rack {
+                roots[i] = Some(roots[i].map_or(df_clear, |r: f64| r.min(df_clear)));
+            }
+        }
+    }
+    roots
 }

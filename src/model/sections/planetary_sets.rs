@@ -419,16 +419,7 @@ fn generated_meshes(
         });
         if let Some(pg) = planet {
             if let Some(prev) = centre.insert(pg, geo.a_w) {
-                if (prev - geo.a_w).abs() > 1e-3 * gear_specs[pg].module_mm * MM {
-                    problems.push(
-                        p.to_string(),
-                        format!("{:.4} mm vs {:.4} mm", prev / MM, geo.a_w / MM),
-                        format!(
-                            "planet \"{}\": its centre distances to the sun and to the ring must be equal (coaxial set); adjust profile shifts or tooth counts",
-                            gear_specs[pg].name
-                        ),
-                    );
-                }
+                check_coaxial(set, pg, (prev, geo.a_w), parts, problems);
             }
         }
         meshes.push(Mesh {
@@ -446,6 +437,22 @@ fn generated_meshes(
     }
     if gen_ok && set.planets > 1 {
         check_neighbours(set, &centre, parts, problems);
+    }
+}
+
+/// Coaxial set: planet `pg`'s two centre distances `(a1, a2)` (to the sun and to the ring, m)
+/// agree to 0.001 m_n.
+fn check_coaxial(set: &Set<'_>, pg: usize, (a1, a2): (f64, f64), parts: &Parts<'_>, problems: &mut Problems) {
+    let g = &parts.gears.specs[pg];
+    if (a1 - a2).abs() > 1e-3 * g.module_mm * MM {
+        problems.push(
+            set.path.clone(),
+            format!("{:.4} mm vs {:.4} mm", a1 / MM, a2 / MM),
+            format!(
+                "planet \"{}\": its centre distances to the sun and to the ring must be equal (coaxial set); adjust profile shifts or tooth counts",
+                g.name
+            ),
+        );
     }
 }
 

@@ -8,6 +8,7 @@ use super::common::*;
 use super::members::Members;
 use crate::model::choice::choice;
 use crate::model::problems::Problems;
+use crate::physics::kinematics::Constraint;
 
 /// Clutch or brake.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -43,6 +44,21 @@ pub struct ShiftElement {
     pub kind: ShiftElementKind,
     /// Members (two for a clutch, one for a brake).
     pub members: Vec<usize>,
+}
+
+impl ShiftElement {
+    /// The kinematic constraint of the element while engaged.
+    pub fn row(&self) -> Constraint {
+        match self.kind {
+            ShiftElementKind::Clutch => Constraint::Clutch {
+                a: self.members[0],
+                b: self.members[1],
+            },
+            ShiftElementKind::Brake => Constraint::Brake {
+                member: self.members[0],
+            },
+        }
+    }
 }
 
 /// Checked shift elements with their name index; `ok` false if any failed.

@@ -398,21 +398,24 @@ fn check_hysteresis(s: &ShiftSpec, ratios: &[f64], p: &mut Problems) {
         }
         // Output-speed (vehicle-speed) thresholds must increase with the gear.
         if i + 1 < n - 1 {
-            for (key, v, r) in [
-                ("upshift_rpm", up, (ratios[i], ratios[i + 1])),
-                ("downshift_rpm", down, (ratios[i + 1], ratios[i + 2])),
-            ] {
-                let (w0, w1) = (v[i] / r.0, v[i + 1] / r.1);
-                if w1 <= w0 {
-                    p.push(
-                        format!("vehicle.shift.{key}[{}]", i + 1),
-                        v[i + 1],
-                        format!(
-                            "the output speed at this threshold ({w1:.0} rpm) must exceed the previous one ({w0:.0} rpm)"
-                        ),
-                    );
-                }
-            }
+            check_rising(s, ratios, i, p);
+        }
+    }
+}
+
+/// The output speeds at the thresholds of gear pairs `i` and `i + 1` rise with the gear.
+fn check_rising(s: &ShiftSpec, ratios: &[f64], i: usize, p: &mut Problems) {
+    for (key, v, r) in [
+        ("upshift_rpm", &s.upshift_rpm, (ratios[i], ratios[i + 1])),
+        ("downshift_rpm", &s.downshift_rpm, (ratios[i + 1], ratios[i + 2])),
+    ] {
+        let (w0, w1) = (v[i] / r.0, v[i + 1] / r.1);
+        if w1 <= w0 {
+            p.push(
+                format!("vehicle.shift.{key}[{}]", i + 1),
+                v[i + 1],
+                format!("the output speed at this threshold ({w1:.0} rpm) must exceed the previous one ({w0:.0} rpm)"),
+            );
         }
     }
 }

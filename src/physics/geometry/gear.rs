@@ -34,21 +34,21 @@ use super::profile::{ProfileInput, ToothProfile};
 pub struct GearSpec {
     /// Number of teeth (positive also for an internal gear).
     pub z: u32,
-    /// Normal module m_n [m].
+    /// Normal module m_n \[m\].
     pub mn: f64,
-    /// Normal pressure angle α_n [rad].
+    /// Normal pressure angle α_n \[rad\].
     pub alpha_n: f64,
-    /// Helix angle β on the reference cylinder, magnitude [rad] (0 = spur). Hand not needed.
+    /// Helix angle β on the reference cylinder, magnitude \[rad\] (0 = spur). Hand not needed.
     pub beta: f64,
     /// Profile shift coefficient x [-] (for a ring see the module docs: `x = −x_ISO`).
     pub x: f64,
-    /// Face width b [m].
+    /// Face width b \[m\].
     pub b: f64,
     /// True for an internal (ring) gear.
     pub internal: bool,
-    /// Tip diameter override [m]; takes precedence over the nominal value.
+    /// Tip diameter override \[m\]; takes precedence over the nominal value.
     pub tip_diameter: Option<f64>,
-    /// Root diameter override [m]; takes precedence over the nominal value.
+    /// Root diameter override \[m\]; takes precedence over the nominal value.
     pub root_diameter: Option<f64>,
     /// Addendum factor h_aP* of the gear (basic rack dedendum) [-], default 1.0.
     pub ha_p: f64,
@@ -86,12 +86,12 @@ impl GearSpec {
         self.internal = internal;
         self
     }
-    /// Tip diameter override [m].
+    /// Tip diameter override \[m\].
     pub fn with_tip_diameter(mut self, d_a: f64) -> Self {
         self.tip_diameter = Some(d_a);
         self
     }
-    /// Root diameter override [m].
+    /// Root diameter override \[m\].
     pub fn with_root_diameter(mut self, d_f: f64) -> Self {
         self.root_diameter = Some(d_f);
         self
@@ -180,44 +180,44 @@ impl GearSpec {
 pub struct GearGeometry {
     /// The input this was built from.
     pub spec: GearSpec,
-    /// Transverse pressure angle `α_t = atan(tan α_n / cos β)` [rad].
+    /// Transverse pressure angle `α_t = atan(tan α_n / cos β)` \[rad\].
     pub alpha_t: f64,
-    /// Base helix angle `β_b = asin(sin β cos α_n)` [rad].
+    /// Base helix angle `β_b = asin(sin β cos α_n)` \[rad\].
     pub beta_b: f64,
-    /// Transverse module `m_t = m_n / cos β` [m].
+    /// Transverse module `m_t = m_n / cos β` \[m\].
     pub m_t: f64,
-    /// Reference diameter `d = m_t z` [m].
+    /// Reference diameter `d = m_t z` \[m\].
     pub d: f64,
-    /// Base diameter `d_b = d cos α_t` [m].
+    /// Base diameter `d_b = d cos α_t` \[m\].
     pub d_b: f64,
-    /// Tip diameter [m] (override or nominal; ring: the inner circle).
+    /// Tip diameter \[m\] (override or nominal; ring: the inner circle).
     pub d_a: f64,
-    /// Root diameter [m] (override or nominal; ring: the outer circle).
+    /// Root diameter \[m\] (override or nominal; ring: the outer circle).
     pub d_f: f64,
-    /// Form diameter: where the involute meets the root fillet [m].
+    /// Form diameter: where the involute meets the root fillet \[m\].
     pub d_form: f64,
-    /// Transverse pitch `p_t = π m_t` [m].
+    /// Transverse pitch `p_t = π m_t` \[m\].
     pub p_t: f64,
-    /// Transverse base pitch `p_bt = π m_t cos α_t` [m].
+    /// Transverse base pitch `p_bt = π m_t cos α_t` \[m\].
     pub p_bt: f64,
-    /// Normal pitch `p_n = π m_n` [m].
+    /// Normal pitch `p_n = π m_n` \[m\].
     pub p_n: f64,
-    /// Normal base pitch `p_bn = π m_n cos α_n` [m].
+    /// Normal base pitch `p_bn = π m_n cos α_n` \[m\].
     pub p_bn: f64,
-    /// Transverse tooth thickness on the reference circle [m]:
+    /// Transverse tooth thickness on the reference circle \[m\]:
     /// external `m_t(π/2 + 2x tan α_n)`, ring `m_t(π/2 − 2x tan α_n)`.
     pub s_t: f64,
-    /// Normal tooth thickness on the reference cylinder `s_n = s_t cos β` [m].
+    /// Normal tooth thickness on the reference cylinder `s_n = s_t cos β` \[m\].
     pub s_n: f64,
-    /// Transverse tooth thickness (arc) on the tip circle [m].
+    /// Transverse tooth thickness (arc) on the tip circle \[m\].
     pub s_at: f64,
-    /// Transverse space width (arc) on the tip circle [m] (the opening of a tooth space).
+    /// Transverse space width (arc) on the tip circle \[m\] (the opening of a tooth space).
     pub e_at: f64,
-    /// Tooth height `|d_a − d_f|/2` [m].
+    /// Tooth height `|d_a − d_f|/2` \[m\].
     pub h: f64,
     /// Effective tool dedendum factor `h_fP,eff` implied by the actual root diameter [-].
     pub hf_p_eff: f64,
-    /// Tool tip (fillet) radius actually used [m] (`ρ_fP* m_n` unless reduced).
+    /// Tool tip (fillet) radius actually used \[m\] (`ρ_fP* m_n` unless reduced).
     pub rho_f: f64,
     /// True if `ρ_fP* m_n` did not fit in the tool tooth / tooth space and was reduced to the
     /// largest value that fits (full-radius root).
@@ -265,53 +265,7 @@ impl GearGeometry {
                 m_t * (FRAC_PI_2 + 2.0 * spec.x * tan_an),
             )
         };
-        let mm = |v: f64| v * 1e3;
-        if !(d_f > 0.0) {
-            return Err(GeometryError::Impossible(format!(
-                "root diameter d_f = {:.6} mm is not positive (d = {:.6} mm, m_n = {:.6} mm, x = {})",
-                mm(d_f),
-                mm(d),
-                mm(mn),
-                spec.x
-            )));
-        }
-        if !(d_a > 0.0) {
-            return Err(GeometryError::Impossible(format!(
-                "tip diameter d_a = {:.6} mm is not positive",
-                mm(d_a)
-            )));
-        }
-        if spec.internal {
-            if !(d_f > d_a) {
-                return Err(GeometryError::Impossible(format!(
-                    "ring gear: root diameter {:.6} mm must exceed tip diameter {:.6} mm",
-                    mm(d_f),
-                    mm(d_a)
-                )));
-            }
-            if !(d_a > d_b) {
-                return Err(GeometryError::Impossible(format!(
-                    "ring gear: tip circle d_a = {:.6} mm lies inside the base circle d_b = {:.6} mm (no involute there)",
-                    mm(d_a),
-                    mm(d_b)
-                )));
-            }
-        } else {
-            if !(d_a > d_f) {
-                return Err(GeometryError::Impossible(format!(
-                    "tip diameter {:.6} mm must exceed root diameter {:.6} mm",
-                    mm(d_a),
-                    mm(d_f)
-                )));
-            }
-            if !(d_a > d_b) {
-                return Err(GeometryError::Impossible(format!(
-                    "tip circle d_a = {:.6} mm lies inside the base circle d_b = {:.6} mm",
-                    mm(d_a),
-                    mm(d_b)
-                )));
-            }
-        }
+        check_diameters(spec, d, d_a, d_f, d_b)?;
         let hf_p_eff = if spec.internal {
             (d_f - d) / (2.0 * mn) - spec.x
         } else {
@@ -337,20 +291,7 @@ impl GearGeometry {
         let psi_a = profile.half_thickness_angle(r_a);
         let s_at = 2.0 * r_a * psi_a;
         let e_at = 2.0 * PI * r_a / z - s_at;
-        if !(s_at > 0.0) {
-            return Err(GeometryError::Impossible(format!(
-                "tooth is pointed: thickness on the tip circle d_a = {:.6} mm would be {:.6} mm",
-                mm(d_a),
-                mm(s_at)
-            )));
-        }
-        if !(e_at > 0.0) {
-            return Err(GeometryError::Impossible(format!(
-                "no tooth space left on the tip circle d_a = {:.6} mm (space width {:.6} mm)",
-                mm(d_a),
-                mm(e_at)
-            )));
-        }
+        check_tip_land(d_a, s_at, e_at)?;
         let (x_min, undercut) = if spec.internal {
             (None, false)
         } else {
@@ -395,49 +336,49 @@ impl GearGeometry {
     pub fn is_internal(&self) -> bool {
         self.spec.internal
     }
-    /// Reference radius [m].
+    /// Reference radius \[m\].
     pub fn r(&self) -> f64 {
         self.d / 2.0
     }
-    /// Base radius [m].
+    /// Base radius \[m\].
     pub fn r_b(&self) -> f64 {
         self.d_b / 2.0
     }
-    /// Tip radius [m].
+    /// Tip radius \[m\].
     pub fn r_a(&self) -> f64 {
         self.d_a / 2.0
     }
-    /// Root radius [m].
+    /// Root radius \[m\].
     pub fn r_f(&self) -> f64 {
         self.d_f / 2.0
     }
-    /// Form radius (involute/fillet junction) [m].
+    /// Form radius (involute/fillet junction) \[m\].
     pub fn r_form(&self) -> f64 {
         self.d_form / 2.0
     }
-    /// Face width [m].
+    /// Face width \[m\].
     pub fn b(&self) -> f64 {
         self.spec.b
     }
 
-    /// Angular half-thickness of the tooth on the involute at radius `r` [rad] [std]:
+    /// Angular half-thickness of the tooth on the involute at radius `r` \[rad\] [std]:
     /// external `ψ(r) = s_t/d + inv α_t − inv α_r`, ring `ψ(r) = s_t/d − inv α_t + inv α_r`
     /// with `cos α_r = r_b / r`. Precondition: `r ≥ r_b` (clamped to the base circle below).
     pub fn half_thickness_angle(&self, r: f64) -> f64 {
         self.profile.half_thickness_angle(r)
     }
 
-    /// Transverse tooth thickness (arc) on the involute at radius `r` [m]: `2 r ψ(r)`.
+    /// Transverse tooth thickness (arc) on the involute at radius `r` \[m\]: `2 r ψ(r)`.
     pub fn tooth_thickness_at(&self, r: f64) -> f64 {
         2.0 * r * self.half_thickness_angle(r)
     }
 
-    /// Transverse space width (arc) on the involute at radius `r` [m]: `2πr/z − s(r)`.
+    /// Transverse space width (arc) on the involute at radius `r` \[m\]: `2πr/z − s(r)`.
     pub fn space_width_at(&self, r: f64) -> f64 {
         2.0 * PI * r / f64::from(self.spec.z) - self.tooth_thickness_at(r)
     }
 
-    /// Pressure angle of the involute at radius `r` [rad] (`acos(r_b/r)`).
+    /// Pressure angle of the involute at radius `r` \[rad\] (`acos(r_b/r)`).
     pub fn pressure_angle_at(&self, r: f64) -> f64 {
         pressure_angle_at(r, self.r_b())
     }
@@ -451,6 +392,81 @@ impl GearGeometry {
     pub(crate) fn inv_alpha_t(&self) -> f64 {
         inv(self.alpha_t)
     }
+}
+
+/// The diameters of a gear are possible: root and tip circles positive, the tip beyond the root
+/// (inside it for a ring) and beyond the base circle (so that there is an involute).
+fn check_diameters(spec: &GearSpec, d: f64, d_a: f64, d_f: f64, d_b: f64) -> Result<(), GeometryError> {
+    let mn = spec.mn;
+    let mm = |v: f64| v * 1e3;
+    if !(d_f > 0.0) {
+        return Err(GeometryError::Impossible(format!(
+            "root diameter d_f = {:.6} mm is not positive (d = {:.6} mm, m_n = {:.6} mm, x = {})",
+            mm(d_f),
+            mm(d),
+            mm(mn),
+            spec.x
+        )));
+    }
+    if !(d_a > 0.0) {
+        return Err(GeometryError::Impossible(format!(
+            "tip diameter d_a = {:.6} mm is not positive",
+            mm(d_a)
+        )));
+    }
+    if spec.internal {
+        if !(d_f > d_a) {
+            return Err(GeometryError::Impossible(format!(
+                "ring gear: root diameter {:.6} mm must exceed tip diameter {:.6} mm",
+                mm(d_f),
+                mm(d_a)
+            )));
+        }
+        if !(d_a > d_b) {
+            return Err(GeometryError::Impossible(format!(
+                "ring gear: tip circle d_a = {:.6} mm lies inside the base circle d_b = {:.6} mm (no involute there)",
+                mm(d_a),
+                mm(d_b)
+            )));
+        }
+    } else {
+        if !(d_a > d_f) {
+            return Err(GeometryError::Impossible(format!(
+                "tip diameter {:.6} mm must exceed root diameter {:.6} mm",
+                mm(d_a),
+                mm(d_f)
+            )));
+        }
+        if !(d_a > d_b) {
+            return Err(GeometryError::Impossible(format!(
+                "tip circle d_a = {:.6} mm lies inside the base circle d_b = {:.6} mm",
+                mm(d_a),
+                mm(d_b)
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The tooth is not pointed and leaves a space on the tip circle: thickness `s_at` and space
+/// width `e_at` on the tip circle of diameter `d_a` positive.
+fn check_tip_land(d_a: f64, s_at: f64, e_at: f64) -> Result<(), GeometryError> {
+    let mm = |v: f64| v * 1e3;
+    if !(s_at > 0.0) {
+        return Err(GeometryError::Impossible(format!(
+            "tooth is pointed: thickness on the tip circle d_a = {:.6} mm would be {:.6} mm",
+            mm(d_a),
+            mm(s_at)
+        )));
+    }
+    if !(e_at > 0.0) {
+        return Err(GeometryError::Impossible(format!(
+            "no tooth space left on the tip circle d_a = {:.6} mm (space width {:.6} mm)",
+            mm(d_a),
+            mm(e_at)
+        )));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

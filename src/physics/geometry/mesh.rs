@@ -3,14 +3,14 @@
 //!
 //! # Coordinate along the line of action
 //!
-//! `s` [m] is measured along the transverse line of action from the pitch point C (s = 0),
+//! `s` \[m\] is measured along the transverse line of action from the pitch point C (s = 0),
 //! **negative towards gear 1's base tangent point T1** (`s_T1 = −r_b1 tan α_wt`). Gear 1 is
 //! the pinion (always an external gear); in an internal mesh gear 2 is the ring.
 //!
 //! * External mesh: T1 and T2 lie on opposite sides of C, `s_T2 = +r_b2 tan α_wt`.
 //!   Curvature radii (distances from T1, T2) `ρ1 = r_b1 tan α_wt + s`, `ρ2 = r_b2 tan α_wt − s`,
 //!   both flanks convex.
-//! * Internal mesh [derived]: the line of action touches both base circles on the same side
+//! * Internal mesh \[derived\]: the line of action touches both base circles on the same side
 //!   of C, so `s_T2 = −r_b2 tan α_wt` (beyond T1, since r_b2 > r_b1), and
 //!   `T1T2 = (r_b2 − r_b1) tan α_wt = a_w sin α_wt`. The distances from the centres of curvature
 //!   are `ρ1 = r_b1 tan α_wt + s` (convex pinion flank) and `ρ2 = r_b2 tan α_wt + s` (concave
@@ -50,55 +50,55 @@ pub struct MeshGeometry {
     pub z2: u32,
     /// Gear ratio `u = z2/z1` (> 0 for both kinds).
     pub u: f64,
-    /// Normal module [m].
+    /// Normal module \[m\].
     pub mn: f64,
-    /// Transverse module [m].
+    /// Transverse module \[m\].
     pub m_t: f64,
-    /// Normal pressure angle [rad].
+    /// Normal pressure angle \[rad\].
     pub alpha_n: f64,
-    /// Transverse pressure angle on the reference circle [rad].
+    /// Transverse pressure angle on the reference circle \[rad\].
     pub alpha_t: f64,
-    /// Helix angle [rad].
+    /// Helix angle \[rad\].
     pub beta: f64,
-    /// Base helix angle [rad].
+    /// Base helix angle \[rad\].
     pub beta_b: f64,
-    /// Reference centre distance `a = m_t (z2 ± z1)/2` (+ external, − internal) [m].
+    /// Reference centre distance `a = m_t (z2 ± z1)/2` (+ external, − internal) \[m\].
     pub a: f64,
-    /// Operating centre distance [m].
+    /// Operating centre distance \[m\].
     pub a_w: f64,
-    /// Operating transverse pressure angle α_wt [rad].
+    /// Operating transverse pressure angle α_wt \[rad\].
     pub alpha_wt: f64,
-    /// Zero-backlash operating centre distance from the profile shifts [m].
+    /// Zero-backlash operating centre distance from the profile shifts \[m\].
     pub a_w_from_shifts: f64,
-    /// Operating pitch radius of gear 1 `r_b1 / cos α_wt` [m].
+    /// Operating pitch radius of gear 1 `r_b1 / cos α_wt` \[m\].
     pub r_w1: f64,
-    /// Operating pitch radius of gear 2 [m].
+    /// Operating pitch radius of gear 2 \[m\].
     pub r_w2: f64,
-    /// Base radii [m].
+    /// Base radii \[m\].
     pub r_b1: f64,
-    /// Base radius of gear 2 [m].
+    /// Base radius of gear 2 \[m\].
     pub r_b2: f64,
-    /// Tip radii [m].
+    /// Tip radii \[m\].
     pub r_a1: f64,
-    /// Tip radius of gear 2 [m].
+    /// Tip radius of gear 2 \[m\].
     pub r_a2: f64,
-    /// Transverse base pitch (common) [m].
+    /// Transverse base pitch (common) \[m\].
     pub p_bt: f64,
-    /// Length T1T2 of the line of action between the base tangent points [m].
+    /// Length T1T2 of the line of action between the base tangent points \[m\].
     pub t1t2: f64,
-    /// Position of T1 on the line of action [m].
+    /// Position of T1 on the line of action \[m\].
     pub s_t1: f64,
-    /// Position of T2 on the line of action [m].
+    /// Position of T2 on the line of action \[m\].
     pub s_t2: f64,
-    /// Start of contact A (end nearer T1) [m].
+    /// Start of contact A (end nearer T1) \[m\].
     pub s_a: f64,
-    /// Point B = E − p_bt [m].
+    /// Point B = E − p_bt \[m\].
     pub s_b: f64,
-    /// Point D = A + p_bt [m].
+    /// Point D = A + p_bt \[m\].
     pub s_d: f64,
-    /// End of contact E [m].
+    /// End of contact E \[m\].
     pub s_e: f64,
-    /// Length of the path of contact `g_α = s_E − s_A` [m].
+    /// Length of the path of contact `g_α = s_E − s_A` \[m\].
     pub g_alpha: f64,
     /// Transverse contact ratio `ε_α = g_α / p_bt`.
     pub eps_alpha: f64,
@@ -106,10 +106,10 @@ pub struct MeshGeometry {
     pub eps_beta: f64,
     /// Total contact ratio `ε_γ = ε_α + ε_β`.
     pub eps_gamma: f64,
-    /// Common (smaller) face width [m].
+    /// Common (smaller) face width \[m\].
     pub b: f64,
     /// Circumferential backlash on the operating pitch circle
-    /// `j_wt = 2π r_w1/z1 − s_w1 − s_w2` [m] (s_w: tooth thicknesses on the operating pitch
+    /// `j_wt = 2π r_w1/z1 − s_w1 − s_w2` \[m\] (s_w: tooth thicknesses on the operating pitch
     /// circles; ring: its own tooth). Zero for the shift-derived centre distance.
     pub backlash_t: f64,
     /// Gear 2's tip reaches gear 1 below gear 1's form circle (involute interference/undercut).
@@ -147,7 +147,7 @@ impl MeshGeometry {
     /// `T1A = T1T2 − √(r_a2² − r_b2²)`; internal [derived, same construction]
     /// `T1A = √(r_a2² − r_b2²) − T1T2`. `ε_α = g_α/p_bt`, `ε_β = b sin β/(π m_n)`.
     ///
-    /// Tip interference of internal meshes [recalled] (KHK Co., "Gear technical reference",
+    /// Tip interference of internal meshes \[recalled\] (KHK Co., "Gear technical reference",
     /// internal gear interference; also Maitra, Handbook of Gear Design): with `θ1 =
     /// acos((r_a2² − r_a1² − a_w²)/(2 a_w r_a1)) + inv α_a1 − inv α_wt`, `θ2 =
     /// acos((a_w² + r_a2² − r_a1²)/(2 a_w r_a2))`, no interference iff
@@ -163,80 +163,15 @@ impl MeshGeometry {
         kind: MeshKind,
         centre_distance: Option<f64>,
     ) -> Result<MeshGeometry, GeometryError> {
+        check_pair(g1, g2, kind)?;
         let (s1, s2) = (&g1.spec, &g2.spec);
-        same("normal module mn [m]", s1.mn, s2.mn, 1e-9 * s1.mn.max(s2.mn))?;
-        same(
-            "normal pressure angle alpha_n [rad]",
-            s1.alpha_n,
-            s2.alpha_n,
-            1e-9,
-        )?;
-        same("helix angle beta [rad]", s1.beta, s2.beta, 1e-9)?;
-        if g1.is_internal() {
-            return Err(GeometryError::Impossible(
-                "gear 1 of a mesh must be an external gear (the pinion)".into(),
-            ));
-        }
-        match kind {
-            MeshKind::External if g2.is_internal() => {
-                return Err(GeometryError::Impossible(
-                    "external mesh given a ring gear as gear 2 (use MeshKind::Internal)".into(),
-                ))
-            }
-            MeshKind::Internal if !g2.is_internal() => {
-                return Err(GeometryError::Impossible(
-                    "internal mesh needs a ring (internal gear) as gear 2".into(),
-                ))
-            }
-            MeshKind::Internal if s2.z <= s1.z => {
-                return Err(GeometryError::Impossible(format!(
-                    "internal mesh: ring z2 = {} must have more teeth than pinion z1 = {}",
-                    s2.z, s1.z
-                )))
-            }
-            _ => {}
-        }
         let internal = kind == MeshKind::Internal;
         let (z1, z2) = (f64::from(s1.z), f64::from(s2.z));
         let mn = s1.mn;
         let m_t = g1.m_t;
         let alpha_t = g1.alpha_t;
-        let (zs, xs) = if internal {
-            (z2 - z1, s2.x - s1.x)
-        } else {
-            (z1 + z2, s1.x + s2.x)
-        };
-        let a = m_t * zs / 2.0;
-        // [std] operating pressure angle from the shifts
-        let inv_wt = g1.inv_alpha_t() + 2.0 * s1.alpha_n.tan() * xs / zs;
-        if !(inv_wt > 0.0) {
-            return Err(GeometryError::Impossible(format!(
-                "profile shift sum {xs} too negative: inv α_wt = {inv_wt:e} ≤ 0"
-            )));
-        }
-        let alpha_wt_shift = inv_inverse(inv_wt);
-        let a_w_from_shifts = a * alpha_t.cos() / alpha_wt_shift.cos();
-        let (a_w, alpha_wt) = match centre_distance {
-            None => (a_w_from_shifts, alpha_wt_shift),
-            Some(aw) => {
-                if !(aw.is_finite() && aw > 0.0) {
-                    return Err(GeometryError::InvalidParameter {
-                        name: "centre_distance",
-                        value: aw,
-                        requirement: "must be a finite number > 0",
-                    });
-                }
-                let c = a * alpha_t.cos() / aw;
-                if !(c < 1.0) {
-                    return Err(GeometryError::Impossible(format!(
-                        "centre distance {:.6} mm is not larger than (r_b2 ± r_b1) = {:.6} mm",
-                        aw * 1e3,
-                        a * alpha_t.cos() * 1e3
-                    )));
-                }
-                (aw, c.acos())
-            }
-        };
+        let (a, a_w_from_shifts, a_w, alpha_wt) =
+            operating_centre_distance(g1, g2, internal, centre_distance)?;
         let (r_b1, r_b2) = (g1.r_b(), g2.r_b());
         let (r_a1, r_a2) = (g1.r_a(), g2.r_a());
         let (cw, tw) = (alpha_wt.cos(), alpha_wt.tan());
@@ -280,19 +215,7 @@ impl MeshGeometry {
         };
         let interference1 = s_a < s1_at(g1.r_form()) - tol;
         let interference2 = s_e > s2_at(g2.r_form()) + tol;
-        let tip_interference = internal && {
-            let c1 = (r_a2 * r_a2 - r_a1 * r_a1 - a_w * a_w) / (2.0 * a_w * r_a1);
-            let c2 = (a_w * a_w + r_a2 * r_a2 - r_a1 * r_a1) / (2.0 * a_w * r_a2);
-            if c1.abs() > 1.0 || c2.abs() > 1.0 {
-                false // tip circles do not intersect
-            } else {
-                let aa1 = (r_b1 / r_a1).acos();
-                let aa2 = (r_b2 / r_a2).acos();
-                let th1 = c1.acos() + inv(aa1) - inv(alpha_wt);
-                let th2 = c2.acos();
-                th1 * z1 / z2 + inv(alpha_wt) - inv(aa2) < th2
-            }
-        };
+        let tip_interference = internal && tip_interference(g1, g2, a_w, alpha_wt);
         let b = s1.b.min(s2.b);
         let eps_alpha = g_alpha / p_bt;
         let eps_beta = b * s1.beta.sin() / (PI * mn);
@@ -342,18 +265,18 @@ impl MeshGeometry {
         self.kind == MeshKind::Internal
     }
 
-    /// Curvature radius of gear 1's flank at position s: `r_b1 tan α_wt + s` [m].
+    /// Curvature radius of gear 1's flank at position s: `r_b1 tan α_wt + s` \[m\].
     pub fn rho1(&self, s: f64) -> f64 {
         s - self.s_t1
     }
 
-    /// Curvature radius (magnitude) of gear 2's flank at position s [m]: external
+    /// Curvature radius (magnitude) of gear 2's flank at position s \[m\]: external
     /// `r_b2 tan α_wt − s`, internal `r_b2 tan α_wt + s` (concave ring flank).
     pub fn rho2(&self, s: f64) -> f64 {
         (self.s_t2 - s).abs()
     }
 
-    /// Reduced (equivalent) radius of curvature at s [m]: external `ρ1ρ2/(ρ1 + ρ2)`,
+    /// Reduced (equivalent) radius of curvature at s \[m\]: external `ρ1ρ2/(ρ1 + ρ2)`,
     /// internal `ρ1ρ2/(ρ2 − ρ1)` (concave ring flank) [std].
     pub fn reduced_radius(&self, s: f64) -> f64 {
         let (r1, r2) = (self.rho1(s), self.rho2(s));
@@ -387,12 +310,12 @@ impl MeshGeometry {
         w1 * self.rho1(s) + w1 / self.u * self.rho2(s)
     }
 
-    /// Position s at which gear 1's flank is in contact at radius r [m].
+    /// Position s at which gear 1's flank is in contact at radius r \[m\].
     pub fn s_at_radius1(&self, r: f64) -> f64 {
         (r * r - self.r_b1 * self.r_b1).max(0.0).sqrt() + self.s_t1
     }
 
-    /// Position s at which gear 2's flank is in contact at radius r [m].
+    /// Position s at which gear 2's flank is in contact at radius r \[m\].
     pub fn s_at_radius2(&self, r: f64) -> f64 {
         let l = (r * r - self.r_b2 * self.r_b2).max(0.0).sqrt();
         if self.is_internal() {
@@ -402,19 +325,129 @@ impl MeshGeometry {
         }
     }
 
-    /// Radius on gear 1 of the contact point at s [m].
+    /// Radius on gear 1 of the contact point at s \[m\].
     pub fn radius1_at(&self, s: f64) -> f64 {
         self.r_b1.hypot(self.rho1(s))
     }
 
-    /// Radius on gear 2 of the contact point at s [m].
+    /// Radius on gear 2 of the contact point at s \[m\].
     pub fn radius2_at(&self, s: f64) -> f64 {
         self.r_b2.hypot(self.rho2(s))
     }
 
-    /// Rotation of gear 1 while the contact moves over the whole path: `g_α / r_b1` [rad].
+    /// Rotation of gear 1 while the contact moves over the whole path: `g_α / r_b1` \[rad\].
     pub fn contact_angle1(&self) -> f64 {
         self.g_alpha / self.r_b1
+    }
+}
+
+/// Gear 1 and gear 2 can mesh as `kind`: same module, pressure angle and helix angle; gear 1
+/// external; a ring as gear 2 exactly for an internal mesh, with more teeth than the pinion.
+fn check_pair(g1: &GearGeometry, g2: &GearGeometry, kind: MeshKind) -> Result<(), GeometryError> {
+    let (s1, s2) = (&g1.spec, &g2.spec);
+    same("normal module mn [m]", s1.mn, s2.mn, 1e-9 * s1.mn.max(s2.mn))?;
+    same(
+        "normal pressure angle alpha_n [rad]",
+        s1.alpha_n,
+        s2.alpha_n,
+        1e-9,
+    )?;
+    same("helix angle beta [rad]", s1.beta, s2.beta, 1e-9)?;
+    if g1.is_internal() {
+        return Err(GeometryError::Impossible(
+            "gear 1 of a mesh must be an external gear (the pinion)".into(),
+        ));
+    }
+    match kind {
+        MeshKind::External if g2.is_internal() => {
+            return Err(GeometryError::Impossible(
+                "external mesh given a ring gear as gear 2 (use MeshKind::Internal)".into(),
+            ))
+        }
+        MeshKind::Internal if !g2.is_internal() => {
+            return Err(GeometryError::Impossible(
+                "internal mesh needs a ring (internal gear) as gear 2".into(),
+            ))
+        }
+        MeshKind::Internal if s2.z <= s1.z => {
+            return Err(GeometryError::Impossible(format!(
+                "internal mesh: ring z2 = {} must have more teeth than pinion z1 = {}",
+                s2.z, s1.z
+            )))
+        }
+        _ => {}
+    }
+    Ok(())
+}
+
+/// Reference centre distance `a`, the zero-backlash operating centre distance from the profile
+/// shifts, and the operating centre distance `a_w` with its transverse pressure angle α_wt
+/// (from the shifts, or from `centre_distance` when given); see [`MeshGeometry::new`].
+fn operating_centre_distance(
+    g1: &GearGeometry,
+    g2: &GearGeometry,
+    internal: bool,
+    centre_distance: Option<f64>,
+) -> Result<(f64, f64, f64, f64), GeometryError> {
+    let (s1, s2) = (&g1.spec, &g2.spec);
+    let (z1, z2) = (f64::from(s1.z), f64::from(s2.z));
+    let (m_t, alpha_t) = (g1.m_t, g1.alpha_t);
+    let (zs, xs) = if internal {
+        (z2 - z1, s2.x - s1.x)
+    } else {
+        (z1 + z2, s1.x + s2.x)
+    };
+    let a = m_t * zs / 2.0;
+    // [std] operating pressure angle from the shifts
+    let inv_wt = g1.inv_alpha_t() + 2.0 * s1.alpha_n.tan() * xs / zs;
+    if !(inv_wt > 0.0) {
+        return Err(GeometryError::Impossible(format!(
+            "profile shift sum {xs} too negative: inv α_wt = {inv_wt:e} ≤ 0"
+        )));
+    }
+    let alpha_wt_shift = inv_inverse(inv_wt);
+    let a_w_from_shifts = a * alpha_t.cos() / alpha_wt_shift.cos();
+    let (a_w, alpha_wt) = match centre_distance {
+        None => (a_w_from_shifts, alpha_wt_shift),
+        Some(aw) => {
+            if !(aw.is_finite() && aw > 0.0) {
+                return Err(GeometryError::InvalidParameter {
+                    name: "centre_distance",
+                    value: aw,
+                    requirement: "must be a finite number > 0",
+                });
+            }
+            let c = a * alpha_t.cos() / aw;
+            if !(c < 1.0) {
+                return Err(GeometryError::Impossible(format!(
+                    "centre distance {:.6} mm is not larger than (r_b2 ± r_b1) = {:.6} mm",
+                    aw * 1e3,
+                    a * alpha_t.cos() * 1e3
+                )));
+            }
+            (aw, c.acos())
+        }
+    };
+    Ok((a, a_w_from_shifts, a_w, alpha_wt))
+}
+
+/// Tip (trochoid) interference of an internal mesh's pinion tip with the ring tip outside the
+/// path of contact (KHK criterion, see [`MeshGeometry::new`]) at centre distance `a_w` and
+/// operating pressure angle `alpha_wt`.
+fn tip_interference(g1: &GearGeometry, g2: &GearGeometry, a_w: f64, alpha_wt: f64) -> bool {
+    let (r_b1, r_b2) = (g1.r_b(), g2.r_b());
+    let (r_a1, r_a2) = (g1.r_a(), g2.r_a());
+    let (z1, z2) = (f64::from(g1.spec.z), f64::from(g2.spec.z));
+    let c1 = (r_a2 * r_a2 - r_a1 * r_a1 - a_w * a_w) / (2.0 * a_w * r_a1);
+    let c2 = (a_w * a_w + r_a2 * r_a2 - r_a1 * r_a1) / (2.0 * a_w * r_a2);
+    if c1.abs() > 1.0 || c2.abs() > 1.0 {
+        false // tip circles do not intersect
+    } else {
+        let aa1 = (r_b1 / r_a1).acos();
+        let aa2 = (r_b2 / r_a2).acos();
+        let th1 = c1.acos() + inv(aa1) - inv(alpha_wt);
+        let th2 = c2.acos();
+        th1 * z1 / z2 + inv(alpha_wt) - inv(aa2) < th2
     }
 }
 

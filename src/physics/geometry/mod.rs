@@ -11,8 +11,8 @@
 //!   radii and speeds along the path.
 //!
 //! Sources: ISO 21771 / ISO 53 relations as given in `spec/physics.md` §2 [std]; derivations
-//! written next to each formula ([derived]); the internal-gear tip-interference criterion is
-//! [recalled] from the KHK gear technical reference and checked by a brute-force test.
+//! written next to each formula (\[derived\]); the internal-gear tip-interference criterion is
+//! \[recalled\] from the KHK gear technical reference and checked by a brute-force test.
 
 // `!(a > b)` is used on purpose: it also rejects NaN, which `a <= b` would let through.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]

@@ -17,7 +17,9 @@ use crate::scene::N_SOURCES;
 /// One loss item's power over time.
 #[derive(Clone, Debug)]
 pub struct LossItemSeries {
+    /// Loss source of the item (from its column name `loss_<source>_<item>_w`).
     pub source: Source,
+    /// Item name (gear, mesh, bearing, … as in the model file).
     pub name: String,
     /// W per row.
     pub power_w: Vec<f64>,
@@ -26,26 +28,32 @@ pub struct LossItemSeries {
 /// The columns of `timeseries.csv` that the plots use.
 #[derive(Clone, Debug, Default)]
 pub struct TimeSeries {
+    /// Output time per row, s.
     pub time_s: Vec<f64>,
+    /// The segment's mean vehicle speed per row, km/h (0 for rig cycles).
     pub vehicle_speed_kmh: Vec<f64>,
     /// Gear-state name per row ("" where missing).
     pub gear: Vec<String>,
     /// (node name, °C per row), in column order.
     pub temps_c: Vec<(String, Vec<f64>)>,
+    /// Power of every loss item, in column order.
     pub items: Vec<LossItemSeries>,
     /// Per-source total power, W, indexed by `Source::index()` (zeros for a source the file
     /// has no column of: files written before that source existed).
     pub source_w: [Vec<f64>; N_SOURCES],
+    /// Sum of the items' power per row, W.
     pub total_loss_w: Vec<f64>,
     /// Efficiency as a fraction, NaN where undefined.
     pub efficiency: Vec<f64>,
 }
 
 impl TimeSeries {
+    /// Number of rows.
     pub fn len(&self) -> usize {
         self.time_s.len()
     }
 
+    /// True when the file has no data rows.
     pub fn is_empty(&self) -> bool {
         self.time_s.is_empty()
     }
@@ -83,6 +91,25 @@ fn parse_num(field: &str) -> Option<f64> {
         return Some(f64::NAN);
     }
     f.parse::<f64>().ok().filter(|v| v.is_finite())
+}
+
+/// What is wrong with an efficiency outside [0, 1].
+const NOT_AN_EFFICIENCY: &str = "is not an efficiency (a fraction in [0, 1])";
+
+/// A number for a message: as written for the usual magnitudes, in exponent form outside them
+/// (1e308, not 309 digits).
+fn number(v: f64) -> String {
+    if v == 0.0 || (1e-6..1e9).contains(&v.abs()) {
+        v.to_string()
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// True for an efficiency geartherm can have written: a fraction in [0, 1], or no value (NaN:
+/// undefined where there is no output power).
+fn is_efficiency(v: f64) -> bool {
+    v.is_nan() || (0.0..=1.0).contains(&v)
 }
 
 fn csv_err(path: &Path, e: csv::Error) -> PlotError {
@@ -196,7 +223,17 @@ pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
             ts.source_w[k].push(v);
         }
         ts.total_loss_w.push(num(c_total)?);
-        ts.efficiency.push(num(c_eff)?);
+        let eff = num(c_eff)?;
+        if !is_efficiency(eff) {
+            return Err(PlotError::Csv {
+                path: path.to_path_buf(),
+                msg: format!(
+                    "line {line}, column `efficiency`: {} {NOT_AN_EFFICIENCY}",
+                    number(eff)
+                ),
+            });
+        }
+        ts.efficiency.push(eff);
     }
     if ts.is_empty() {
         return Err(PlotError::Data {
@@ -213,43 +250,59 @@ pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
 pub struct EnergyBySource(BTreeMap<String, Option<f64>>);
 
 impl EnergyBySource {
+    /// Energy lost by source `s` over the run, J.
     pub fn get(&self, s: Source) -> Option<f64> {
         self.0.get(s.as_str()).copied().flatten()
     }
 
+    /// Energy lost by all sources over the run, J.
     pub fn total(&self) -> Option<f64> {
         self.0.get("total").copied().flatten()
     }
 }
 
+/// One entry of `energy_by_item_j`: the energy one loss item dissipated over the run.
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(default)]
 pub struct ItemEnergy {
+    /// Loss source of the item (`churning`, `bearing`, …).
     pub source: String,
+    /// Item name.
     pub name: String,
+    /// Energy, J.
     pub j: Option<f64>,
 }
 
+/// One node's entry of `temperatures_c`, °C.
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(default)]
 pub struct TempStats {
+    /// Lowest temperature over the output rows, °C.
     pub min: Option<f64>,
+    /// Highest temperature over the output rows, °C.
     pub max: Option<f64>,
+    /// Temperature at the end of the run, °C (key `final`).
     #[serde(rename = "final")]
     pub last: Option<f64>,
 }
 
+/// One entry of `nodes`: a thermal network node.
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(default)]
 pub struct NodeInfo {
+    /// Node name from the model file.
     pub name: String,
+    /// True for a boundary (prescribed temperature), false for a capacity node.
     pub boundary: bool,
 }
 
+/// One entry of `skipped`: something the scene left out of the run.
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(default)]
 pub struct Skipped {
+    /// The item or table left out.
     pub what: String,
+    /// Why (idle in every gear state the run uses, above the oil, …).
     pub why: String,
 }
 
@@ -258,28 +311,54 @@ pub struct Skipped {
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(default)]
 pub struct Summary {
+    /// Model name.
     pub model: Option<String>,
+    /// Cycle name.
     pub cycle: Option<String>,
+    /// Solver as asked (`auto` by default).
     pub solver: Option<serde_json::Value>,
+    /// Relative tolerance of the integration.
     pub rtol: Option<serde_json::Value>,
+    /// Absolute tolerance of the integration, K on temperatures.
     pub atol: Option<serde_json::Value>,
+    /// Wall time of the integration, s.
     pub wall_time_s: Option<f64>,
+    /// Accepted integration steps.
     pub steps: Option<f64>,
+    /// Energy lost per source and in total, J.
     pub energy_lost_j: Option<EnergyBySource>,
+    /// Energy lost per loss item, J.
     pub energy_by_item_j: Vec<ItemEnergy>,
+    /// |lost − stored − to boundaries| over the largest of the three energies.
     pub energy_balance_relative: Option<f64>,
-    /// `cycle_efficiency` (∫P_out/∫P_in); `mean_efficiency` in directories written before it.
+    /// `cycle_efficiency` (∫P_out/∫P_in); `mean_efficiency` in directories of earlier versions.
     #[serde(alias = "mean_efficiency")]
     pub cycle_efficiency: Option<f64>,
+    /// Min, max and final temperature per node, °C.
     pub temperatures_c: BTreeMap<String, TempStats>,
+    /// The network's nodes, capacity nodes first.
     pub nodes: Vec<NodeInfo>,
+    /// Name of the node whose temperature sets the oil properties.
     pub oil_node: Option<String>,
+    /// What the scene left out of the run.
     pub skipped: Vec<Skipped>,
 }
 
 impl Summary {
+    /// True when `node` is a boundary node of the run.
     pub fn is_boundary(&self, node: &str) -> bool {
         self.nodes.iter().any(|n| n.name == node && n.boundary)
+    }
+
+    /// The values the report writes as they must be: `cycle_efficiency` a fraction in [0, 1]
+    /// (an efficiency is never drawn or written over 100 %). Err: the key and what is wrong.
+    pub fn check(&self) -> Result<(), String> {
+        match self.cycle_efficiency {
+            Some(e) if !is_efficiency(e) => {
+                Err(format!("cycle_efficiency: {} {NOT_AN_EFFICIENCY}", number(e)))
+            }
+            _ => Ok(()),
+        }
     }
 }
 
@@ -296,6 +375,7 @@ pub fn value_text(v: &Option<serde_json::Value>) -> String {
     }
 }
 
+/// Read and deserialise a JSON file; errors name the file.
 pub fn read_json<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T, PlotError> {
     let text = fs::read_to_string(path).map_err(|e| PlotError::Io {
         path: path.to_path_buf(),
@@ -309,14 +389,20 @@ pub fn read_json<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T, PlotErr
 
 /// Everything a run report needs.
 pub struct RunData {
+    /// The run's output directory.
     pub dir: PathBuf,
+    /// Its `timeseries.csv`.
     pub ts: TimeSeries,
+    /// Its `summary.json`.
     pub summary: Summary,
 }
 
+/// Read `timeseries.csv` and `summary.json` of the run output directory `dir`.
 pub fn read_run(dir: &Path) -> Result<RunData, PlotError> {
     let ts = read_timeseries(&dir.join("timeseries.csv"))?;
-    let summary: Summary = read_json(&dir.join("summary.json"))?;
+    let path = dir.join("summary.json");
+    let summary: Summary = read_json(&path)?;
+    summary.check().map_err(|what| PlotError::Data { path, what })?;
     Ok(RunData {
         dir: dir.to_path_buf(),
         ts,
@@ -327,34 +413,52 @@ pub fn read_run(dir: &Path) -> Result<RunData, PlotError> {
 /// One row of `map.csv`.
 #[derive(Clone, Debug, Deserialize)]
 pub struct MapRow {
+    /// Input speed, rpm.
     pub speed_rpm: f64,
+    /// Input torque, N·m.
     pub torque_nm: f64,
+    /// Efficiency P_out/(P_out + P_loss) at the equilibrium, fraction (empty without one).
     pub efficiency: Option<f64>,
+    /// Total loss at the equilibrium, W.
     pub total_loss_w: Option<f64>,
+    /// Churning loss at the equilibrium, W.
     pub churning_w: Option<f64>,
+    /// Pocketing loss at the equilibrium, W.
     pub pocketing_w: Option<f64>,
+    /// Sliding (mesh friction) loss at the equilibrium, W.
     pub sliding_w: Option<f64>,
+    /// Equilibrium temperature of the oil node, °C.
     pub oil_temp_c: Option<f64>,
+    /// Iterations the steady solver took (Newton and pseudo-transient together).
     pub iterations: Option<f64>,
+    /// True when the steady solver converged at this point.
     pub converged: bool,
 }
 
+/// `map.json`: what the map was computed for.
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(default)]
 pub struct MapMeta {
+    /// Model name.
     pub model: Option<String>,
+    /// Gear state of the map.
     pub gear: Option<serde_json::Value>,
 }
 
 /// A map on its (speed × torque) grid. Cell (i, j) = speed i, torque j; `None` = no point.
 pub struct MapGrid {
+    /// The map's `map.json`.
     pub meta: MapMeta,
+    /// Input speeds of the grid, rpm, ascending.
     pub speeds_rpm: Vec<f64>,
+    /// Input torques of the grid, N·m, ascending.
     pub torques_nm: Vec<f64>,
+    /// Rows by cell, torque-major: cell (i, j) at `j * speeds_rpm.len() + i`.
     pub cells: Vec<Option<MapRow>>,
 }
 
 impl MapGrid {
+    /// The row at speed index `i` and torque index `j`, if the map has that point.
     pub fn cell(&self, i: usize, j: usize) -> Option<&MapRow> {
         self.cells[j * self.speeds_rpm.len() + i].as_ref()
     }
@@ -381,6 +485,7 @@ fn nearest(axis: &[f64], x: f64) -> usize {
     }
 }
 
+/// Read `map.csv` and `map.json` of the map output directory `dir` onto their grid.
 pub fn read_map(dir: &Path) -> Result<MapGrid, PlotError> {
     let path = dir.join("map.csv");
     let mut rdr = open_csv(&path)?;
@@ -406,6 +511,16 @@ pub fn read_map(dir: &Path) -> Result<MapGrid, PlotError> {
                     rows.len() + 2,
                     r.speed_rpm,
                     r.torque_nm
+                ),
+            });
+        }
+        if let Some(e) = r.efficiency.filter(|e| !is_efficiency(*e)) {
+            return Err(PlotError::Csv {
+                path,
+                msg: format!(
+                    "row {}, column `efficiency`: {} {NOT_AN_EFFICIENCY}",
+                    rows.len() + 2,
+                    number(e)
                 ),
             });
         }
@@ -445,29 +560,47 @@ pub fn read_map(dir: &Path) -> Result<MapGrid, PlotError> {
 /// One row of `bench.csv`.
 #[derive(Clone, Debug, Deserialize)]
 pub struct BenchRow {
+    /// Solver (method) name.
     pub solver: String,
+    /// Relative tolerance.
     pub rtol: Option<f64>,
+    /// Absolute tolerance, K on temperatures.
     pub atol: Option<f64>,
+    /// Wall time of the integration, s.
     pub wall_time_s: Option<f64>,
+    /// Accepted steps.
     pub steps: Option<f64>,
+    /// Rejected steps.
     pub rejected: Option<f64>,
+    /// Right-hand-side evaluations.
     pub rhs_evals: Option<f64>,
+    /// Jacobian oil-column evaluations (ROS3: explicit loss-slope differences).
     pub jac_evals: Option<f64>,
+    /// LU factorisations.
     pub lu_count: Option<f64>,
+    /// Largest |T − T_ref| over the nodes at the end of the run, K.
     pub err_final_k: Option<f64>,
+    /// Largest |T − T_ref| over the nodes and the output grid, K.
     pub err_max_k: Option<f64>,
+    /// RMS of T − T_ref over the nodes and the output grid, K.
     pub err_rms_k: Option<f64>,
+    /// |lost − stored − to boundaries| over the largest of the three energies.
     pub energy_balance_relative: Option<f64>,
+    /// True for the default solver and tolerance.
     pub default: bool,
 }
 
+/// `bench.json`: what the work-precision study was run on.
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(default)]
 pub struct BenchMeta {
+    /// Model name.
     pub model: Option<String>,
+    /// Cycle name.
     pub cycle: Option<String>,
 }
 
+/// Read `bench.csv` and `bench.json` of the bench output directory `dir`.
 pub fn read_bench(dir: &Path) -> Result<(Vec<BenchRow>, BenchMeta), PlotError> {
     let path = dir.join("bench.csv");
     let mut rdr = open_csv(&path)?;

@@ -17,6 +17,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use tempfile::NamedTempFile;
 
+use crate::report::files::user_path;
+
 pub mod data;
 pub mod efficiency;
 pub mod energy;
@@ -24,6 +26,7 @@ pub mod heatmap;
 pub mod index;
 pub mod losses;
 pub mod map_index;
+pub mod panel;
 pub mod study;
 pub mod style;
 pub mod temperatures;
@@ -33,27 +36,54 @@ pub mod work_precision;
 #[cfg(test)]
 mod tests;
 
-/// Errors of the plot reports. Every variant names the file concerned.
+/// Errors of the plot reports. Every variant names the file concerned, as the user knows it
+/// (a file in a transaction's temporary directory by its place in the target:
+/// [`user_path`]).
 #[derive(Debug, thiserror::Error)]
 pub enum PlotError {
-    #[error("{}: {source}", path.display())]
+    /// A file could not be read or written.
+    #[error("{}: {source}", user_path(path).display())]
     Io {
+        /// The file.
         path: PathBuf,
+        /// The I/O error.
         #[source]
         source: std::io::Error,
     },
-    #[error("{}: malformed CSV: {msg}", path.display())]
-    Csv { path: PathBuf, msg: String },
-    #[error("{}: malformed JSON: {source}", path.display())]
-    Json {
+    /// A CSV file is malformed (field count, a value that is not a finite number).
+    #[error("{}: malformed CSV: {msg}", user_path(path).display())]
+    Csv {
+        /// The file.
         path: PathBuf,
+        /// What is wrong, with line and column where known.
+        msg: String,
+    },
+    /// A JSON file does not parse.
+    #[error("{}: malformed JSON: {source}", user_path(path).display())]
+    Json {
+        /// The file.
+        path: PathBuf,
+        /// The parser's error.
         #[source]
         source: serde_json::Error,
     },
-    #[error("{}: {what}", path.display())]
-    Data { path: PathBuf, what: String },
-    #[error("{}: drawing failed: {msg}", path.display())]
-    Draw { path: PathBuf, msg: String },
+    /// A file parses but lacks what the figure needs (a required column, any data rows).
+    #[error("{}: {what}", user_path(path).display())]
+    Data {
+        /// The file.
+        path: PathBuf,
+        /// What is missing.
+        what: String,
+    },
+    /// Rendering a figure failed.
+    #[error("{}: drawing failed: {msg}", user_path(path).display())]
+    Draw {
+        /// The figure's file.
+        path: PathBuf,
+        /// The drawing backend's error.
+        msg: String,
+    },
+    /// The embedded font could not be registered.
     #[error("the embedded DejaVu Sans font could not be loaded")]
     Font,
 }
@@ -199,16 +229,14 @@ pub fn render_map(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
 /// `error_vs_speed_sliding.png`, `error_vs_speed_churning.png`.
 pub fn render_validation(
     dir: &Path,
-    rows: &[crate::solve::validation::Row],
+    rows: &[crate::reference::Row],
     texts: &[(&str, String)],
 ) -> Result<Vec<PathBuf>, PlotError> {
     std::fs::create_dir_all(dir).map_err(|e| io_err(dir, e))?;
     style::ensure_fonts()?;
-    let pick = |q: &str| -> Vec<&crate::solve::validation::Row> {
-        rows.iter().filter(|r| r.quantity == q).collect()
-    };
+    let pick = |q: &str| -> Vec<&crate::reference::Row> { rows.iter().filter(|r| r.quantity == q).collect() };
     let (sl, ch) = (pick("sliding"), pick("churning"));
-    let el: Vec<&crate::solve::validation::Row> = rows
+    let el: Vec<&crate::reference::Row> = rows
         .iter()
         .filter(|r| !matches!(r.quantity, "sliding" | "churning" | "efficiency"))
         .collect();

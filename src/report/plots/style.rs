@@ -29,11 +29,15 @@ static DEJAVU_SANS_BOLD: &[u8] = include_bytes!(concat!(
     "/assets/fonts/DejaVuSans-Bold.ttf"
 ));
 
-/// Font sizes in pixels at 1600×1000.
+/// Font size of figure titles, px at 1600×1000.
 pub const TITLE_PX: u32 = 36;
+/// Font size of axis descriptions, px at 1600×1000.
 pub const AXIS_DESC_PX: u32 = 28;
+/// Font size of tick labels, px at 1600×1000.
 pub const TICK_PX: u32 = 22;
+/// Font size of legend labels, px at 1600×1000.
 pub const LEGEND_PX: u32 = 22;
+/// Font size of notes under or beside a plot, px at 1600×1000.
 pub const NOTE_PX: u32 = 19;
 
 /// Register the embedded fonts with plotters (once per process).
@@ -54,26 +58,35 @@ pub fn ensure_fonts() -> Result<(), PlotError> {
     }
 }
 
+/// The embedded regular font at `px` pixels.
 pub fn font(px: u32) -> FontDesc<'static> {
     (FONT, px).into_font()
 }
 
+/// The embedded bold font at `px` pixels.
 pub fn bold(px: u32) -> FontDesc<'static> {
     (FONT, px).into_font().style(FontStyle::Bold)
 }
 
+/// Regular text at `px` pixels in the text colour.
 pub fn text(px: u32) -> TextStyle<'static> {
     TextStyle::from(font(px)).color(&TEXT)
 }
 
+/// [`text`] anchored at the horizontal and vertical position `h`, `v`.
 pub fn text_at(px: u32, h: HPos, v: VPos) -> TextStyle<'static> {
     text(px).pos(Pos::new(h, v))
 }
 
+/// Colour of text and axes.
 pub const TEXT: RGBColor = RGBColor(25, 25, 25);
+/// Colour of the minor grid lines.
 pub const GRID: RGBColor = RGBColor(225, 225, 225);
+/// Colour of the major grid lines and frames.
 pub const GRID_BOLD: RGBColor = RGBColor(195, 195, 195);
+/// Grey for outlines, hatching and items without a source colour.
 pub const NEUTRAL: RGBColor = RGBColor(120, 120, 120);
+/// Fill of cells without a value (map points without an equilibrium).
 pub const MISSING: RGBColor = RGBColor(235, 235, 235);
 
 /// The loss sources (the scene's list); their colour is the same in every figure.
@@ -125,6 +138,7 @@ const PALETTE: [RGBColor; 20] = [
     RGBColor(150, 150, 150),
 ];
 
+/// Colour of the `i`-th series of a figure (the palette repeats).
 pub fn series_colour(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
 }
@@ -132,8 +146,11 @@ pub fn series_colour(i: usize) -> RGBColor {
 /// Colour maps sampled at 0, 0.1, …, 1 (matplotlib's perceptually uniform maps).
 #[derive(Clone, Copy, Debug)]
 pub enum ColourMap {
+    /// matplotlib's viridis (dark blue → yellow).
     Viridis,
+    /// matplotlib's inferno (black → pale yellow).
     Inferno,
+    /// matplotlib's plasma (dark blue → yellow through magenta).
     Plasma,
 }
 
@@ -183,6 +200,8 @@ pub fn padded_range(values: impl IntoIterator<Item = f64>, pad: f64) -> (f64, f6
     pad_range(lo, hi, pad)
 }
 
+/// (lo, hi) padded by `pad` of its width; widened when empty or degenerate, (0, 1) when not
+/// finite.
 pub fn pad_range(lo: f64, hi: f64, pad: f64) -> (f64, f64) {
     if !lo.is_finite() || !hi.is_finite() {
         return (0.0, 1.0);
@@ -242,6 +261,33 @@ pub fn fmt_sig(v: f64, sig: usize) -> String {
     format!("{v:.decimals$}")
 }
 
+/// `v` with `decimals` decimals while that stays short (|v| < 10⁹), else with four significant
+/// digits in exponent form ([`fmt_sig`]); "–" when not finite. For table cells.
+pub fn fmt_fixed(v: f64, decimals: usize) -> String {
+    if v.is_finite() && v.abs() < 1e9 {
+        format!("{v:.decimals$}")
+    } else {
+        fmt_sig(v, 4)
+    }
+}
+
+/// `part` as a percentage of `whole` with one decimal; "–" when `whole` is not positive or
+/// the share is not a finite number.
+pub fn fmt_share(part: f64, whole: f64) -> String {
+    let pct = 100.0 * part / whole;
+    // 100·part overflows for parts near f64::MAX; the ratio first does not.
+    let pct = if pct.is_finite() {
+        pct
+    } else {
+        100.0 * (part / whole)
+    };
+    if whole > 0.0 && pct.is_finite() {
+        format!("{} %", fmt_fixed(pct, 1))
+    } else {
+        "–".into()
+    }
+}
+
 /// A "nice" step (1, 2, 2.5, 5 × 10^k) giving about `n` intervals over `span`.
 pub fn nice_step(span: f64, n: usize) -> f64 {
     if !(span.is_finite() && span > 0.0) {
@@ -276,14 +322,20 @@ pub fn time_axis(t_max: f64) -> (f64, &'static str) {
 /// Marker shapes (distinct shapes so figures also read in black and white).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Marker {
+    /// Filled circle.
     Circle,
+    /// Filled triangle, point up.
     Triangle,
+    /// Filled square.
     Square,
+    /// Filled diamond.
     Diamond,
+    /// Diagonal cross.
     Cross,
 }
 
 impl Marker {
+    /// Marker of the `i`-th series (the five shapes repeat).
     pub fn nth(i: usize) -> Marker {
         [
             Marker::Circle,
@@ -335,21 +387,31 @@ pub fn draw_marker_px<DB: DrawingBackend>(
 /// What a legend entry shows next to its label.
 #[derive(Clone, Debug)]
 pub enum Swatch {
+    /// A solid line of the colour and stroke width (px).
     Line(RGBColor, u32),
+    /// A dashed line of the colour and stroke width (px).
     Dashed(RGBColor, u32),
+    /// A filled box of the colour.
     Fill(RGBColor),
+    /// A hatched box (cells without a value).
     Hatched,
+    /// A line of the colour with the marker on it.
     MarkerLine(RGBColor, Marker),
+    /// A ring with a dot (a highlighted point).
     Ring(RGBColor),
 }
 
+/// One legend entry: its label and what is drawn beside it.
 #[derive(Clone, Debug)]
 pub struct LegendEntry {
+    /// Text of the entry.
     pub label: String,
+    /// What is drawn next to the text.
     pub swatch: Swatch,
 }
 
 impl LegendEntry {
+    /// An entry with `label` and `swatch`.
     pub fn new(label: impl Into<String>, swatch: Swatch) -> Self {
         LegendEntry {
             label: label.into(),

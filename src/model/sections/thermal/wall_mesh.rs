@@ -20,7 +20,7 @@
 //!
 //! With an infinitely conducting wall the patches move together and the mesh reduces exactly to
 //! the lumped node (tested). The network then has N − 1 more nodes: the generator of the large
-//! networks the sparse LU is for (docs/performance.md, "Sparse networks").
+//! networks the sparse LU is for (docs/performance.md, "Large networks").
 
 use serde::{Deserialize, Serialize};
 

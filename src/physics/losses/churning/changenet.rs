@@ -1,4 +1,4 @@
-//! Changenet & Velex 2007 churning model [recalled] (C. Changenet, P. Velex, "A model for the
+//! Changenet & Velex 2007 churning model \[recalled\] (C. Changenet, P. Velex, "A model for the
 //! prediction of churning losses in geared transmissions — preliminary results", J. Mech. Design
 //! 129(1):128–133, 2007; physics.md §5.3). Not checked against the paper: coefficients are
 //! configurable.
@@ -35,7 +35,7 @@ use super::immersion::immersion_angle;
 use super::{check_positive, ChurningError, ChurningGear, ChurningPower, OilState};
 use std::f64::consts::PI;
 
-/// Parameters of the Changenet–Velex model (all [recalled] except V0 and g).
+/// Parameters of the Changenet–Velex model (all \[recalled\] except V0 and g).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ChangenetParams {
     /// Sump oil volume V0, m³ (default 1.5 L, roughly an FZG test gearbox filled to the wheel

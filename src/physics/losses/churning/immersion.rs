@@ -6,7 +6,7 @@
 //!   seed 000's `r_a²·(π/2 − asin(1 − h̄) − (1 − h̄)·√(h̄(2 − h̄)))` (test below);
 //! - wetted periphery arc `2 θ r_a`;
 //! - wetted chord: the largest horizontal extent of the wetted segment, `L = 2 r_a sin θ` for
-//!   θ ≤ π/2 and `L = 2 r_a` (the diameter) for θ > π/2 [derived]. Seed 000 uses `2 r_a sin θ`
+//!   θ ≤ π/2 and `L = 2 r_a` (the diameter) for θ > π/2 \[derived\]. Seed 000 uses `2 r_a sin θ`
 //!   throughout, which goes to 0 at full immersion and makes the face Reynolds number vanish and the
 //!   face drag (∝ (sin θ)^(−1/2) or ^(−1/7)) diverge at θ = π. The bound is continuous in h (with a
 //!   kink at h = r_a) and finite at full immersion.

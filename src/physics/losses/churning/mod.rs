@@ -7,7 +7,7 @@
 //!   dimensionally consistent forms of physics.md §5.1: periphery + faces + tooth cavities.
 //! - [`stavytskyi`]: Stavytskyi et al. 2022 (seed 001): Coriolis term of the oil pumped through the
 //!   tooth spaces + periphery + faces, reconstructed from a garbled scan (decisions listed there).
-//! - [`changenet`]: Changenet & Velex 2007 empirical moment coefficient [recalled].
+//! - [`changenet`]: Changenet & Velex 2007 empirical moment coefficient \[recalled\].
 //!
 //! Common conventions: SI units; `h` is the depth of the gear's lowest point (tip circle) below
 //! the static oil level; `h ≤ 0` means not immersed (zero power; the scene should skip the gear),
@@ -90,10 +90,10 @@ impl ChurningGear {
         if self.teeth < 3 {
             return Err(ChurningError::InvalidGear("teeth must be >= 3"));
         }
-        if !(self.root_radius < self.pitch_radius && self.pitch_radius < self.tip_radius) {
-            return Err(ChurningError::InvalidGear(
-                "radii must satisfy root < pitch < tip",
-            ));
+        // The pitch circle may lie outside [root, tip]: a profile shift above the rack's
+        // dedendum lifts the root over it (x > 1.25), below minus its addendum the tip under it.
+        if self.root_radius >= self.tip_radius {
+            return Err(ChurningError::InvalidGear("radii must satisfy root < tip"));
         }
         if !(self.helix_angle.is_finite() && self.helix_angle.abs() < 0.5 * PI - 1e-6) {
             return Err(ChurningError::InvalidGear("helix_angle must be in (-pi/2, pi/2)"));
@@ -252,7 +252,7 @@ pub enum ChurningModel {
     Seetharaman,
     /// Stavytskyi et al. 2022 (seed 001), reconstructed.
     Stavytskyi,
-    /// Changenet & Velex 2007 [recalled]. Recommended default.
+    /// Changenet & Velex 2007 \[recalled\]. Recommended default.
     #[default]
     Changenet,
 }

@@ -1,4 +1,4 @@
-//! Where a churning model is used outside the range it was fitted or derived on (issue 14).
+//! Where a churning model is used outside the range it was fitted or derived on.
 //!
 //! Only ranges the models themselves define are checked; the fitted ranges of geometry and
 //! immersion of Changenet & Velex 2007 could not be found in a source (docs/validation.md says

@@ -5,7 +5,7 @@
 //!
 //! 1. **Periphery** [seed 000 code, consistent]: `P_P = 4 μ b r_a² ω² θ` — the shear 2μω of the
 //!    potential vortex outside a rotating cylinder on the wetted arc 2θ r_a·b, times ω r_a.
-//! 2. **Faces** [derived]: each wetted face (area `A_f = r_a²(θ − sin θ cos θ)`) is a flat plate of
+//! 2. **Faces** \[derived\]: each wetted face (area `A_f = r_a²(θ − sin θ cos θ)`) is a flat plate of
 //!    length L (the wetted chord, `2 r_a sin θ`, bounded at 2 r_a) swept at the tip speed U = ω r_a:
 //!    `P_F = 2 · ½ ρ U³ A_f C_F(Re_L)`, `Re_L = ω r_a L/ν` (both faces). Mean skin-friction laws:
 //!    laminar Blasius `C_F = 1.328 Re_L^(−1/2)` [std]; turbulent 1/7-power law
@@ -19,8 +19,8 @@
 //!    is required (it is not dimensionally consistent; test below) and (sin θ)^(−0.07).
 //!    Transition: laminar below `transition_reynolds` (default 5×10⁵, the flat-plate value),
 //!    above it the mixed law `C_F,turb − A/Re` continuous at the switch (see
-//!    [`super::flat_plate_cf`]); the mixed law is never below the laminar one ("take the larger").
-//! 3. **Tooth cavities / root filling** [derived]: seed 000 describes a biharmonic (Stokes) flow in
+//!    `super::flat_plate_cf`); the mixed law is never below the laminar one ("take the larger").
+//! 3. **Tooth cavities / root filling** \[derived\]: seed 000 describes a biharmonic (Stokes) flow in
 //!    each immersed tooth space; its code `n·2μ·A·ω·(D_o − D_r)²(D_o + D_r)` mixes mm and m and is
 //!    not used. Default [`CavityTerm::StokesCavity`] (candidate (a) of physics.md): a lid-driven
 //!    creeping-flow cavity per immersed space, `P_C = n_imm · C_rf · μ (ω r_a)² b · max(s_a/h_t, 1)`,

@@ -233,7 +233,7 @@ const ROLL_TOL: f64 = 1e-12;
 
 /// Scan points per half pitch (π/z_S) when locating the end of the pocket phase and the gap-kind
 /// switches; each bracket is then bisected to round-off. 64 finds the same ends and switches as
-/// the former 512 on every test gear and bundled model
+/// 512 on every test gear and bundled model
 /// (`coarse_scan_finds_the_same_phase_and_switches`) at 1/8 of the closed-form evaluations.
 const SCAN_STEPS_PER_HALF_PITCH: usize = 64;
 

@@ -4,7 +4,7 @@
 //! ε2 = AC/p_bt (addendum contact ratios), valid for ε_α < 2. For an internal mesh u + 1 → u − 1
 //! (u = z2/z1 > 0; ISO writes u < 0).
 //!
-//! **What it is [derived]:** with first-order friction, constant μ and 50:50 sharing, the mesh
+//! **What it is \[derived\]:** with first-order friction, constant μ and 50:50 sharing, the mesh
 //! loss over one base pitch is `P/P_in = μ (1 ± 1/u)/(r_b1 cos β_b)·(1/p_bt)·∫_A^E |s|·LS(s) ds`.
 //! With F(x) = sign(x)x²/2 (units of p_bt) and A = −ε2, B = ε1 − 1, D = 1 − ε2, E = ε1:
 //! `∫|s| LS ds / p_bt² = ½[F(E) − F(A) − F(B) + F(D)]`, so
@@ -13,7 +13,7 @@
 //! `1 − ε_α + ε1² + ε2²` (Ohlendorf). Outside that range Ohlendorf's polynomial is not the 50:50
 //! integral any more; [`uniform_sharing_hv`] is the general form.
 //!
-//! **Helical gears [derived]:** in a helical mesh with the load spread uniformly along all contact
+//! **Helical gears \[derived\]:** in a helical mesh with the load spread uniformly along all contact
 //! lines (no per-slice 50:50 sharing: a slice in single contact carries the same line load as each
 //! pair of a slice in double contact), and a constant total line length (ε_β integer), the same
 //! integral gives `H_V,hel = π(u ± 1)/(z1 u cos β_b)·(sign(ε1)ε1² + sign(ε2)ε2²)/ε_α`

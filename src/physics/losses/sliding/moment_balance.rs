@@ -1,6 +1,6 @@
 //! First-order loss vs seed 003's moment-balance sliding-loss ratio (physics.md §7).
 //!
-//! **Derivation [derived].** One tooth pair at distance s from the pitch point (n = s/(r_b1 tan α_wt)),
+//! **Derivation \[derived\].** One tooth pair at distance s from the pitch point (n = s/(r_b1 tan α_wt)),
 //! normal force F (inclined by β_b in the plane of action), friction μF perpendicular to the plane
 //! of action with lever arm ρ1 = r_b1 tan α_wt (1 + n) about gear 1. Moment balance of gear 1:
 //! `T1 = F·(r_b1 cos β_b + κ μ ρ1)`, κ = sign(v_1t − v_2t) if gear 1 drives, −sign(v_1t − v_2t)

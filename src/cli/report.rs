@@ -1,0 +1,69 @@
+//! `geartherm report DIR`: re-render a run, map or bench directory as one transaction (its
+//! inputs are carried into the new result set, the figures and report.md replace the old ones
+//! whole).
+
+use std::path::PathBuf;
+
+use geartherm::report::files::OutputDir;
+use geartherm::report::plots::{self, PlotError};
+
+use super::output::{emit, invalid, EXIT_INVALID, EXIT_IO};
+use super::Failure;
+
+/// Arguments of `report`.
+#[derive(clap::Args, Debug)]
+pub struct ReportArgs {
+    /// Directory with timeseries.csv + summary.json, map.csv, or bench.csv.
+    pub dir: PathBuf,
+}
+
+fn failure(e: PlotError) -> Failure {
+    Failure {
+        // Unreadable or malformed inputs are invalid input; failing to write is I/O.
+        code: match &e {
+            PlotError::Csv { .. } | PlotError::Json { .. } | PlotError::Data { .. } => EXIT_INVALID,
+            PlotError::Io { source, .. } if source.kind() == std::io::ErrorKind::InvalidData => EXIT_INVALID,
+            _ => EXIT_IO,
+        },
+        message: format!("report: {e}"),
+    }
+}
+
+/// Run `report`.
+pub fn report(a: &ReportArgs) -> Result<(), Failure> {
+    let dir = &a.dir;
+    let kinds = ["timeseries.csv", "map.csv", "bench.csv"];
+    if !dir.is_dir() || !kinds.iter().any(|k| dir.join(k).is_file()) {
+        return Err(invalid(format!(
+            "report: {} holds no timeseries.csv, map.csv or bench.csv",
+            dir.display()
+        )));
+    }
+    let out = OutputDir::begin(dir)?;
+    out.carry_over(&[
+        "timeseries.csv",
+        "summary.json",
+        "map.csv",
+        "map.json",
+        "bench.csv",
+        "bench.json",
+    ])?;
+    let mut written = Vec::new();
+    if out.path().join("timeseries.csv").is_file() {
+        written.extend(plots::render_run(out.path()).map_err(failure)?);
+    }
+    if out.path().join("map.csv").is_file() {
+        written.extend(plots::render_map(out.path()).map_err(failure)?);
+    }
+    if out.path().join("bench.csv").is_file() {
+        written.push(plots::render_bench(out.path()).map_err(failure)?);
+    }
+    let text: String = written
+        .iter()
+        .filter_map(|p| p.file_name())
+        .map(|name| format!("{}\n", out.target().join(name).display()))
+        .collect();
+    emit(&text)?;
+    out.commit()?;
+    Ok(())
+}

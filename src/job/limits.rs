@@ -1,0 +1,221 @@
+//! The allowed range of every numeric job option, written once. Each front end names an option
+//! differently (`--speed-rpm` on the command line, `speed_rpm` in a study file and in Python);
+//! the message names both, so that it reads the same from each.
+
+use super::JobError;
+
+/// A closed range of a numeric option.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limit {
+    /// The option's name in study files and Python (`speed_rpm`).
+    pub name: &'static str,
+    /// The command-line flag (`--speed-rpm`).
+    pub flag: &'static str,
+    /// Least allowed value.
+    pub lo: f64,
+    /// Greatest allowed value.
+    pub hi: f64,
+    /// Unit as printed after a value (empty for none).
+    pub unit: &'static str,
+}
+
+impl Limit {
+    /// `[lo, hi] unit`.
+    pub fn allowed(&self) -> String {
+        format!("[{}, {}]{}", short(self.lo), short(self.hi), self.unit_suffix())
+    }
+
+    fn unit_suffix(&self) -> String {
+        if self.unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {}", self.unit)
+        }
+    }
+
+    /// `v` if it is finite and inside the range, else the option error naming it.
+    pub fn check(&self, v: f64) -> Result<f64, JobError> {
+        if v.is_finite() && (self.lo..=self.hi).contains(&v) {
+            return Ok(v);
+        }
+        Err(JobError::option(
+            self.name,
+            short(v),
+            self.allowed(),
+            format!(
+                "{} ({}) = {}{}: must lie in {}",
+                self.name,
+                self.flag,
+                short(v),
+                self.unit_suffix(),
+                self.allowed()
+            ),
+        ))
+    }
+
+    /// Check an optional value.
+    pub fn check_opt(&self, v: Option<f64>) -> Result<Option<f64>, JobError> {
+        v.map(|x| self.check(x)).transpose()
+    }
+}
+
+/// A number as a user typed it: plain in the usual range, in exponent form outside it (so that
+/// 1e-300 is not printed with 300 zeros).
+pub fn short(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e9).contains(&x.abs()) || !x.is_finite() {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// Input shaft speed, rpm (the cycle parser holds input speeds to the same bound).
+pub const SPEED_RPM: Limit = Limit {
+    name: "speed_rpm",
+    flag: "--speed-rpm",
+    lo: 0.0,
+    hi: 50_000.0,
+    unit: "rpm",
+};
+
+/// Input torque of an equilibrium, N·m (negative: overrun).
+pub const TORQUE_NM: Limit = Limit {
+    name: "torque_nm",
+    flag: "--torque-nm",
+    lo: -1e6,
+    hi: 1e6,
+    unit: "N m",
+};
+
+/// Input torque of a loss evaluation, N·m (drive only: the loss report's efficiency assumes
+/// power flows from input to output).
+pub const DRIVE_TORQUE_NM: Limit = Limit {
+    name: "torque_nm",
+    flag: "--torque-nm",
+    lo: 0.0,
+    hi: 1e6,
+    unit: "N m",
+};
+
+/// Oil temperature of a loss evaluation, °C (the oil catalogue's Walther fits are stated from
+/// −60 °C; above 250 °C every gear oil has cracked).
+pub const OIL_TEMP_C: Limit = Limit {
+    name: "oil_temp_c",
+    flag: "--oil-temp-c",
+    lo: -60.0,
+    hi: 250.0,
+    unit: "°C",
+};
+
+/// Initial temperature of every node, °C.
+pub const INITIAL_TEMP_C: Limit = Limit {
+    name: "initial_temp_c",
+    flag: "--initial-temp-c",
+    lo: -60.0,
+    hi: 250.0,
+    unit: "°C",
+};
+
+/// Ambient temperature, °C: arctic cold to an engine bay's hottest air.
+pub const AMBIENT_C: Limit = Limit {
+    name: "ambient_c",
+    flag: "--ambient-c",
+    lo: -60.0,
+    hi: 150.0,
+    unit: "°C",
+};
+
+/// Temperature at which the oil properties are frozen, °C.
+pub const FROZEN_VISCOSITY_C: Limit = Limit {
+    name: "frozen_viscosity_c",
+    flag: "--frozen-viscosity-c",
+    lo: -60.0,
+    hi: 250.0,
+    unit: "°C",
+};
+
+/// Relative tolerance of the transient solvers.
+pub const RTOL: Limit = Limit {
+    name: "rtol",
+    flag: "--rtol",
+    lo: 1e-14,
+    hi: 1e-1,
+    unit: "",
+};
+
+/// Absolute tolerance on temperatures, K.
+pub const ATOL: Limit = Limit {
+    name: "atol",
+    flag: "--atol",
+    lo: 1e-14,
+    hi: 1.0,
+    unit: "K",
+};
+
+/// Vehicle speed for h(v) links at an equilibrium, km/h.
+pub const VEHICLE_SPEED_KMH: Limit = Limit {
+    name: "vehicle_speed_kmh",
+    flag: "--vehicle-speed-kmh",
+    lo: 0.0,
+    hi: 400.0,
+    unit: "km/h",
+};
+
+/// Step budget of a transient run.
+pub const MAX_STEPS: Limit = Limit {
+    name: "max_steps",
+    flag: "--max-steps",
+    lo: 1.0,
+    hi: 1e9,
+    unit: "",
+};
+
+/// Tightest tolerance of the work-precision sweep.
+pub const MIN_RTOL: Limit = Limit {
+    name: "min_rtol",
+    flag: "--min-rtol",
+    lo: 1e-13,
+    hi: 1e-3,
+    unit: "",
+};
+
+/// Repeats per work-precision point (the median wall time is kept).
+pub const REPEATS: Limit = Limit {
+    name: "repeats",
+    flag: "--repeats",
+    lo: 1.0,
+    hi: 1000.0,
+    unit: "",
+};
+
+/// Every limit, for tables and tests.
+pub const ALL: [Limit; 14] = [
+    SPEED_RPM,
+    TORQUE_NM,
+    DRIVE_TORQUE_NM,
+    OIL_TEMP_C,
+    INITIAL_TEMP_C,
+    AMBIENT_C,
+    FROZEN_VISCOSITY_C,
+    RTOL,
+    ATOL,
+    VEHICLE_SPEED_KMH,
+    MAX_STEPS,
+    MIN_RTOL,
+    REPEATS,
+    MAP_AXIS_POINTS,
+];
+
+/// Points per map axis.
+pub const MAP_AXIS_POINTS: Limit = Limit {
+    name: "map_axis_points",
+    flag: "--speed-rpm/--torque-nm",
+    lo: 1.0,
+    hi: 2000.0,
+    unit: "",
+};
+
+/// Most points of a map (N_speed × N_torque): each equilibrium keeps its losses and solver
+/// state (about 5 kB), and a 2-core machine solves about 1000 points per second; beyond this a
+/// map is a study (`geartherm study`), not a map.
+pub const MAX_MAP_POINTS: usize = 40_000;

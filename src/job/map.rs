@@ -1,0 +1,230 @@
+//! `map`: equilibria over a speed × torque grid in one gear state (rayon, warm starts), written
+//! whole or not at all.
+
+use serde::{Deserialize, Serialize};
+
+use crate::solve::steady::SteadyOptions as NewtonOptions;
+use crate::solve::sweep::{self, MapPoint};
+
+use super::limits::{self, short, MAX_MAP_POINTS};
+use super::steady::{check_equilibrium, point_scene};
+use super::{JobError, Model};
+
+/// Options of a map (`geartherm map`, `Model.map`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MapOptions {
+    /// Gear-state name.
+    pub gear: String,
+    /// Input speeds, rpm.
+    pub speed_rpm: Vec<f64>,
+    /// Input torques, N·m.
+    pub torque_nm: Vec<f64>,
+    /// Vehicle speed for h(v) links, km/h.
+    #[serde(default)]
+    pub vehicle_speed_kmh: f64,
+    /// Ambient temperature, °C (None: the model's).
+    #[serde(default)]
+    pub ambient_c: Option<f64>,
+}
+
+/// `A:B:N`: N points from A to B (A ≤ B), as the grid axes are written on the command line.
+pub fn axis(name: &str, flag: &str, s: &str) -> Result<Vec<f64>, JobError> {
+    let max = limits::MAP_AXIS_POINTS.hi;
+    let bad = || {
+        JobError::option(
+            name,
+            s,
+            format!("A:B:N with A ≤ B finite and 1 ≤ N ≤ {max}"),
+            format!("{name} ({flag}) = {s}: expected A:B:N (from A to B in N points, A ≤ B finite, 1 ≤ N ≤ {max})"),
+        )
+    };
+    let parts: Vec<&str> = s.split(':').collect();
+    let [a, b, n] = parts.as_slice() else {
+        return Err(bad());
+    };
+    let a: f64 = a.trim().parse().map_err(|_| bad())?;
+    let b: f64 = b.trim().parse().map_err(|_| bad())?;
+    let n: usize = n.trim().parse().map_err(|_| bad())?;
+    if n == 0 || n as f64 > max || !a.is_finite() || !b.is_finite() || (n > 1 && b < a) {
+        return Err(bad());
+    }
+    Ok((0..n)
+        .map(|k| {
+            if n == 1 {
+                a
+            } else {
+                a + (b - a) * k as f64 / (n - 1) as f64
+            }
+        })
+        .collect())
+}
+
+impl MapOptions {
+    /// Every range check of the options but the gear, which needs the model.
+    pub fn check(&self) -> Result<(), JobError> {
+        for (axis, values) in [("speed_rpm", &self.speed_rpm), ("torque_nm", &self.torque_nm)] {
+            if values.is_empty() || values.len() as f64 > limits::MAP_AXIS_POINTS.hi {
+                return Err(JobError::option(
+                    axis,
+                    values.len(),
+                    format!("1 to {} points", limits::MAP_AXIS_POINTS.hi),
+                    format!(
+                        "{axis}: {} points; a map axis has 1 to {} points",
+                        values.len(),
+                        limits::MAP_AXIS_POINTS.hi
+                    ),
+                ));
+            }
+        }
+        let n = self.speed_rpm.len() * self.torque_nm.len();
+        if n > MAX_MAP_POINTS {
+            return Err(JobError::option(
+                "points",
+                n,
+                format!("at most {MAX_MAP_POINTS}"),
+                format!(
+                    "speed_rpm × torque_nm: {} × {} = {n} points; a map may have at most {MAX_MAP_POINTS} points \
+                     (a larger grid is a study)",
+                    self.speed_rpm.len(),
+                    self.torque_nm.len()
+                ),
+            ));
+        }
+        for &s in &self.speed_rpm {
+            limits::SPEED_RPM.check(s)?;
+        }
+        for &t in &self.torque_nm {
+            limits::TORQUE_NM.check(t)?;
+        }
+        super::steady::check_point(self.vehicle_speed_kmh, self.ambient_c)
+    }
+}
+
+/// What a map found besides its table (`map.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct MapMeta {
+    /// Model name.
+    pub model: String,
+    /// Gear-state name.
+    pub gear: String,
+    /// Grid points.
+    pub points: usize,
+    /// Points with an equilibrium (all of them in a returned map).
+    pub converged: usize,
+    /// Newton + pseudo-transient iterations per point.
+    pub mean_iterations: f64,
+    /// Wall time of the sweep, s.
+    pub wall_time_s: f64,
+    /// Worker threads.
+    pub threads: usize,
+}
+
+/// A finished map: `map.csv` text and `map.json` contents.
+#[derive(Debug, Clone)]
+pub struct MapResult {
+    /// The `map.csv` text.
+    pub csv: String,
+    /// The `map.json` contents.
+    pub meta: MapMeta,
+}
+
+impl MapResult {
+    /// The files of a map's output directory: `map.csv` and `map.json`.
+    pub fn files(&self) -> Result<Vec<(&'static str, Vec<u8>)>, JobError> {
+        let json = serde_json::to_vec_pretty(&self.meta)
+            .map_err(|e| JobError::numerical(format!("cannot serialise map.json: {e}")))?;
+        Ok(vec![
+            ("map.csv", self.csv.clone().into_bytes()),
+            ("map.json", json),
+        ])
+    }
+}
+
+/// A checked map with its compiled scene, ready to solve.
+pub struct Prepared {
+    /// The scene of the map's gear state.
+    pub scene: crate::scene::Scene,
+    /// The gear state's index.
+    pub state: usize,
+}
+
+/// Check the options and compile the scene: everything that can fail as invalid input.
+pub fn prepare(m: &Model, o: &MapOptions) -> Result<Prepared, JobError> {
+    o.check()?;
+    let (scene, state) = point_scene(m, &o.gear, o.vehicle_speed_kmh, o.ambient_c)?;
+    Ok(Prepared { scene, state })
+}
+
+/// Solve the map; `tick` is called once per point (progress).
+pub fn map(m: &Model, o: &MapOptions, tick: &(dyn Fn() + Sync)) -> Result<MapResult, JobError> {
+    solve(m, o, &prepare(m, o)?, tick)
+}
+
+/// Solve a prepared map and check every point (the second half of [`map`]).
+pub fn solve(
+    m: &Model,
+    o: &MapOptions,
+    p: &Prepared,
+    tick: &(dyn Fn() + Sync),
+) -> Result<MapResult, JobError> {
+    let (scene, state) = (&p.scene, p.state);
+    let start = std::time::Instant::now();
+    let points = sweep::map(
+        scene,
+        state,
+        &o.speed_rpm,
+        &o.torque_nm,
+        o.vehicle_speed_kmh / 3.6,
+        &NewtonOptions::default(),
+        tick,
+    );
+    let wall = start.elapsed().as_secs_f64();
+    // A map is returned whole or not at all: points without an equilibrium are a failure that
+    // names them, not a map with holes.
+    let failed = failures(scene, &points);
+    if !failed.is_empty() {
+        return Err(JobError::numerical(format!(
+            "{}: {} of {} points failed, nothing written (narrow the grid); first: {}",
+            m.label(),
+            failed.len(),
+            points.len(),
+            failed.iter().take(5).cloned().collect::<Vec<_>>().join("; ")
+        )));
+    }
+    let iterations: usize = points
+        .iter()
+        .filter_map(|p| p.equilibrium.as_ref())
+        .map(|e| e.solution.iterations + e.solution.ptc_iterations)
+        .sum();
+    let n = points.len();
+    Ok(MapResult {
+        csv: crate::report::map::map_csv(&points, scene.thermal.oil),
+        meta: MapMeta {
+            model: m.gearbox.name.clone(),
+            gear: o.gear.clone(),
+            points: n,
+            converged: n,
+            mean_iterations: iterations as f64 / n.max(1) as f64,
+            wall_time_s: wall,
+            threads: rayon::current_num_threads(),
+        },
+    })
+}
+
+fn failures(scene: &crate::scene::Scene, points: &[MapPoint]) -> Vec<String> {
+    points
+        .iter()
+        .filter_map(|p| {
+            let why = match &p.equilibrium {
+                None => "no equilibrium".to_string(),
+                Some(e) => check_equilibrium(scene, e).err()?,
+            };
+            Some(format!(
+                "{} rpm, {} N m: {why}",
+                short(p.speed_rpm),
+                short(p.torque_nm)
+            ))
+        })
+        .collect()
+}

@@ -1,0 +1,238 @@
+//! `steady`: the equilibrium at one operating point, its checks and its report.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use crate::physics::oil::KELVIN_OFFSET;
+use crate::report::sources::SourceValues;
+use crate::scene::{Inputs, Needs, OperatingPoint, RangeLog, RangeWarning, Scene};
+use crate::solve::equilibrium::{equilibrium, Equilibrium};
+use crate::solve::steady::{SteadyError, SteadyOptions as NewtonOptions};
+
+use super::limits::{self, short};
+use super::{JobError, Model};
+
+/// Largest residual of an equilibrium relative to its total loss (the solver converges to about
+/// 1e-12; a larger residual is not an equilibrium, whatever the step criterion said).
+pub const MAX_RELATIVE_RESIDUAL: f64 = 1e-6;
+
+/// Options of an equilibrium (`geartherm steady`, a study's steady point, `Model.steady`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SteadyOptions {
+    /// Gear-state name.
+    pub gear: String,
+    /// Input speed, rpm.
+    pub speed_rpm: f64,
+    /// Input torque, N·m (negative: overrun).
+    pub torque_nm: f64,
+    /// Vehicle speed for h(v) links, km/h.
+    #[serde(default)]
+    pub vehicle_speed_kmh: f64,
+    /// Ambient temperature, °C (None: the model's).
+    #[serde(default)]
+    pub ambient_c: Option<f64>,
+}
+
+impl SteadyOptions {
+    /// Every range check of the options but the gear, which needs the model.
+    pub fn check(&self) -> Result<(), JobError> {
+        limits::SPEED_RPM.check(self.speed_rpm)?;
+        limits::TORQUE_NM.check(self.torque_nm)?;
+        check_point(self.vehicle_speed_kmh, self.ambient_c)
+    }
+
+    /// `gear G at N rpm, T N m` for messages.
+    pub fn describe(&self) -> String {
+        format!(
+            "gear {} at {} rpm, {} N m{}",
+            self.gear,
+            short(self.speed_rpm),
+            short(self.torque_nm),
+            self.ambient_c
+                .map_or(String::new(), |c| format!(", ambient {} °C", short(c)))
+        )
+    }
+}
+
+/// Checks shared by steady points and maps: vehicle speed and ambient.
+pub(crate) fn check_point(vehicle_speed_kmh: f64, ambient_c: Option<f64>) -> Result<(), JobError> {
+    limits::VEHICLE_SPEED_KMH.check(vehicle_speed_kmh)?;
+    limits::AMBIENT_C.check_opt(ambient_c)?;
+    Ok(())
+}
+
+/// A checked equilibrium (the `geartherm steady --json` document).
+#[derive(Debug, Clone, Serialize)]
+pub struct SteadyResult {
+    /// Model name.
+    pub model: String,
+    /// Gear-state name.
+    pub gear: String,
+    /// Input speed, rpm.
+    pub speed_rpm: f64,
+    /// Input torque, N·m.
+    pub torque_nm: f64,
+    /// Temperature per node, °C.
+    pub temperatures_c: BTreeMap<String, f64>,
+    /// Loss per item (`source:name`), W.
+    pub losses_w: BTreeMap<String, f64>,
+    /// Loss per source, W (every source, zero where the model has none).
+    pub by_source_w: SourceValues,
+    /// Total loss, W.
+    pub total_loss_w: f64,
+    /// Efficiency P/(P + losses) (None without power).
+    pub efficiency: Option<f64>,
+    /// Newton iterations.
+    pub iterations: usize,
+    /// Pseudo-transient iterations.
+    pub ptc_iterations: usize,
+    /// `newton` or `newton+ptc`.
+    pub method: &'static str,
+    /// Final residual, W.
+    pub residual_w: f64,
+    /// Loss models used outside their fitted range at the equilibrium.
+    pub warnings: Vec<RangeWarning>,
+}
+
+/// The scene of one gear state with the ambient set.
+pub(crate) fn point_scene(
+    m: &Model,
+    gear: &str,
+    vehicle_speed_kmh: f64,
+    ambient_c: Option<f64>,
+) -> Result<(Scene, usize), JobError> {
+    let state = m.state(gear)?;
+    check_point(vehicle_speed_kmh, ambient_c)?;
+    // Scene pruning: only this gear state's active items are compiled.
+    let needs = Needs {
+        states: Some(vec![state]),
+        ..Needs::default()
+    };
+    let mut scene = m.compile(&needs)?;
+    m.set_ambient(&mut scene, ambient_c)?;
+    Ok((scene, state))
+}
+
+/// The inputs of an equilibrium.
+pub(crate) fn inputs(state: usize, speed_rpm: f64, torque_nm: f64, vehicle_speed_kmh: f64) -> Inputs {
+    Inputs {
+        state,
+        input_speed: speed_rpm * std::f64::consts::PI / 30.0,
+        input_torque: torque_nm,
+        vehicle_speed: vehicle_speed_kmh / 3.6,
+    }
+}
+
+/// Solve and check the equilibrium at `o`.
+pub fn steady(m: &Model, o: &SteadyOptions) -> Result<SteadyResult, JobError> {
+    o.check()?;
+    let (scene, state) = point_scene(m, &o.gear, o.vehicle_speed_kmh, o.ambient_c)?;
+    let at = inputs(state, o.speed_rpm, o.torque_nm, o.vehicle_speed_kmh);
+    let eq = equilibrium(&scene, at, None, &NewtonOptions::default()).map_err(|e| {
+        JobError::numerical(format!(
+            "{}: no equilibrium in {}: {}",
+            m.label(),
+            o.describe(),
+            describe(&scene, &e)
+        ))
+    })?;
+    check_equilibrium(&scene, &eq)
+        .map_err(|what| JobError::numerical(format!("{}: {}: {what}", m.label(), o.describe())))?;
+    Ok(result(m, o, &scene, state, &eq))
+}
+
+fn result(m: &Model, o: &SteadyOptions, scene: &Scene, state: usize, eq: &Equilibrium) -> SteadyResult {
+    let temperatures_c = scene
+        .thermal
+        .names
+        .iter()
+        .zip(&eq.solution.temperatures)
+        .map(|(n, t)| (n.clone(), t - KELVIN_OFFSET))
+        .collect();
+    let losses_w = scene
+        .losses
+        .items
+        .iter()
+        .zip(&eq.losses)
+        .map(|(it, q)| (format!("{}:{}", it.source.as_str(), it.name), *q))
+        .collect();
+    let mut log = RangeLog::new(&scene.losses);
+    let t_oil = eq.solution.temperatures[scene.thermal.oil];
+    log.check(
+        &scene.losses,
+        &OperatingPoint {
+            state,
+            input_speed: o.speed_rpm * std::f64::consts::PI / 30.0,
+            input_torque: o.torque_nm,
+            oil: scene.thermal.oil_properties(t_oil),
+        },
+    );
+    SteadyResult {
+        model: m.gearbox.name.clone(),
+        gear: o.gear.clone(),
+        speed_rpm: o.speed_rpm,
+        torque_nm: o.torque_nm,
+        temperatures_c,
+        losses_w,
+        by_source_w: SourceValues::new(eq.by_source, "", false),
+        total_loss_w: eq.by_source.iter().sum(),
+        efficiency: eq.efficiency,
+        iterations: eq.solution.iterations,
+        ptc_iterations: eq.solution.ptc_iterations,
+        method: eq.solution.method,
+        residual_w: eq.solution.residual_w,
+        warnings: log.warnings(&scene.losses),
+    }
+}
+
+/// Every number of an equilibrium finite and its residual small, else the first failure named.
+pub fn check_equilibrium(scene: &Scene, eq: &Equilibrium) -> Result<(), String> {
+    for (n, t) in scene.thermal.names.iter().zip(&eq.solution.temperatures) {
+        if !t.is_finite() {
+            return Err(format!("temperature of node {n} is not finite"));
+        }
+    }
+    for (it, q) in scene.losses.items.iter().zip(&eq.losses) {
+        if !q.is_finite() {
+            return Err(format!(
+                "loss item {}:{} is not finite",
+                it.source.as_str(),
+                it.name
+            ));
+        }
+    }
+    let total: f64 = eq.by_source.iter().sum();
+    let r = eq.solution.residual_w;
+    if !r.is_finite() || r > MAX_RELATIVE_RESIDUAL * total.abs().max(1.0) {
+        return Err(format!(
+            "no equilibrium: residual {r:.3e} W exceeds {MAX_RELATIVE_RESIDUAL:e} of the total loss {total:.3e} W"
+        ));
+    }
+    Ok(())
+}
+
+/// A steady-solver failure in words, with node names.
+pub fn describe(scene: &Scene, e: &SteadyError) -> String {
+    let name = |i: usize| scene.thermal.names.get(i).cloned().unwrap_or_default();
+    match e {
+        SteadyError::NoEquilibriumInRange {
+            node,
+            temperature_k,
+            bound_k,
+            which,
+        } => format!(
+            "node {} is driven past its {which} limit {:.1} °C (toward {:.1} °C): the losses grow faster with \
+             temperature than the cooling removes heat",
+            name(*node),
+            bound_k - KELVIN_OFFSET,
+            temperature_k - KELVIN_OFFSET
+        ),
+        SteadyError::Singular { nodes } => format!(
+            "node(s) {} have no thermal path to a boundary",
+            nodes.iter().map(|&i| name(i)).collect::<Vec<_>>().join(", ")
+        ),
+        other => other.to_string(),
+    }
+}
