@@ -13,8 +13,13 @@
 //! - [`file`]: the whole file, one field per section; [`parse`]: TOML text → [`file::ModelFile`],
 //!   every section's type errors with their full key paths; [`validate`]: the order in which the
 //!   sections are checked, → [`Gearbox`]; [`gearbox`]: the checked gearbox;
-//! - [`problems`] (what a check reports), [`overrides`] (key-path overrides), [`source`] (the
-//!   loss sources), [`catalogue`] and [`bearing_catalogue`] (the oils and bearings compiled in).
+//! - [`choice`]: model choices (`churning = "changenet"`), enums read by name once with their
+//!   section; [`problems`] (what a check reports), [`overrides`] (key-path overrides), [`source`]
+//!   (the loss sources), [`catalogue`] and [`bearing_catalogue`] (the oils and bearings compiled
+//!   in).
+//!
+//! The paths `model::thermal`, `model::wall_mesh`, `model::bearings`, `model::pump` name the
+//! section modules, and `model::gearbox` every checked part type.
 
 pub mod bearing_catalogue;
 pub mod catalogue;

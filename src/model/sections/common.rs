@@ -1,6 +1,6 @@
 //! Helpers the section checks share: units, quoting, name lists, identifiers, heat targets.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeSet, HashMap};
 
 use crate::model::problems::Problems;
 
@@ -23,6 +23,27 @@ pub(crate) fn list<'a, T: AsRef<str> + 'a + ?Sized>(it: impl Iterator<Item = &'a
     } else {
         v.join(", ")
     }
+}
+
+/// Index of part `name` in `ix`, or a problem at `path` naming what it is not (`what`: "member",
+/// "gear") and listing the defined ones.
+pub(crate) fn lookup<'a, T: AsRef<str> + 'a + ?Sized>(
+    ix: &HashMap<&str, usize>,
+    name: &str,
+    path: String,
+    what: &str,
+    defined: impl Iterator<Item = &'a T>,
+    problems: &mut Problems,
+) -> Option<usize> {
+    let r = ix.get(name).copied();
+    if r.is_none() {
+        problems.push(
+            path,
+            q(name),
+            format!("unknown {what}; defined {what}s: {}", list(defined)),
+        );
+    }
+    r
 }
 
 /// Letters, digits and `_`, at least one: the names of thermal nodes, bearings and seals.

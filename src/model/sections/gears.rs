@@ -124,18 +124,8 @@ pub(crate) struct Gears<'a> {
 impl Gears<'_> {
     /// Index of gear `name`, or a problem at `path` listing the defined gears.
     pub fn lookup(&self, name: &str, path: String, problems: &mut Problems) -> Option<usize> {
-        let r = self.ix.get(name).copied();
-        if r.is_none() {
-            problems.push(
-                path,
-                q(name),
-                format!(
-                    "unknown gear; defined gears: {}",
-                    list(self.specs.iter().map(|g| &g.name))
-                ),
-            );
-        }
-        r
+        let defined = self.specs.iter().map(|g| &g.name);
+        lookup(&self.ix, name, path, "gear", defined, problems)
     }
 }
 

@@ -61,18 +61,8 @@ pub(crate) struct Members<'a> {
 impl Members<'_> {
     /// Index of member `name`, or a problem at `path` listing the defined members.
     pub fn lookup(&self, name: &str, path: String, problems: &mut Problems) -> Option<usize> {
-        let r = self.ix.get(name).copied();
-        if r.is_none() {
-            problems.push(
-                path,
-                q(name),
-                format!(
-                    "unknown member; defined members: {}",
-                    list(self.specs.iter().map(|m| &m.name))
-                ),
-            );
-        }
-        r
+        let defined = self.specs.iter().map(|m| &m.name);
+        lookup(&self.ix, name, path, "member", defined, problems)
     }
 
     /// The checked members, in file order.
