@@ -26,8 +26,8 @@ pub struct HeatSpec {
 /// What a heat rule applies to.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum HeatTarget {
-    /// All items of a source (its name, [`Source::as_str`]).
-    Source(String),
+    /// All items of a source.
+    Source(Source),
     /// One item, `source:name`.
     Item(String),
 }
@@ -75,7 +75,7 @@ fn target(h: &HeatSpec, p: &str, items: &LossItemNames<'_>, problems: &mut Probl
             }
             Some(HeatTarget::Item(item.clone()))
         }
-        (None, Some(s)) => Some(HeatTarget::Source(s.as_str().to_string())),
+        (None, Some(s)) => Some(HeatTarget::Source(*s)),
         _ => {
             problems.push(p, "", "give either item or source");
             None
