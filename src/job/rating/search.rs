@@ -6,9 +6,11 @@
 //! 1. f(T_min). Above the limit: the speed alone heats the oil past it; the rating is T_min,
 //!    flagged [`Status::LimitAtMinimum`]. Without any equilibrium there: a numerical failure.
 //! 2. Expansion: T_k = T_min + 10 N·m · 4^(k−1), the last one clamped to T_max, until f > 0 or
-//!    an equilibrium no longer exists because the oil runs past the solver's valid range (hotter
-//!    than any limit). Never above the limit up to T_max: the rating is T_max, flagged
-//!    [`Status::Ceiling`].
+//!    the steady solver finds no equilibrium inside its valid range, taken as hotter than any
+//!    limit (were it a solver failure below the limit, the narrowing would close in on it with
+//!    f(a) still below −tolerance and end with an error naming the torque: a rating is only
+//!    returned at a verified equilibrium). Never above the limit up to T_max: the rating is
+//!    T_max, flagged [`Status::Ceiling`].
 //! 3. The bracket [a, b] with f(a) ≤ 0 < f(b) is narrowed by the Illinois variant of regula
 //!    falsi [recalled: M. Dowell, P. Jarratt, "A modified regula falsi method for computing the
 //!    root of an equation", BIT 11 (1971) 168–174], with a bisection step whenever b has no
@@ -26,7 +28,7 @@
 use crate::physics::oil::KELVIN_OFFSET;
 use crate::scene::{Inputs, Scene};
 use crate::solve::equilibrium::{equilibrium, Equilibrium, OIL_RANGE_C};
-use crate::solve::steady::{BoundSide, SteadyError, SteadyOptions as NewtonOptions};
+use crate::solve::steady::{SteadyError, SteadyOptions as NewtonOptions};
 
 use super::super::steady::{check_equilibrium, describe};
 
@@ -118,9 +120,10 @@ impl Point<'_> {
         }
     }
 
-    /// The equilibrium at `torque` from `warm` (then from the ambient); Ok(None) when a node is
-    /// driven past the upper end of its valid range (hotter than any limit); Err(reason) when
-    /// there is no equilibrium for another reason.
+    /// The equilibrium at `torque` from `warm` (then from the ambient); Ok(None) when the solver
+    /// finds none inside the valid temperature range (taken as hotter than any limit: a wrong
+    /// guess can only end the search with an error, never with a rating, see [`search`]);
+    /// Err(reason) when there is no equilibrium for another reason.
     fn probe(&self, torque: f64, warm: Option<&Found>) -> Result<Option<Found>, (f64, String)> {
         let o = NewtonOptions::default();
         let at = self.inputs(torque);
@@ -135,10 +138,9 @@ impl Point<'_> {
                 let f = eq.solution.temperatures[self.scene.thermal.oil] - self.limit_k;
                 Ok(Some(Found { torque, eq, f }))
             }
-            Err(SteadyError::NoEquilibriumInRange {
-                which: BoundSide::Upper,
-                ..
-            }) => Ok(None),
+            // No equilibrium inside the valid range: with positive losses the oil would run past
+            // its upper end (the solver can report either end when the iterates overshoot).
+            Err(SteadyError::NoEquilibriumInRange { .. }) => Ok(None),
             Err(e) => Err((torque, describe(self.scene, &e))),
         }
     }
@@ -151,8 +153,8 @@ pub fn search(p: &Point<'_>, t_min: f64, t_max: f64) -> Result<Search, (f64, Str
         return Err((
             t_min,
             format!(
-                "no equilibrium even at the lowest torque: the oil runs past {:.0} °C",
-                OIL_RANGE_C.1
+                "no equilibrium even at the lowest torque: none inside the valid range (oil {:.0} … {:.0} °C)",
+                OIL_RANGE_C.0, OIL_RANGE_C.1
             ),
         ));
     };
