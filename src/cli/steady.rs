@@ -172,6 +172,7 @@ pub fn map(a: &MapArgs) -> Result<(), Failure> {
         b.finish_and_clear();
     }
     let r = result?;
+    warnings(&r.meta.warnings);
     for (name, bytes) in r.files()? {
         out.write(name, &bytes)?;
     }
