@@ -86,7 +86,7 @@ fn cli(row: &Row, out: &Path) -> Outcome {
             }
         }
     }
-    if row.job == "run" {
+    if row.job == "run" || row.job == "rating" {
         cmd.arg("--quiet").arg("--out").arg(out);
     }
     let o = cmd.output().unwrap();

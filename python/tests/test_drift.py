@@ -35,7 +35,7 @@ def _cli(job, options, out):
             args.append(f"{flag}={','.join(repr(x) for x in v)}")
         elif v is not False:
             args.append(f"{flag}={v!r}" if isinstance(v, float) else f"{flag}={v}")
-    if job == "run":
+    if job in ("run", "rating"):
         args += ["--quiet", "--out", str(out)]
     p = subprocess.run(args, cwd=ROOT, capture_output=True, text=True)
     kind = {0: "ok", 1: "refused", 2: "failed"}[p.returncode]
