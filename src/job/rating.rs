@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::physics::oil::KELVIN_OFFSET;
 use crate::scene::{OperatingPoint, RangeLog, RangeWarning, Scene};
+use crate::solve::equilibrium::Equilibrium;
 
 use super::limits::{self, short};
 use super::steady::{self, point_scene, SteadyOptions, SteadyResult};
@@ -237,7 +238,7 @@ pub fn solve(
     let start = std::time::Instant::now();
     let limit_k = o.oil_limit_c + KELVIN_OFFSET;
     let (t_min, t_max) = (o.torque_min_nm, o.ceiling());
-    let found: Vec<Result<search::Search, (f64, f64, String)>> = o
+    let found: Vec<Result<search::Outcome<Equilibrium>, (f64, f64, String)>> = o
         .speed_rpm
         .par_iter()
         .map(|&rpm| {
@@ -282,7 +283,13 @@ pub fn solve(
 }
 
 /// The rating point of a finished search, with its equilibrium as `steady` reports it.
-fn point(m: &Model, o: &RatingOptions, p: &Prepared, rpm: f64, s: search::Search) -> RatingPoint {
+fn point(
+    m: &Model,
+    o: &RatingOptions,
+    p: &Prepared,
+    rpm: f64,
+    s: search::Outcome<Equilibrium>,
+) -> RatingPoint {
     let so = SteadyOptions {
         gear: o.gear.clone(),
         speed_rpm: rpm,
@@ -290,17 +297,17 @@ fn point(m: &Model, o: &RatingOptions, p: &Prepared, rpm: f64, s: search::Search
         vehicle_speed_kmh: o.vehicle_speed_kmh,
         ambient_c: o.ambient_c,
     };
-    let eq = steady::result(m, &so, &p.scene, p.state, &s.equilibrium);
+    let eq = steady::result(m, &so, &p.scene, p.state, &s.payload);
     RatingPoint {
         speed_rpm: rpm,
         rated_torque_nm: s.torque,
-        rated_power_w: s.equilibrium.power,
-        oil_temp_c: s.equilibrium.solution.temperatures[p.scene.thermal.oil] - KELVIN_OFFSET,
+        rated_power_w: s.payload.power,
+        oil_temp_c: s.payload.solution.temperatures[p.scene.thermal.oil] - KELVIN_OFFSET,
         total_loss_w: eq.total_loss_w,
         efficiency: eq.efficiency,
         status: s.status,
         non_monotonic: s.non_monotonic,
-        equilibria: s.equilibria,
+        equilibria: s.probes,
         equilibrium: eq,
     }
 }
