@@ -91,6 +91,16 @@ def test_steady_and_map(at6):
     assert isinstance(m, pd.DataFrame) and len(m) == 4
 
 
+def test_rating_puts_the_oil_at_the_limit():
+    fzg = geartherm.Model.load(FZG)
+    r = fzg.rating("1", [1000, 3000], 100.0)
+    assert [p["status"] for p in r["points"]] == ["rated", "rated"]
+    for p in r["points"]:
+        s = fzg.steady("1", p["speed_rpm"], p["rated_torque_nm"])
+        assert abs(s["temperatures_c"]["oil"] - 100.0) <= 0.01
+    assert fzg.rating("1", 3000, 30.0)["points"][0]["status"] == "limit_at_minimum"
+
+
 def test_models_and_results_pickle(at6):
     m = at6.override({"lubrication.oil_level_mm": 50})
     m2 = pickle.loads(pickle.dumps(m))
