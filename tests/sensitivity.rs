@@ -16,8 +16,9 @@ use geartherm::solve::sensitivity::{
     integrate_fixed, integrate_sensitivities, Direction, SensitivityOptions,
 };
 
-const MODELS: [&str; 5] = [
+const MODELS: [&str; 6] = [
     "models/at6_lepelletier.toml",
+    "models/ev_reducer.toml",
     "models/fzg_c.toml",
     "models/helical_stage.toml",
     "models/mm82_wind_gearbox.toml",
