@@ -63,7 +63,7 @@ fn at6_third_gear_operating_point_is_plausible() {
         "--oil-temp-c",
         "80",
     ]);
-    let total = v["total_w"].as_f64().unwrap();
+    let total = v["loss_total_w"].as_f64().unwrap();
     let eff = v["efficiency"].as_f64().unwrap();
     let by = &v["by_source"];
     let (c, p, s) = (

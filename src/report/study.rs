@@ -183,6 +183,16 @@ impl Table {
         }
     }
 
+    /// The table of `rows` with the output columns `outputs` in this order (the study's columns:
+    /// the same whatever the rows hold), then any other output the rows carry.
+    pub fn with_outputs(rows: Vec<CaseRow>, outputs: &[String]) -> Table {
+        let mut t = Table::new(rows);
+        let extra: Vec<String> = t.outputs.drain(..).filter(|o| !outputs.contains(o)).collect();
+        t.outputs = outputs.to_vec();
+        t.outputs.extend(extra);
+        t
+    }
+
     /// The value of an output column in a row.
     pub fn output(&self, row: &CaseRow, name: &str) -> Option<f64> {
         row.outputs.iter().find(|(k, _)| k == name).and_then(|(_, v)| *v)
