@@ -502,7 +502,10 @@ fn vanishing_speeds_are_standstill_not_failures() {
             ]);
             assert_eq!(code(&o), 0, "{m} at {n} rpm: {}", stderr(&o));
             let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
-            assert!(v["loss_total_w"].as_f64().is_some_and(f64::is_finite), "{m} at {n}");
+            assert!(
+                v["loss_total_w"].as_f64().is_some_and(f64::is_finite),
+                "{m} at {n}"
+            );
         }
     }
     let d = tempfile::tempdir().unwrap();

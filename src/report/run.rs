@@ -378,7 +378,11 @@ pub fn skipped_items(scene: &Scene) -> Vec<(Source, String)> {
             let (src, rest) = sk.what.split_once(" of ")?;
             let source = Source::ALL.into_iter().find(|x| x.as_str() == src)?;
             let name = rest.split_once(' ')?.1;
-            let present = scene.losses.items.iter().any(|it| it.source == source && it.name == name);
+            let present = scene
+                .losses
+                .items
+                .iter()
+                .any(|it| it.source == source && it.name == name);
             (!present).then(|| (source, name.to_string()))
         })
         .collect()

@@ -60,7 +60,10 @@ impl Serialize for SourceValues {
     fn serialize<S: Serializer>(&self, ser: S) -> Result<S::Ok, S::Error> {
         let mut m = ser.serialize_map(Some(Source::ALL.len() + usize::from(self.total)))?;
         for s in Source::ALL {
-            m.serialize_entry(&format!("{}{}{}", self.prefix, s.as_str(), self.suffix), &self.get(s))?;
+            m.serialize_entry(
+                &format!("{}{}{}", self.prefix, s.as_str(), self.suffix),
+                &self.get(s),
+            )?;
         }
         if self.total {
             m.serialize_entry(&format!("{}total{}", self.prefix, self.suffix), &self.sum())?;
@@ -90,6 +93,9 @@ mod tests {
         assert_eq!(j.as_object().unwrap().len(), Source::ALL.len() + 1);
         assert!(csv_columns().starts_with("loss_churning_w,loss_pocketing_w,loss_sliding_w,loss_bearing_w"));
         let j = serde_json::to_value(SourceValues::new(v, "_w", true).prefixed("loss_")).unwrap();
-        assert_eq!((j["loss_sliding_w"].as_f64(), j["loss_total_w"].as_f64()), (Some(2.0), Some(3.0)));
+        assert_eq!(
+            (j["loss_sliding_w"].as_f64(), j["loss_total_w"].as_f64()),
+            (Some(2.0), Some(3.0))
+        );
     }
 }
