@@ -23,7 +23,12 @@ use serde::{Deserialize, Serialize};
 /// plain Python classes there, so they import from `geartherm` and pickle with their fields).
 /// `kind`: `model`, `input`, `solve`, `io`, `not_found` or `error`; `problems`: (path, value,
 /// allowed) triples.
-fn py_error(kind: &str, message: String, problems: Vec<(String, String, String)>, file: Option<String>) -> PyErr {
+fn py_error(
+    kind: &str,
+    message: String,
+    problems: Vec<(String, String, String)>,
+    file: Option<String>,
+) -> PyErr {
     Python::attach(|py| {
         let build = || -> PyResult<PyErr> {
             let f = py.import("geartherm.errors")?.getattr("_from_native")?;
@@ -277,7 +282,11 @@ fn load_study(spec: &str, text: String, file: &str) -> PyResult<Study> {
 #[pyfunction]
 fn study_file(path: PathBuf) -> PyResult<(String, String, String)> {
     let s = Study::from_file(&path).map_err(study_error)?;
-    Ok((to_json(&s.spec)?, s.model_text.clone(), s.model_file.display().to_string()))
+    Ok((
+        to_json(&s.spec)?,
+        s.model_text.clone(),
+        s.model_file.display().to_string(),
+    ))
 }
 
 /// Plan a study: (fingerprint, case ids in order, output columns).
@@ -335,7 +344,9 @@ fn run_cases(
     let rows = py.detach(|| {
         in_pool(threads, || {
             let done: Mutex<Vec<CaseRow>> = Mutex::new(Vec::with_capacity(cases.len()));
-            s.run(&cases, false, &|row, _| done.lock().unwrap_or_else(|e| e.into_inner()).push(row));
+            s.run(&cases, false, &|row, _| {
+                done.lock().unwrap_or_else(|e| e.into_inner()).push(row)
+            });
             done.into_inner().unwrap_or_else(|e| e.into_inner())
         })
     });
@@ -419,7 +430,11 @@ fn run_study(
         return Err(e);
     }
     let table = match (&out, compact && shard.is_none()) {
-        (Some(dir), true) => py.detach(|| runner::compact(&s, dir)).map_err(runner_error)?.table,
+        (Some(dir), true) => {
+            py.detach(|| runner::compact(&s, dir))
+                .map_err(runner_error)?
+                .table
+        }
         (Some(dir), false) => runner::journaled(&s, dir).map_err(runner_error)?,
         (None, _) => runner::table(&s, rows),
     };
@@ -463,7 +478,8 @@ fn study_compact(py: Python<'_>, spec: &str, text: String, file: &str, out: Path
 fn study_table(spec: &str, text: String, file: &str, rows: &str) -> PyResult<String> {
     let s = load_study(spec, text, file)?;
     let rows: Vec<CaseRow> = serde_json::from_str(rows).map_err(|e| json_error("rows", e))?;
-    let csv = study_csv(&runner::table(&s, rows)).map_err(|e| py_error("io", format!("study.csv: {e}"), Vec::new(), None))?;
+    let csv = study_csv(&runner::table(&s, rows))
+        .map_err(|e| py_error("io", format!("study.csv: {e}"), Vec::new(), None))?;
     Ok(String::from_utf8_lossy(&csv).into_owned())
 }
 

@@ -82,23 +82,28 @@ def _rebuild(cls: type, message: str, fields: dict) -> GearthermError:
 
 
 class ModelError(GearthermError, ValueError):
-    """An invalid model file or override; ``.problems`` lists every problem, ``.path`` is the
-    first key path."""
+    """An invalid model file or override.
+
+    ``.problems`` lists every problem, ``.path`` is the first key path."""
 
 
 class InputError(GearthermError, ValueError):
-    """An invalid argument: unknown cycle or gear, an option out of its range (``.path`` names
-    the option, ``.allowed`` its range), an invalid study."""
+    """An invalid argument: unknown cycle or gear, an option out of its range, an invalid study.
+
+    ``.path`` names the option, ``.value`` the value given, ``.allowed`` its range."""
 
 
 class SolveError(GearthermError, RuntimeError):
-    """A numerical failure; the message names the time, node or loss item."""
+    """A numerical failure: a run that cannot integrate, a point without equilibrium.
+
+    The message names the time, the node or the loss item (as the CLI's exit 2)."""
 
 
 class RangeWarning(UserWarning):
-    """A loss model used outside the range it was fitted on, or a loss item not counted (the
-    ``warnings`` of a run's summary, a steady point or a losses report). Filter them with
-    :func:`warnings.simplefilter` as any warning."""
+    """A loss model used outside the range it was fitted on, or a loss item not counted.
+
+    Raised for each entry of the ``warnings`` of a run's summary, a steady point or a losses
+    report; filter them with :func:`warnings.simplefilter` as any warning."""
 
 
 def _from_native(kind: str, message: str, problems: Sequence[Problem], file: Optional[str]) -> BaseException:
