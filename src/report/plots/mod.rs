@@ -27,6 +27,7 @@ pub mod index;
 pub mod losses;
 pub mod map_index;
 pub mod panel;
+pub mod quantity;
 pub mod study;
 pub mod style;
 pub mod temperatures;
