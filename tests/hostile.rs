@@ -231,7 +231,7 @@ fn report_on_malformed_or_non_finite_inputs_exits_1_and_keeps_the_directory() {
     let dir = d.path().join("r");
     std::fs::create_dir(&dir).unwrap();
     let header = "time_s,vehicle_speed_kmh,gear,input_speed_rpm,input_torque_nm,output_power_w,temp_oil_c,\
-                  churning_w,pocketing_w,sliding_w,total_loss_w,efficiency\n";
+                  loss_churning_w,loss_pocketing_w,loss_sliding_w,loss_total_w,efficiency\n";
     write(
         &dir,
         "timeseries.csv",
