@@ -1,13 +1,63 @@
-//! `[oil]`: catalogue entry or inline viscosities and density.
+//! `[oil]`: a catalogue entry or inline viscosities and density, checked into an [`Oil`].
+
+use serde::{Deserialize, Serialize};
 
 use super::common::q;
 use crate::model::catalogue;
+use crate::model::choice::choice;
 use crate::model::problems::Problems;
-use crate::model::schema::OilSpec;
-use crate::physics::oil::{Oil, WaltherVariant, ALPHA_T_MINERAL, CST};
+use crate::physics::oil::{BaseOil, Oil, WaltherVariant, ALPHA_T_MINERAL, CST};
 
-/// Validate `[oil]`.
-pub(super) fn validate_oil(o: &OilSpec, problems: &mut Problems) -> Option<Oil> {
+/// `[oil]` as written: either a catalogue name or inline data.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct OilSpec {
+    /// Name of an oil in `models/oils.toml` (the catalogue compiled into the binary).
+    #[serde(default)]
+    pub catalogue: Option<String>,
+    /// Display name for an inline oil.
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Kinematic viscosity at 40 °C, cSt (mm²/s).
+    #[serde(default)]
+    pub nu40_cst: Option<f64>,
+    /// Kinematic viscosity at 100 °C, cSt.
+    #[serde(default)]
+    pub nu100_cst: Option<f64>,
+    /// Density at 15 °C, kg/m³.
+    #[serde(default)]
+    pub rho15_kg_m3: Option<f64>,
+    /// Volumetric thermal expansion α_T, 1/K (default −6.5e−4, mineral).
+    #[serde(default)]
+    pub thermal_expansion_per_k: Option<f64>,
+    /// Walther constant: `astm_d341` (0.7, default), `c06` (0.6, seed 001), `c08` (0.8, DIN 51563).
+    #[serde(default, deserialize_with = "crate::model::choice::optional")]
+    pub walther: Option<WaltherVariant>,
+    /// Base stock (`mineral`, `pao`, `ester`, `pag`, ...): sets the default lubricant factor.
+    #[serde(default, deserialize_with = "crate::model::choice::optional")]
+    pub base: Option<BaseOil>,
+    /// Lubricant factor X_L measured for this oil (default: the base's standard value).
+    #[serde(default)]
+    pub lubricant_factor: Option<f64>,
+}
+
+choice!(@names WaltherVariant {
+    AstmD341 = "astm_d341",
+    C06 = "c06",
+    C08 = "c08",
+});
+choice!(@names BaseOil {
+    Mineral = "mineral",
+    Pao = "pao",
+    Ester = "ester",
+    Pag = "pag",
+    PagWaterSoluble = "pag_water_soluble",
+    PhosphateEster = "phosphate_ester",
+    TractionFluid = "traction_fluid",
+});
+
+/// Check `[oil]` and build the oil.
+pub(crate) fn validate_oil(o: &OilSpec, problems: &mut Problems) -> Option<Oil> {
     let variant = o.walther.unwrap_or(WaltherVariant::AstmD341);
     let inline = o.nu40_cst.is_some() || o.nu100_cst.is_some() || o.rho15_kg_m3.is_some();
     let (name, nu40, nu100, rho15, alpha, base, x_l) = match (&o.catalogue, inline) {
@@ -92,6 +142,21 @@ pub(super) fn validate_oil(o: &OilSpec, problems: &mut Problems) -> Option<Oil> 
         Err(e) => {
             problems.push("oil", "", e.to_string());
             None
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::choice::Choice;
+
+    /// The model file names an oil's base as the oil catalogue does.
+    #[test]
+    fn base_names_are_the_physics_names() {
+        assert_eq!(BaseOil::NAMES.len(), BaseOil::ALL.len());
+        for b in BaseOil::ALL {
+            assert_eq!(b.name(), b.as_str());
         }
     }
 }

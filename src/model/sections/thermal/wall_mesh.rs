@@ -24,8 +24,11 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::problems::Problems;
-use super::thermal::{Link, LinkLaw, NodeRef, ThermalNetwork, ThermalNode};
+use super::common::NodeRef;
+use super::links::{Link, LinkLaw};
+use super::network::ThermalNetwork;
+use super::nodes::ThermalNode;
+use crate::model::problems::Problems;
 
 /// `[thermal.wall_mesh]` as written.
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
@@ -201,7 +204,7 @@ pub fn mesh_wall(mut net: ThermalNetwork, spec: &WallMeshSpec, problems: &mut Pr
         } else {
             all.clone()
         };
-        let law = scaled(&l.law, 1.0 / targets.len() as f64);
+        let law = l.law.scaled(1.0 / targets.len() as f64);
         let at = |r: NodeRef, p: usize| if touches(r) { NodeRef::Node(p) } else { r };
         for &p in &targets {
             links.push(Link {
@@ -251,36 +254,4 @@ pub fn mesh_wall(mut net: ThermalNetwork, spec: &WallMeshSpec, problems: &mut Pr
     net.groups
         .push((base.name.clone(), all.iter().map(|&p| (p, scale)).collect()));
     net
-}
-
-/// A link law for one of `1/scale` equal parts of the wall.
-fn scaled(law: &LinkLaw, scale: f64) -> LinkLaw {
-    match law {
-        LinkLaw::Conductance(g) => LinkLaw::Conductance(g * scale),
-        LinkLaw::Convection { area, h } => LinkLaw::Convection {
-            area: area * scale,
-            h: *h,
-        },
-        LinkLaw::Table { area, table } => LinkLaw::Table {
-            area: area * scale,
-            table: table.clone(),
-        },
-        LinkLaw::Law { area, h0, h1 } => LinkLaw::Law {
-            area: area * scale,
-            h0: *h0,
-            h1: *h1,
-        },
-        LinkLaw::Rotating {
-            area,
-            gear,
-            radius,
-            fluid,
-        } => LinkLaw::Rotating {
-            area: area * scale,
-            gear: *gear,
-            radius: *radius,
-            fluid: *fluid,
-        },
-        LinkLaw::Radiation(k) => LinkLaw::Radiation(k * scale),
-    }
 }
