@@ -103,7 +103,7 @@ geartherm.study(sys.argv[1], out=sys.argv[2], progress=False, threads=1)
 
 
 def test_ctrl_c_stops_a_study_cleanly_and_the_rerun_solves_every_case_once(tmp_path):
-    toml = _study_toml(tmp_path, cases=300, cycle="wltc")
+    toml = _study_toml(tmp_path, cases=600, cycle="wltc")
     out = tmp_path / "out"
     p = subprocess.Popen([sys.executable, "-c", CHILD, str(toml), str(out)], stderr=subprocess.PIPE, text=True)
     journal = out / "journal.jsonl"
@@ -114,13 +114,13 @@ def test_ctrl_c_stops_a_study_cleanly_and_the_rerun_solves_every_case_once(tmp_p
         time.sleep(0.05)
     p.send_signal(signal.SIGINT)
     _, err = p.communicate(timeout=120)
-    assert p.returncode != 0 and "KeyboardInterrupt" in err, err
     first = [json.loads(l)["case"] for l in journal.read_text().splitlines()[1:]]
-    assert 2 <= len(first) < 300, len(first)
+    assert p.returncode != 0 and "KeyboardInterrupt" in err, (p.returncode, len(first), err)
+    assert 2 <= len(first) < 600, len(first)
     assert not (out / "study.csv").exists()
     s = geartherm.Study.load(toml)
     df = s.run(out=out, progress=False)
-    assert s.tally["already_done"] == len(first) and s.tally["solved"] == 300 - len(first)
+    assert s.tally["already_done"] == len(first) and s.tally["solved"] == 600 - len(first), (s.tally, len(first))
     every = [json.loads(l)["case"] for l in journal.read_text().splitlines()[1:]]
     assert sorted(every) == sorted(set(every)) == sorted(s.cases)
     assert list(df.case) == s.cases
