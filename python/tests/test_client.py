@@ -96,6 +96,10 @@ def test_progress_is_reported_and_a_callback_exception_stops_the_study(tmp_path)
     assert 1 <= len(journaled) < 300
 
 
+def _default_sigint():
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 CHILD = """
 import sys, geartherm
 geartherm.study(sys.argv[1], out=sys.argv[2], progress=False, threads=1)
@@ -105,7 +109,11 @@ geartherm.study(sys.argv[1], out=sys.argv[2], progress=False, threads=1)
 def test_ctrl_c_stops_a_study_cleanly_and_the_rerun_solves_every_case_once(tmp_path):
     toml = _study_toml(tmp_path, cases=600, cycle="wltc")
     out = tmp_path / "out"
-    p = subprocess.Popen([sys.executable, "-c", CHILD, str(toml), str(out)], stderr=subprocess.PIPE, text=True)
+    # SIGINT as a foreground process gets it (a shell without job control starts background
+    # commands with SIGINT ignored, and Python then installs no handler of its own).
+    p = subprocess.Popen(
+        [sys.executable, "-c", CHILD, str(toml), str(out)], stderr=subprocess.PIPE, text=True, preexec_fn=_default_sigint
+    )
     journal = out / "journal.jsonl"
     deadline = time.time() + 120
     while time.time() < deadline:
@@ -130,7 +138,13 @@ def test_the_cli_stops_on_sigint_with_status_130_and_resumes(tmp_path):
     toml = _study_toml(tmp_path, cases=300, cycle="wltc")
     out = tmp_path / "out"
     env = dict(os.environ, RAYON_NUM_THREADS="1")
-    p = subprocess.Popen([str(BIN), "study", str(toml), "--out", str(out), "--quiet"], env=env, stderr=subprocess.PIPE, text=True)
+    p = subprocess.Popen(
+        [str(BIN), "study", str(toml), "--out", str(out), "--quiet"],
+        env=env,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=_default_sigint,
+    )
     journal = out / "journal.jsonl"
     deadline = time.time() + 120
     while time.time() < deadline:
@@ -269,8 +283,10 @@ def test_per_source_names_are_one_rule_across_jobs():
     st = at6.steady(gear="6", speed_rpm=2000, torque_nm=100)
     ts = at6.run(cycle="hwfet").timeseries
     mp = at6.map(gear="6", speed_rpm=[2000], torque_nm=[100])
-    for where in (lo, st, ts.columns, mp.columns):
+    ra = geartherm.Model.load(FZG).rating(gear="1", speed_rpm=1500, oil_limit_c=90)["points"][0]
+    for where in (lo, st, ts.columns, mp.columns, ra["equilibrium"]):
         assert all(k in where for k in keys), keys
+    assert ra["loss_total_w"] == ra["equilibrium"]["loss_total_w"]
     assert lo["loss_total_w"] == pytest.approx(sum(lo[k] for k in keys[:-1]))
     assert st["loss_total_w"] == pytest.approx(mp["loss_total_w"].iloc[0], rel=1e-9)
     # The study table: energy_<source>_j for runs, loss_<source>_w for steady points; the same

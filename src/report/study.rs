@@ -38,7 +38,7 @@ pub struct CaseRow {
     pub status: String,
     /// Failure message (empty when ok).
     pub message: String,
-    /// Outputs with units in their names (`energy_total_j`, `max_temp_sump_c`, …); absent on
+    /// Outputs with units in their names (`energy_total_j`, `temp_max_sump_c`, …); absent on
     /// failure; None for an undefined value (e.g. efficiency without output power).
     pub outputs: Vec<(String, Option<f64>)>,
 }

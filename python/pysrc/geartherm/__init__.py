@@ -415,9 +415,38 @@ class Model:
         torque_max_nm: Optional[float] = None,
     ) -> Dict[str, Any]:
         """Thermal rating, as ``geartherm rating``: at each input speed the highest input torque
-        whose equilibrium oil temperature stays at or below ``oil_limit_c`` (the ``rating.json``
-        document as a dict: ``points`` with ``rated_torque_nm``, ``rated_power_w``, ``status``, the
-        equilibrium at that torque)."""
+        whose equilibrium oil temperature stays at or below ``oil_limit_c``.
+
+        Parameters
+        ----------
+        gear : str
+            Gear-state name.
+        speed_rpm : float or sequence of float
+            Input speed(s), rpm, 0 … 50 000 (a sequence gives the rating curve).
+        oil_limit_c : float
+            Oil temperature limit, °C, −60 … 200.
+        vehicle_speed_kmh, ambient_c : float
+            As in :meth:`steady`.
+        torque_min_nm : float, default 0
+            Lowest torque searched, N·m.
+        torque_max_nm : float, optional
+            The ceiling, N·m (default 1e6: a model states no torque capacity).
+
+        Returns
+        -------
+        dict
+            The ``rating.json`` document: ``points`` with ``speed_rpm``, ``rated_torque_nm``,
+            ``rated_power_w``, ``oil_temp_c``, ``loss_total_w``, ``efficiency``, ``status``,
+            ``non_monotonic`` and the ``equilibrium`` at that torque (the :meth:`steady` dict);
+            ``warnings`` (each also raised as a :class:`RangeWarning`).
+
+        Raises
+        ------
+        InputError
+            An unknown gear or an option out of its range.
+        SolveError
+            No equilibrium at the lowest torque, or a jump across the limit.
+        """
         speeds = [float(speed_rpm)] if isinstance(speed_rpm, (int, float)) else [float(s) for s in speed_rpm]
         o = {
             "gear": str(gear),
@@ -428,7 +457,9 @@ class Model:
             "torque_min_nm": float(torque_min_nm),
             "torque_max_nm": None if torque_max_nm is None else float(torque_max_nm),
         }
-        return json.loads(self._m.rating(o))
+        r = json.loads(self._m.rating(o))
+        _warn_ranges(r.get("warnings"))
+        return r
 
     def run(
         self,
