@@ -146,7 +146,13 @@ fn run_outputs_follow_the_contract() {
     let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
     let engine_side: Vec<usize> = if header.contains(&"engine_speed_rpm") {
         (0..header.len())
-            .filter(|&i| header[i].starts_with("loss_converter_") || header[i].starts_with("loss_pump_"))
+            // The engine side's items (not their per-source sums `loss_converter_w`, `loss_pump_w`).
+            .filter(|&i| {
+                let h = header[i];
+                (h.starts_with("loss_converter_") || h.starts_with("loss_pump_"))
+                    && h != "loss_converter_w"
+                    && h != "loss_pump_w"
+            })
             .collect()
     } else {
         Vec::new()
@@ -155,7 +161,7 @@ fn run_outputs_follow_the_contract() {
         col("input_torque_nm"),
         col("input_speed_rpm"),
         col("output_power_w"),
-        col("total_loss_w"),
+        col("loss_total_w"),
     );
     let rows: Vec<Vec<f64>> = lines
         .map(|l| {

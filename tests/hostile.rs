@@ -139,7 +139,7 @@ fn efficiency_lies_in_0_1_when_losses_exceed_the_power() {
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let eta = v["efficiency"].as_f64().unwrap();
     let p = v["input_power_w"].as_f64().unwrap();
-    let l = v["total_w"].as_f64().unwrap();
+    let l = v["loss_total_w"].as_f64().unwrap();
     assert!(l > p, "the case has more loss than power ({l} W vs {p} W)");
     assert!((0.0..=1.0).contains(&eta), "{eta}");
     assert!((eta - p / (p + l)).abs() < 1e-12, "{eta}");
@@ -174,7 +174,7 @@ fn losses_never_print_null_numbers() {
                 for it in v["items"].as_array().unwrap() {
                     assert!(it["w"].is_f64(), "{m}: {it}");
                 }
-                assert!(v["total_w"].is_f64(), "{m}");
+                assert!(v["loss_total_w"].is_f64(), "{m}");
                 let e = &v["efficiency"];
                 assert!(
                     e.is_null() || (0.0..=1.0).contains(&e.as_f64().unwrap()),
@@ -231,7 +231,7 @@ fn report_on_malformed_or_non_finite_inputs_exits_1_and_keeps_the_directory() {
     let dir = d.path().join("r");
     std::fs::create_dir(&dir).unwrap();
     let header = "time_s,vehicle_speed_kmh,gear,input_speed_rpm,input_torque_nm,output_power_w,temp_oil_c,\
-                  churning_w,pocketing_w,sliding_w,total_loss_w,efficiency\n";
+                  loss_churning_w,loss_pocketing_w,loss_sliding_w,loss_total_w,efficiency\n";
     write(
         &dir,
         "timeseries.csv",
@@ -502,7 +502,10 @@ fn vanishing_speeds_are_standstill_not_failures() {
             ]);
             assert_eq!(code(&o), 0, "{m} at {n} rpm: {}", stderr(&o));
             let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
-            assert!(v["total_w"].as_f64().is_some_and(f64::is_finite), "{m} at {n}");
+            assert!(
+                v["loss_total_w"].as_f64().is_some_and(f64::is_finite),
+                "{m} at {n}"
+            );
         }
     }
     let d = tempfile::tempdir().unwrap();

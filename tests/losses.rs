@@ -63,26 +63,20 @@ fn at6_third_gear_operating_point_is_plausible() {
         "--oil-temp-c",
         "80",
     ]);
-    let total = v["total_w"].as_f64().unwrap();
+    let total = v["loss_total_w"].as_f64().unwrap();
     let eff = v["efficiency"].as_f64().unwrap();
-    let by = &v["by_source"];
-    let (c, p, s) = (
-        by["churning_w"].as_f64().unwrap(),
-        by["pocketing_w"].as_f64().unwrap(),
-        by["sliding_w"].as_f64().unwrap(),
-    );
+    let src = |name: &str| v[format!("loss_{name}_w")].as_f64().unwrap();
+    let (c, p, s) = (src("churning"), src("pocketing"), src("sliding"));
     eprintln!("AT6 3rd, 2000 rpm, 200 N m, 80 °C: total {total:.1} W (churning {c:.1}, pocketing {p:.2}, sliding {s:.1}), efficiency {eff:.5}");
     assert!(total.is_finite() && total > 0.0);
     assert!(c > 0.0 && p >= 0.0 && s > 0.0);
     // Every source (bearings and seals included) adds up to the total.
-    let all: f64 = by
-        .as_object()
-        .unwrap()
-        .values()
-        .map(|v| v.as_f64().unwrap())
+    let all: f64 = geartherm::scene::Source::ALL
+        .iter()
+        .map(|x| src(x.as_str()))
         .sum();
     assert!((all - total).abs() < 1e-9 * total);
-    assert!(by["bearing_w"].as_f64().unwrap() > 0.0 && by["seal_w"].as_f64().unwrap() > 0.0);
+    assert!(src("bearing") > 0.0 && src("seal") > 0.0);
     assert!(c + p + s < total);
     let items: f64 = v["items"]
         .as_array()
@@ -96,10 +90,7 @@ fn at6_third_gear_operating_point_is_plausible() {
     }
     // A planetary automatic in a middle gear: the gear train alone (gears, bearings, seals) 97–99.9 %
     // at 42 kW (ISO/TR 14179-2-level magnitudes); the pump and the converter come on top.
-    let own: f64 = ["clutch_drag_w", "pump_w", "converter_w"]
-        .iter()
-        .map(|k| by[*k].as_f64().unwrap())
-        .sum();
+    let own: f64 = ["clutch_drag", "pump", "converter"].iter().map(|k| src(k)).sum();
     let p_in = 2000.0 * std::f64::consts::PI / 30.0 * 200.0;
     let gear_train = p_in / (p_in + total - own);
     assert!(
@@ -108,7 +99,7 @@ fn at6_third_gear_operating_point_is_plausible() {
     );
     assert!(eff < gear_train, "{eff}");
     // 3rd at 2000 rpm is 51 km/h: the converter is locked (above 35 km/h) with 20 rpm slip.
-    let conv = by["converter_w"].as_f64().unwrap();
+    let conv = src("converter");
     assert!(
         (conv - 200.0 * 20.0 * std::f64::consts::PI / 30.0).abs() < 1e-6,
         "{conv}"

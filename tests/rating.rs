@@ -206,7 +206,7 @@ fn the_cli_writes_the_curve_for_a_sweep_and_nothing_for_a_point() {
     let csv = std::fs::read_to_string(out.join("rating.csv")).unwrap();
     assert_eq!(
         csv.lines().next().unwrap(),
-        "speed_rpm,rated_torque_nm,rated_power_kw,oil_temp_c,total_loss_w,efficiency,flags"
+        "speed_rpm,rated_torque_nm,rated_power_kw,oil_temp_c,loss_total_w,efficiency,flags"
     );
     assert_eq!(csv.lines().count(), 5);
     let json: serde_json::Value =

@@ -42,7 +42,7 @@ path = 'thermal.links["housing-air"].h_table.h_w_per_m2k'
 scale = [0.5, 2.0]
 {extra}
 [outputs]
-pareto = ["energy_total_j", "max_temp_sump_c"]
+pareto = ["energy_total_j", "temp_max_sump_c"]
 "#,
         model.display().to_string().replace('\\', "/")
     );
@@ -223,7 +223,7 @@ range = [0.5, 1.5]"#,
     let e = v["energy_lost_j"]["total"].as_f64().unwrap();
     let t = v["temperatures_c"]["sump"]["max"].as_f64().unwrap();
     assert_eq!(good[col("energy_total_j")].parse::<f64>().unwrap(), e);
-    assert_eq!(good[col("max_temp_sump_c")].parse::<f64>().unwrap(), t);
+    assert_eq!(good[col("temp_max_sump_c")].parse::<f64>().unwrap(), t);
 }
 
 /// Split a command line written by `Study::command_line` (words, single-quoted words).

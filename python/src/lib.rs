@@ -4,49 +4,46 @@
 //! as JSON or CSV text that the Python package (`pysrc/geartherm/`) turns into dicts and pandas
 //! DataFrames. Every solve runs with the GIL released.
 
-use std::collections::HashMap;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
+use std::time::Duration;
 
 use geartherm::job::{
     self, ErrorKind, JobError, LossesOptions, MapOptions, RatingOptions, RunOptions, SteadyOptions,
 };
 use geartherm::model::Override;
+use geartherm::report::study::{study_csv, CaseRow};
+use geartherm::study::runner::{self, Output, RunnerError};
 use geartherm::study::spec::StudySpec;
-use geartherm::study::{CaseRow, Study, StudyError};
-use pyo3::create_exception;
-use pyo3::exceptions::{PyException, PyFileNotFoundError, PyOSError};
+use geartherm::study::{Case, Study, StudyError};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use serde::{Deserialize, Serialize};
 
-create_exception!(
-    _native,
-    GearthermError,
-    PyException,
-    "Base class of geartherm errors."
-);
-create_exception!(
-    _native,
-    ModelError,
-    GearthermError,
-    "An invalid model (or override): `.problems` lists (path, value, allowed); `.path` is the first key path."
-);
-create_exception!(
-    _native,
-    InputError,
-    GearthermError,
-    "An invalid argument: unknown cycle or gear, value out of range."
-);
-create_exception!(
-    _native,
-    SolveError,
-    GearthermError,
-    "A numerical failure (the message names time, node or loss item)."
-);
+/// The Python exception of a failure, built by `geartherm.errors._from_native` (the classes are
+/// plain Python classes there, so they import from `geartherm` and pickle with their fields).
+/// `kind`: `model`, `input`, `solve`, `io`, `not_found` or `error`; `problems`: (path, value,
+/// allowed) triples.
+fn py_error(
+    kind: &str,
+    message: String,
+    problems: Vec<(String, String, String)>,
+    file: Option<String>,
+) -> PyErr {
+    Python::attach(|py| {
+        let build = || -> PyResult<PyErr> {
+            let f = py.import("geartherm.errors")?.getattr("_from_native")?;
+            let e = f.call1((kind, message.clone(), problems.clone(), file.clone()))?;
+            Ok(PyErr::from_value(e))
+        };
+        build().unwrap_or_else(|e| e)
+    })
+}
 
 /// A job's error as the Python exception of its kind: an invalid model or override is a
-/// `ModelError` (`.problems`, `.path`), another invalid input an `InputError` (with `.path`,
-/// `.value`, `.allowed` of the option), a numerical failure a `SolveError`, a missing file
+/// `ModelError`, another invalid input an `InputError` (both `ValueError`s, with `.path`,
+/// `.value`, `.allowed` and `.problems`), a numerical failure a `SolveError`, a missing file
 /// `FileNotFoundError`, other I/O `OSError`.
 fn job_error(e: JobError) -> PyErr {
     let problems: Vec<(String, String, String)> = e
@@ -54,43 +51,48 @@ fn job_error(e: JobError) -> PyErr {
         .iter()
         .map(|p| (p.path.clone(), p.value.clone(), p.allowed.clone()))
         .collect();
-    let err = match e.kind {
-        ErrorKind::Io if e.io_kind == Some(std::io::ErrorKind::NotFound) => {
-            return PyFileNotFoundError::new_err(e.message)
-        }
-        ErrorKind::Io => return PyOSError::new_err(e.message),
-        ErrorKind::Numerical => return SolveError::new_err(e.message),
-        ErrorKind::Model => ModelError::new_err(e.message),
-        ErrorKind::Option | ErrorKind::Invalid => InputError::new_err(e.message),
+    let kind = match e.kind {
+        ErrorKind::Io if e.io_kind == Some(std::io::ErrorKind::NotFound) => "not_found",
+        ErrorKind::Io => "io",
+        ErrorKind::Numerical => "solve",
+        ErrorKind::Model => "model",
+        ErrorKind::Option | ErrorKind::Invalid => "input",
     };
-    let first = problems.first().cloned();
-    Python::attach(|py| {
-        let v = err.value(py);
-        let _ = v.setattr("problems", problems);
-        let _ = v.setattr("path", first.as_ref().map(|p| p.0.clone()));
-        let _ = v.setattr("value", first.as_ref().map(|p| p.1.clone()));
-        let _ = v.setattr("allowed", first.as_ref().map(|p| p.2.clone()));
-    });
-    err
+    py_error(kind, e.message, problems, None)
+}
+
+fn input_error(message: String) -> PyErr {
+    py_error("input", message, Vec::new(), None)
 }
 
 fn study_error(e: StudyError) -> PyErr {
     match e {
-        StudyError::Io { ref source, .. } if source.kind() == std::io::ErrorKind::NotFound => {
-            PyFileNotFoundError::new_err(e.to_string())
+        StudyError::Io { ref source, ref file } => {
+            let kind = if source.kind() == std::io::ErrorKind::NotFound {
+                "not_found"
+            } else {
+                "io"
+            };
+            py_error(kind, e.to_string(), Vec::new(), Some(file.display().to_string()))
         }
-        StudyError::Io { .. } => PyOSError::new_err(e.to_string()),
-        StudyError::Invalid(m) => InputError::new_err(m),
+        StudyError::Invalid(m) => input_error(m),
         StudyError::Job(j) => job_error(j),
     }
 }
 
+fn runner_error(e: RunnerError) -> PyErr {
+    match e {
+        RunnerError::Foreign(m) => input_error(m),
+        RunnerError::Io(m) => py_error("io", m, Vec::new(), None),
+    }
+}
+
 fn json_error(what: &str, e: serde_json::Error) -> PyErr {
-    InputError::new_err(format!("{what}: {e}"))
+    input_error(format!("{what}: {e}"))
 }
 
 fn to_json<T: Serialize>(v: &T) -> PyResult<String> {
-    serde_json::to_string(v).map_err(|e| GearthermError::new_err(e.to_string()))
+    serde_json::to_string(v).map_err(|e| py_error("error", e.to_string(), Vec::new(), None))
 }
 
 /// What a model is made of: its text, its file name (for messages) and the overrides applied.
@@ -137,7 +139,7 @@ fn build(state: State) -> PyResult<Model> {
 /// A job's options from a Python mapping (floats pass as they are, NaN and infinities
 /// included, so that the job layer checks them as it does for the CLI).
 fn options<T: serde::de::DeserializeOwned>(what: &str, mapping: &Bound<'_, PyAny>) -> PyResult<T> {
-    pythonize::depythonize(mapping).map_err(|e| InputError::new_err(format!("{what}: {e}")))
+    pythonize::depythonize(mapping).map_err(|e| input_error(format!("{what}: {e}")))
 }
 
 #[pymethods]
@@ -147,10 +149,11 @@ impl Model {
     fn load(path: PathBuf) -> PyResult<Model> {
         let text = std::fs::read_to_string(&path).map_err(|e| {
             let msg = format!("{}: cannot read: {e}", path.display());
-            match e.kind() {
-                std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(msg),
-                _ => PyOSError::new_err(msg),
-            }
+            let kind = match e.kind() {
+                std::io::ErrorKind::NotFound => "not_found",
+                _ => "io",
+            };
+            py_error(kind, msg, Vec::new(), Some(path.display().to_string()))
         })?;
         build(State {
             text,
@@ -310,17 +313,57 @@ fn load_study(spec: &str, text: String, file: &str) -> PyResult<Study> {
     Study::new(spec, text, PathBuf::from(file)).map_err(study_error)
 }
 
-/// Plan a study: (fingerprint, case ids in order).
+/// Read a study file: (the study as JSON, the base model's text, its file name).
 #[pyfunction]
-fn study_cases(spec: &str, text: String, file: &str) -> PyResult<(String, Vec<String>)> {
+fn study_file(path: PathBuf) -> PyResult<(String, String, String)> {
+    let s = Study::from_file(&path).map_err(study_error)?;
+    Ok((
+        to_json(&s.spec)?,
+        s.model_text.clone(),
+        s.model_file.display().to_string(),
+    ))
+}
+
+/// Plan a study: (fingerprint, case ids in order, output columns).
+#[pyfunction]
+fn study_cases(spec: &str, text: String, file: &str) -> PyResult<(String, Vec<String>, Vec<String>)> {
     let s = load_study(spec, text, file)?;
     let ids = s.cases().iter().map(|c| s.case_id(c)).collect();
-    Ok((s.fingerprint.clone(), ids))
+    Ok((s.fingerprint.clone(), ids, s.outputs.clone()))
+}
+
+fn pick_cases(s: &Study, indices: Option<Vec<usize>>, shard: Option<(usize, usize)>) -> PyResult<Vec<Case>> {
+    let all = s.cases();
+    let Some(indices) = indices else {
+        return Ok(match shard {
+            Some((i, n)) => s.shard(i, n),
+            None => all,
+        });
+    };
+    indices
+        .iter()
+        .map(|&i| {
+            all.get(i)
+                .copied()
+                .ok_or_else(|| input_error(format!("case index {i}: the study has {} cases", all.len())))
+        })
+        .collect()
+}
+
+fn in_pool<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> Result<T, String> {
+    match threads {
+        Some(n) => Ok(rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build()
+            .map_err(|e| e.to_string())?
+            .install(work)),
+        None => Ok(work()),
+    }
 }
 
 /// Solve the cases at `indices` (positions in the study's case list) in parallel, GIL released;
 /// `threads` bounds the threads (default: all cores). Returns the rows as a JSON array, in the
-/// order of `indices`.
+/// order of `indices` (a Dask task's work).
 #[pyfunction]
 #[pyo3(signature = (spec, text, file, indices, threads = None))]
 fn run_cases(
@@ -332,36 +375,187 @@ fn run_cases(
     threads: Option<usize>,
 ) -> PyResult<String> {
     let s = load_study(spec, text, file)?;
-    let all = s.cases();
-    let mut cases = Vec::with_capacity(indices.len());
-    for &i in &indices {
-        cases.push(*all.get(i).ok_or_else(|| {
-            InputError::new_err(format!("case index {i}: the study has {} cases", all.len()))
-        })?);
-    }
-    let rows = py.detach(|| -> Result<Vec<CaseRow>, String> {
-        let done: Mutex<Vec<(usize, CaseRow)>> = Mutex::new(Vec::with_capacity(cases.len()));
-        let position: HashMap<String, usize> =
-            cases.iter().enumerate().map(|(k, c)| (s.case_id(c), k)).collect();
-        let work = || {
+    let cases = pick_cases(&s, Some(indices.clone()), None)?;
+    let rows = py.detach(|| {
+        in_pool(threads, || {
+            let done: Mutex<Vec<CaseRow>> = Mutex::new(Vec::with_capacity(cases.len()));
             s.run(&cases, false, &|row, _| {
-                let k = position.get(&row.case).copied().unwrap_or(usize::MAX);
-                done.lock().unwrap_or_else(|e| e.into_inner()).push((k, row));
-            })
-        };
-        match threads {
-            Some(n) => rayon::ThreadPoolBuilder::new()
-                .num_threads(n.max(1))
-                .build()
-                .map_err(|e| e.to_string())?
-                .install(work),
-            None => work(),
-        }
-        let mut v = done.into_inner().unwrap_or_else(|e| e.into_inner());
-        v.sort_by_key(|(k, _)| *k);
-        Ok(v.into_iter().map(|(_, r)| r).collect())
+                done.lock().unwrap_or_else(|e| e.into_inner()).push(row)
+            });
+            done.into_inner().unwrap_or_else(|e| e.into_inner())
+        })
     });
-    to_json(&rows.map_err(GearthermError::new_err)?)
+    let mut rows = rows.map_err(|e| py_error("error", e, Vec::new(), None))?;
+    let order: std::collections::HashMap<String, usize> =
+        cases.iter().enumerate().map(|(k, c)| (s.case_id(c), k)).collect();
+    rows.sort_by_key(|r| order.get(&r.case).copied().unwrap_or(usize::MAX));
+    to_json(&rows)
+}
+
+/// Run a study with the library's runner (as `geartherm study`): with `out`, resume from its
+/// journals, journal every case, and (`compact`) write study.csv, study.parquet and the figures
+/// at the end. `progress(done, total)` is called from this thread about ten times a second while
+/// the cases run (GIL released in between); a signal handler that raises (Ctrl-C:
+/// `KeyboardInterrupt`) stops the study cleanly: no new case starts, the running ones finish
+/// and are journaled, then the exception propagates. Returns (the `study.csv` text of every
+/// case done, a tally dict).
+#[pyfunction]
+#[pyo3(signature = (spec, text, file, out = None, shard = None, indices = None, threads = None, progress = None, compact = true))]
+#[allow(clippy::too_many_arguments)]
+fn run_study(
+    py: Python<'_>,
+    spec: &str,
+    text: String,
+    file: &str,
+    out: Option<PathBuf>,
+    shard: Option<(usize, usize)>,
+    indices: Option<Vec<usize>>,
+    threads: Option<usize>,
+    progress: Option<Py<PyAny>>,
+    compact: bool,
+) -> PyResult<(String, Py<PyDict>)> {
+    let s = load_study(spec, text, file)?;
+    let cases = pick_cases(&s, indices, shard)?;
+    let output = out.as_ref().map(|dir| Output {
+        dir: dir.clone(),
+        shard,
+    });
+    let cancel = AtomicBool::new(false);
+    let done = AtomicUsize::new(0);
+    let mut interrupt: Option<PyErr> = None;
+    let result = std::thread::scope(|scope| {
+        let worker = scope.spawn(|| {
+            in_pool(threads, || {
+                runner::run(&s, &cases, output.as_ref(), &cancel, &|_| {
+                    done.fetch_add(1, Ordering::SeqCst);
+                })
+            })
+        });
+        loop {
+            let finished = py.detach(|| {
+                for _ in 0..10 {
+                    if worker.is_finished() {
+                        return true;
+                    }
+                    std::thread::sleep(Duration::from_millis(10));
+                }
+                worker.is_finished()
+            });
+            if let Some(p) = &progress {
+                if let Err(e) = p.call1(py, (done.load(Ordering::SeqCst), cases.len())) {
+                    interrupt.get_or_insert(e);
+                    cancel.store(true, Ordering::SeqCst);
+                }
+            }
+            if let Err(e) = py.check_signals() {
+                interrupt.get_or_insert(e);
+                cancel.store(true, Ordering::SeqCst);
+            }
+            if finished {
+                break;
+            }
+        }
+        worker.join()
+    });
+    let result = result.map_err(|_| py_error("error", "study runner panicked".into(), Vec::new(), None))?;
+    let (tally, rows) = result
+        .map_err(|e| py_error("error", e, Vec::new(), None))?
+        .map_err(runner_error)?;
+    if let Some(e) = interrupt {
+        return Err(e);
+    }
+    let table = match (&out, compact && shard.is_none()) {
+        (Some(dir), true) => {
+            py.detach(|| runner::compact(&s, dir))
+                .map_err(runner_error)?
+                .table
+        }
+        (Some(dir), false) => runner::journaled(&s, dir).map_err(runner_error)?,
+        (None, _) => runner::table(&s, rows),
+    };
+    let csv = study_csv(&table).map_err(|e| py_error("io", format!("study.csv: {e}"), Vec::new(), None))?;
+    let t = PyDict::new(py);
+    t.set_item("cases", tally.cases)?;
+    t.set_item("already_done", tally.already_done)?;
+    t.set_item("solved", tally.solved)?;
+    t.set_item("wall_s", tally.wall_s)?;
+    t.set_item("threads", tally.threads)?;
+    t.set_item("cancelled", tally.cancelled)?;
+    Ok((String::from_utf8_lossy(&csv).into_owned(), t.unbind()))
+}
+
+/// Journal rows solved elsewhere (a Dask task's JSON array) into `out`, as the runner does.
+#[pyfunction]
+fn study_record(spec: &str, text: String, file: &str, out: PathBuf, rows: &str) -> PyResult<()> {
+    let s = load_study(spec, text, file)?;
+    let rows: Vec<CaseRow> = serde_json::from_str(rows).map_err(|e| json_error("rows", e))?;
+    runner::record(&s, &out, &rows).map_err(runner_error)
+}
+
+/// Case ids already journaled in `out`.
+#[pyfunction]
+fn study_done(spec: &str, text: String, file: &str, out: PathBuf) -> PyResult<Vec<String>> {
+    let s = load_study(spec, text, file)?;
+    let t = runner::journaled(&s, &out).map_err(runner_error)?;
+    Ok(t.rows.into_iter().map(|r| r.case).collect())
+}
+
+/// Compact the journals of `out` (study.csv, study.parquet, figures); the `study.csv` text.
+#[pyfunction]
+fn study_compact(py: Python<'_>, spec: &str, text: String, file: &str, out: PathBuf) -> PyResult<String> {
+    let s = load_study(spec, text, file)?;
+    let c = py.detach(|| runner::compact(&s, &out)).map_err(runner_error)?;
+    Ok(String::from_utf8_lossy(&c.csv).into_owned())
+}
+
+/// The `study.csv` text of rows (a JSON array) in the study's case order.
+#[pyfunction]
+fn study_table(spec: &str, text: String, file: &str, rows: &str) -> PyResult<String> {
+    let s = load_study(spec, text, file)?;
+    let rows: Vec<CaseRow> = serde_json::from_str(rows).map_err(|e| json_error("rows", e))?;
+    let csv = study_csv(&runner::table(&s, rows))
+        .map_err(|e| py_error("io", format!("study.csv: {e}"), Vec::new(), None))?;
+    Ok(String::from_utf8_lossy(&csv).into_owned())
+}
+
+/// The oil catalogue as JSON (key, name, viscosities, density, base stock, sources).
+#[pyfunction]
+fn oils() -> PyResult<String> {
+    let v: Vec<serde_json::Value> = geartherm::model::catalogue::oils()
+        .into_iter()
+        .map(|o| {
+            serde_json::json!({
+                "key": o.key,
+                "name": o.name,
+                "nu40_cst": o.nu40_cst,
+                "nu100_cst": o.nu100_cst,
+                "rho15_kg_m3": o.rho15_kg_m3,
+                "thermal_expansion_per_k": o.thermal_expansion_per_k,
+                "density_assumed": o.density_assumed,
+                "base": o.base.map(|b| b.as_str()),
+                "lubricant_factor": o.lubricant_factor,
+                "source": o.source,
+            })
+        })
+        .collect();
+    to_json(&v)
+}
+
+/// The bundled drive cycles as JSON (name, duration, distance, top speed).
+#[pyfunction]
+fn cycles() -> PyResult<String> {
+    let mut v = Vec::new();
+    for name in geartherm::cycle::bundled_names() {
+        let c = geartherm::cycle::DriveCycle::bundled(name).map_err(|e| job_error(e.into()))?;
+        v.push(serde_json::json!({
+            "name": name,
+            "duration_s": c.duration(),
+            "distance_km": c.distance() / 1e3,
+            "max_speed_kmh": c.max_vehicle_speed() * 3.6,
+            "segments": c.len(),
+        }));
+    }
+    to_json(&v)
 }
 
 /// The equivalent `geartherm` command line of every case (for job arrays without Python).
@@ -379,15 +573,18 @@ fn version() -> &'static str {
 
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    let py = m.py();
     m.add_class::<Model>()?;
+    m.add_function(wrap_pyfunction!(study_file, m)?)?;
     m.add_function(wrap_pyfunction!(study_cases, m)?)?;
     m.add_function(wrap_pyfunction!(run_cases, m)?)?;
+    m.add_function(wrap_pyfunction!(run_study, m)?)?;
+    m.add_function(wrap_pyfunction!(study_record, m)?)?;
+    m.add_function(wrap_pyfunction!(study_done, m)?)?;
+    m.add_function(wrap_pyfunction!(study_compact, m)?)?;
+    m.add_function(wrap_pyfunction!(study_table, m)?)?;
     m.add_function(wrap_pyfunction!(study_commands, m)?)?;
+    m.add_function(wrap_pyfunction!(oils, m)?)?;
+    m.add_function(wrap_pyfunction!(cycles, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
-    m.add("GearthermError", py.get_type::<GearthermError>())?;
-    m.add("ModelError", py.get_type::<ModelError>())?;
-    m.add("InputError", py.get_type::<InputError>())?;
-    m.add("SolveError", py.get_type::<SolveError>())?;
     Ok(())
 }

@@ -100,7 +100,8 @@ pub struct RatingPoint {
     pub rated_power_w: f64,
     /// Equilibrium oil temperature at the rated torque, °C.
     pub oil_temp_c: f64,
-    /// Total loss at the rated torque, W.
+    /// Total loss at the rated torque, W (`loss_total_w`, docs/outputs.md).
+    #[serde(rename = "loss_total_w")]
     pub total_loss_w: f64,
     /// Efficiency at the rated torque (None at zero power).
     pub efficiency: Option<f64>,
@@ -157,7 +158,7 @@ impl RatingResult {
     /// The `rating.csv` text: one row per speed.
     pub fn csv(&self) -> String {
         let mut s = String::from(
-            "speed_rpm,rated_torque_nm,rated_power_kw,oil_temp_c,total_loss_w,efficiency,flags\n",
+            "speed_rpm,rated_torque_nm,rated_power_kw,oil_temp_c,loss_total_w,efficiency,flags\n",
         );
         for p in &self.points {
             s.push_str(&format!(

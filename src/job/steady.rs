@@ -78,9 +78,12 @@ pub struct SteadyResult {
     pub temperatures_c: BTreeMap<String, f64>,
     /// Loss per item (`source:name`), W.
     pub losses_w: BTreeMap<String, f64>,
-    /// Loss per source, W (every source, zero where the model has none).
+    /// Loss per source and their sum, W (every source, zero where the model has none), flat
+    /// keys `loss_<source>_w`, `loss_total_w`.
+    #[serde(flatten)]
     pub by_source_w: SourceValues,
-    /// Total loss, W.
+    /// Total loss, W (serialised as `loss_total_w` with the per-source values).
+    #[serde(skip)]
     pub total_loss_w: f64,
     /// Efficiency P/(P + losses) (None without power).
     pub efficiency: Option<f64>,
@@ -183,7 +186,7 @@ pub(crate) fn result(
         torque_nm: o.torque_nm,
         temperatures_c,
         losses_w,
-        by_source_w: SourceValues::new(eq.by_source, "", false),
+        by_source_w: SourceValues::new(eq.by_source, "_w", true).prefixed("loss_"),
         total_loss_w: eq.by_source.iter().sum(),
         efficiency: eq.efficiency,
         iterations: eq.solution.iterations,

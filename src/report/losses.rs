@@ -41,12 +41,14 @@ pub struct LossReport {
     pub input_power_w: f64,
     /// Output speed, rpm.
     pub output_speed_rpm: f64,
-    /// Sum of all loss items, W.
+    /// Sum of all loss items, W (serialised as `loss_total_w` with the per-source values).
+    #[serde(skip)]
     pub total_w: f64,
     /// P_out/(P_out + P_loss) with P_out the loss-free power T·ω (`physics::efficiency`);
     /// null when no power is transmitted.
     pub efficiency: Option<f64>,
-    /// Totals per source (`<source>_w`).
+    /// Totals per source and their sum, flat keys `loss_<source>_w`, `loss_total_w`.
+    #[serde(flatten)]
     pub by_source: SourceValues,
     /// Every item.
     pub items: Vec<ItemReport>,
@@ -60,7 +62,7 @@ pub struct LossReport {
 pub fn losses(gb: &Gearbox, scene: &LossScene, op: &OperatingPoint, oil_temp_c: f64) -> LossReport {
     let mut out = vec![0.0; scene.len()];
     scene.evaluate(op, &mut out);
-    let by = SourceValues::new(sum_by_source(&scene.items, &out), "_w", false);
+    let by = SourceValues::new(sum_by_source(&scene.items, &out), "_w", true).prefixed("loss_");
     let total: f64 = out.iter().sum();
     let p_in = op.input_torque * op.input_speed;
     // The loss items are evaluated at the loss-free torque: T·ω is the power delivered to the

@@ -10,7 +10,7 @@ use super::sources::csv_columns;
 /// `converged = false`.
 pub fn map_csv(points: &[MapPoint], oil: usize) -> String {
     let mut csv = format!(
-        "speed_rpm,torque_nm,efficiency,total_loss_w,{},oil_temp_c,iterations,converged\n",
+        "speed_rpm,torque_nm,efficiency,loss_total_w,{},oil_temp_c,iterations,converged\n",
         csv_columns()
     );
     for p in points {

@@ -312,7 +312,11 @@ pub fn timeseries_csv(
     for it in &scene.losses.items {
         let _ = write!(s, ",loss_{}_{}_w", it.source.as_str(), it.name);
     }
-    let _ = writeln!(s, ",{},total_loss_w,efficiency", csv_columns());
+    let left_out = skipped_items(scene);
+    for (source, name) in &left_out {
+        let _ = write!(s, ",loss_{}_{name}_w", source.as_str());
+    }
+    let _ = writeln!(s, ",{},loss_total_w,efficiency", csv_columns());
     for (k, t) in traj.times.iter().enumerate() {
         let r = &rows[k];
         let y = &traj.states[k];
@@ -347,6 +351,9 @@ pub fn timeseries_csv(
             s.push(',');
             num(&mut s, *q);
         }
+        for _ in &left_out {
+            s.push_str(",0");
+        }
         for v in by {
             let _ = write!(s, ",{v}");
         }
@@ -358,6 +365,27 @@ pub fn timeseries_csv(
         s.push('\n');
     }
     s
+}
+
+/// The loss items the scene left out (its `skipped` list, `<source> of <gear|mesh> <name>`),
+/// as (source, name): `timeseries.csv` writes their columns as zeros, so that its column set is
+/// the model's whatever the overrides (an oil level that leaves a gear dry keeps its column).
+pub fn skipped_items(scene: &Scene) -> Vec<(Source, String)> {
+    scene
+        .skipped
+        .iter()
+        .filter_map(|sk| {
+            let (src, rest) = sk.what.split_once(" of ")?;
+            let source = Source::ALL.into_iter().find(|x| x.as_str() == src)?;
+            let name = rest.split_once(' ')?.1;
+            let present = scene
+                .losses
+                .items
+                .iter()
+                .any(|it| it.source == source && it.name == name);
+            (!present).then(|| (source, name.to_string()))
+        })
+        .collect()
 }
 
 /// Torque at the gearbox input shaft, N·m: T_in = T_out/i + P_loss/ω_in (physics spec §9) with

@@ -15,6 +15,8 @@ pub struct SourceValues {
     pub suffix: &'static str,
     /// Append the sum under `total<suffix>`.
     pub total: bool,
+    /// Key prefix (`"loss_"` for the flat keys of docs/outputs.md, or `""`).
+    pub prefix: &'static str,
 }
 
 impl SourceValues {
@@ -24,7 +26,13 @@ impl SourceValues {
             values,
             suffix,
             total,
+            prefix: "",
         }
+    }
+
+    /// The same values serialised with keys `<prefix><source><suffix>` (e.g. `loss_churning_w`).
+    pub fn prefixed(self, prefix: &'static str) -> SourceValues {
+        SourceValues { prefix, ..self }
     }
 
     /// Value of source `s`.
@@ -52,18 +60,21 @@ impl Serialize for SourceValues {
     fn serialize<S: Serializer>(&self, ser: S) -> Result<S::Ok, S::Error> {
         let mut m = ser.serialize_map(Some(Source::ALL.len() + usize::from(self.total)))?;
         for s in Source::ALL {
-            m.serialize_entry(&format!("{}{}", s.as_str(), self.suffix), &self.get(s))?;
+            m.serialize_entry(
+                &format!("{}{}{}", self.prefix, s.as_str(), self.suffix),
+                &self.get(s),
+            )?;
         }
         if self.total {
-            m.serialize_entry(&format!("total{}", self.suffix), &self.sum())?;
+            m.serialize_entry(&format!("{}total{}", self.prefix, self.suffix), &self.sum())?;
         }
         m.end()
     }
 }
 
-/// CSV header fragment `<source>_w,…` (no leading or trailing comma).
+/// CSV header fragment `loss_<source>_w,…` (no leading or trailing comma).
 pub fn csv_columns() -> String {
-    Source::ALL.map(|s| format!("{}_w", s.as_str())).join(",")
+    Source::ALL.map(|s| format!("loss_{}_w", s.as_str())).join(",")
 }
 
 #[cfg(test)]
@@ -80,6 +91,11 @@ mod tests {
         assert_eq!(j["bearing_w"], 1.0);
         assert_eq!(j["total_w"], 3.0);
         assert_eq!(j.as_object().unwrap().len(), Source::ALL.len() + 1);
-        assert!(csv_columns().starts_with("churning_w,pocketing_w,sliding_w,bearing_w"));
+        assert!(csv_columns().starts_with("loss_churning_w,loss_pocketing_w,loss_sliding_w,loss_bearing_w"));
+        let j = serde_json::to_value(SourceValues::new(v, "_w", true).prefixed("loss_")).unwrap();
+        assert_eq!(
+            (j["loss_sliding_w"].as_f64(), j["loss_total_w"].as_f64()),
+            (Some(2.0), Some(3.0))
+        );
     }
 }

@@ -38,7 +38,7 @@ pub struct CaseRow {
     pub status: String,
     /// Failure message (empty when ok).
     pub message: String,
-    /// Outputs with units in their names (`energy_total_j`, `max_temp_sump_c`, …); absent on
+    /// Outputs with units in their names (`energy_total_j`, `temp_max_sump_c`, …); absent on
     /// failure; None for an undefined value (e.g. efficiency without output power).
     pub outputs: Vec<(String, Option<f64>)>,
 }
@@ -181,6 +181,16 @@ impl Table {
             params,
             outputs,
         }
+    }
+
+    /// The table of `rows` with the output columns `outputs` in this order (the study's columns:
+    /// the same whatever the rows hold), then any other output the rows carry.
+    pub fn with_outputs(rows: Vec<CaseRow>, outputs: &[String]) -> Table {
+        let mut t = Table::new(rows);
+        let extra: Vec<String> = t.outputs.drain(..).filter(|o| !outputs.contains(o)).collect();
+        t.outputs = outputs.to_vec();
+        t.outputs.extend(extra);
+        t
     }
 
     /// The value of an output column in a row.

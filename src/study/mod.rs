@@ -9,9 +9,11 @@
 //! receives each finished case through a callback (the CLI journals it, Python collects it).
 
 pub mod plan;
+pub mod runner;
 pub mod spec;
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 use toml::Value;
@@ -94,6 +96,8 @@ pub struct Study {
     pub jobs: Vec<Job>,
     /// Fingerprint of study and model (a journal of another study is refused).
     pub fingerprint: String,
+    /// The table's output columns (the same for every case, whatever its overrides).
+    pub outputs: Vec<String>,
 }
 
 /// FNV-1a, 64 bit: a stable fingerprint (the same on every platform and version).
@@ -202,15 +206,23 @@ fn output_columns(jobs: &[Job], base: &job::Model) -> Result<Vec<String>, StudyE
     let mut cols = Vec::new();
     if jobs.iter().any(|j| matches!(j, Job::Run(_))) {
         cols.extend(sources.iter().map(|s| format!("energy_{s}_j")));
-        cols.extend(["energy_total_j", "output_energy_j", "cycle_efficiency"].map(String::from));
+        cols.extend(
+            [
+                "energy_total_j",
+                "output_energy_j",
+                "cycle_efficiency",
+                "energy_efficiency",
+            ]
+            .map(String::from),
+        );
         for n in nodes {
-            cols.push(format!("final_temp_{n}_c"));
-            cols.push(format!("max_temp_{n}_c"));
+            cols.push(format!("temp_final_{n}_c"));
+            cols.push(format!("temp_max_{n}_c"));
         }
     }
     if jobs.iter().any(|j| matches!(j, Job::Steady(_))) {
         cols.extend(sources.iter().map(|s| format!("loss_{s}_w")));
-        cols.extend(["total_loss_w", "efficiency"].map(String::from));
+        cols.extend(["loss_total_w", "efficiency"].map(String::from));
         cols.extend(nodes.iter().map(|n| format!("temp_{n}_c")));
     }
     Ok(cols)
@@ -319,7 +331,8 @@ impl Study {
         }
         let jobs = jobs_of(&spec.job).map_err(invalid)?;
         check_jobs(&spec.job, &jobs, &base_model)?;
-        check_outputs(&spec.outputs, &output_columns(&jobs, &base_model)?)?;
+        let outputs = output_columns(&jobs, &base_model)?;
+        check_outputs(&spec.outputs, &outputs)?;
         let spec_json = serde_json::to_string(&spec).map_err(|e| invalid(e.to_string()))?;
         let fingerprint = format!("{:016x}", fnv1a(&[spec_json.as_bytes(), model_text.as_bytes()]));
         Ok(Study {
@@ -331,6 +344,7 @@ impl Study {
             samples,
             jobs,
             fingerprint,
+            outputs,
         })
     }
 
@@ -494,7 +508,22 @@ impl Study {
     /// Solve `cases` in parallel (rayon); `on_done` receives each case as it finishes (from
     /// worker threads, in completion order).
     pub fn run(&self, cases: &[Case], per_case: bool, on_done: &(dyn Fn(CaseRow, CaseFiles) + Sync)) {
+        self.run_until(cases, per_case, &AtomicBool::new(false), on_done);
+    }
+
+    /// [`Study::run`] that starts no new case once `cancel` is set (the cases already running
+    /// finish and reach `on_done`).
+    pub fn run_until(
+        &self,
+        cases: &[Case],
+        per_case: bool,
+        cancel: &AtomicBool,
+        on_done: &(dyn Fn(CaseRow, CaseFiles) + Sync),
+    ) {
         cases.par_iter().with_max_len(1).for_each(|c| {
+            if cancel.load(Ordering::SeqCst) {
+                return;
+            }
             let (row, files) = self.run_case(c, per_case);
             on_done(row, files);
         });
@@ -505,16 +534,19 @@ impl Study {
 /// temperature per node.
 pub fn run_outputs(s: &crate::report::run::Summary) -> Vec<(String, Option<f64>)> {
     let mut out = Vec::new();
-    if let Ok(serde_json::Value::Object(m)) = serde_json::to_value(s.energy_lost_j) {
-        for (k, v) in m {
-            out.push((format!("energy_{k}_j"), v.as_f64()));
-        }
+    for src in crate::scene::Source::ALL {
+        out.push((
+            format!("energy_{}_j", src.as_str()),
+            Some(s.energy_lost_j.get(src)),
+        ));
     }
+    out.push(("energy_total_j".into(), Some(s.energy_lost_j.sum())));
     out.push(("output_energy_j".into(), Some(s.output_energy_j)));
     out.push(("cycle_efficiency".into(), s.cycle_efficiency));
+    out.push(("energy_efficiency".into(), s.energy_efficiency));
     for (node, t) in &s.temperatures_c {
-        out.push((format!("final_temp_{node}_c"), Some(t.r#final)));
-        out.push((format!("max_temp_{node}_c"), Some(t.max)));
+        out.push((format!("temp_final_{node}_c"), Some(t.r#final)));
+        out.push((format!("temp_max_{node}_c"), Some(t.max)));
     }
     out
 }
@@ -525,7 +557,7 @@ pub fn steady_outputs(r: &job::SteadyResult) -> Vec<(String, Option<f64>)> {
         .iter()
         .map(|s| (format!("loss_{}_w", s.as_str()), Some(r.by_source_w.get(*s))))
         .collect();
-    out.push(("total_loss_w".into(), Some(r.total_loss_w)));
+    out.push(("loss_total_w".into(), Some(r.total_loss_w)));
     out.push(("efficiency".into(), r.efficiency));
     for (node, t) in &r.temperatures_c {
         out.push((format!("temp_{node}_c"), Some(*t)));

@@ -28,8 +28,8 @@
 //!
 //! [outputs]
 //! per_case = false            # timeseries.csv + summary.json per case under cases/<id>/
-//! pareto = ["energy_total_j", "max_temp_sump_c"]   # both minimised
-//! effects = ["energy_total_j", "cycle_efficiency", "max_temp_sump_c"]
+//! pareto = ["energy_total_j", "temp_max_sump_c"]   # both minimised
+//! effects = ["energy_total_j", "cycle_efficiency", "temp_max_sump_c"]
 //! ```
 
 use serde::{Deserialize, Serialize};

@@ -2,49 +2,88 @@
 
 >>> import geartherm
 >>> m = geartherm.Model.load("models/at6_lepelletier.toml")
->>> r = m.override({"lubrication.oil_level_mm": 50}).run(cycle="wltc")
->>> r.timeseries[["time_s", "temp_sump_c"]].tail()
->>> r.summary["energy_lost_j"]["total"]
+>>> r = m.override({"lubrication.oil_level_mm": 50}).run(cycle="hwfet")
+>>> float(r.timeseries["temp_sump_c"].iloc[-1]) > 23
+True
 
 Time series and maps are pandas DataFrames whose column names carry their units
-(``temp_sump_c``, ``loss_churning_s1_sun_w``, ``time_s``); summaries are dicts. Errors are
-:class:`GearthermError` subclasses; :class:`ModelError` carries the key path (``.path``) and every
-problem (``.problems``: (path, value, allowed) tuples). Every solve releases the GIL. Models and
-results pickle (their state travels as JSON), so multiprocessing, Dask and Ray can ship them.
+(``temp_sump_c``, ``loss_churning_w``, ``loss_churning_s1_sun_w``, ``time_s``; docs/outputs.md);
+summaries are dicts. Errors are :class:`GearthermError` subclasses (:class:`ModelError` and
+:class:`InputError` are also :class:`ValueError`) carrying the key path (``.path``), the value
+and the allowed range, and they pickle with those fields; a missing file is
+:class:`FileNotFoundError`. Range warnings are :class:`RangeWarning` warnings. Every solve
+releases the GIL. Models and results pickle, so multiprocessing, Dask and Ray can ship them.
 
-:func:`study` runs a design study on this machine's cores, or on a Dask cluster when given a
-``distributed.Client``.
+:func:`study` runs a design study (the runner of ``geartherm study``: progress, Ctrl-C, journal,
+resume, the same files) on this machine's cores, or on a Dask cluster given a
+``distributed.Client``. :func:`oils` and :func:`cycles` list the catalogue oils and the bundled
+drive cycles; :func:`read_run` and :func:`read_study` read result directories back.
 """
 
 from __future__ import annotations
 
-import io
 import json
 import math
 import os
+import tempfile
 from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Union
 
 from . import _native
-from ._native import GearthermError, InputError, ModelError, SolveError
+from ._tables import frame as _frame
+from ._tables import html_table as _html_table
+from ._tables import warn_ranges as _warn_ranges
+from .errors import GearthermError, InputError, ModelError, RangeWarning, SolveError
+from .results import RunResult, read_run
+from .study import Study, read_study, study, study_commands
 
 __all__ = [
     "CalibrationResult",
     "Model",
     "RunResult",
+    "Study",
     "study",
     "study_commands",
+    "read_run",
+    "read_study",
+    "oils",
+    "cycles",
     "toml_value",
+    "SOURCES",
     "GearthermError",
     "ModelError",
     "InputError",
     "SolveError",
+    "RangeWarning",
 ]
 
 __version__ = _native.version()
 
+#: The loss sources, in the order of every per-source column and key.
+SOURCES = ("churning", "pocketing", "sliding", "bearing", "seal", "clutch_drag", "pump", "converter")
+
+#: Solvers of :meth:`Model.run`.
+SOLVERS = ("auto", "ros3", "tr-bdf2", "esdirk34", "bdf", "tsit45")
+
 
 def toml_value(v: Any) -> str:
-    """A Python value as TOML value text (numbers, strings, booleans, lists, dicts)."""
+    """A Python value as TOML value text.
+
+    Parameters
+    ----------
+    v : bool, int, float, str, mapping, iterable or numpy scalar
+
+    Returns
+    -------
+    str
+        ``"true"``, ``"40"``, ``"0.5"``, ``'"fva_3a"'``, ``"[1, 2]"``, ``'{"a" = 1}'``.
+
+    Raises
+    ------
+    ValueError
+        A non-finite float (a model value must be finite).
+    TypeError
+        A value TOML cannot hold.
+    """
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, int):
@@ -64,45 +103,52 @@ def toml_value(v: Any) -> str:
     raise TypeError(f"{v!r}: cannot be written as a TOML value")
 
 
-def _frame(csv_text: str):
+def oils():
+    """The oil catalogue (``models/oils.toml``, compiled in) as a DataFrame.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per oil: ``key`` (the value of ``oil.catalogue``), ``name``, ``nu40_cst`` and
+        ``nu100_cst`` (kinematic viscosity at 40 and 100 °C, cSt), ``rho15_kg_m3`` (density at
+        15 °C), ``thermal_expansion_per_k``, ``density_assumed``, ``base`` (base stock),
+        ``lubricant_factor`` (X_L, None where the oil has none measured), ``source``.
+    """
     import pandas as pd
 
-    # Numbers must come back exactly as written (shortest round-trip form): pandas < 3 needs
-    # float_precision="round_trip" for that; from pandas 3 it is the default (and the option is
-    # deprecated).
-    if int(pd.__version__.split(".")[0]) < 3:
-        return pd.read_csv(io.StringIO(csv_text), float_precision="round_trip")
-    return pd.read_csv(io.StringIO(csv_text))
+    return pd.DataFrame.from_records(json.loads(_native.oils()))
 
 
-class RunResult:
-    """A drive-cycle run: ``summary`` (dict, the ``summary.json`` contents) and ``timeseries``
-    (pandas DataFrame, the ``timeseries.csv`` columns with units in their names; None when run
-    with ``summary_only=True``)."""
+def cycles():
+    """The bundled drive cycles as a DataFrame.
 
-    def __init__(self, summary_json: str, timeseries_csv: Optional[str]):
-        self._summary_json = summary_json
-        self._csv = timeseries_csv
-        self.summary: Dict[str, Any] = json.loads(summary_json)
-        self._frame = None
+    Returns
+    -------
+    pandas.DataFrame
+        One row per cycle: ``name`` (the value of ``Model.run(cycle=...)``), ``duration_s``,
+        ``distance_km``, ``max_speed_kmh``, ``segments``.
+    """
+    import pandas as pd
 
-    @property
-    def timeseries(self):
-        if self._csv is None:
-            return None
-        if self._frame is None:
-            self._frame = _frame(self._csv)
-        return self._frame
+    return pd.DataFrame.from_records(json.loads(_native.cycles()))
 
-    def __reduce__(self):
-        return (RunResult, (self._summary_json, self._csv))
 
-    def __repr__(self) -> str:
-        s = self.summary
-        return (
-            f"RunResult({s.get('model')!r} over {s.get('cycle')!r}: "
-            f"{s['energy_lost_j']['total'] / 1e3:.1f} kJ lost)"
-        )
+def _cycle_arg(cycle: Any, tmp: List[str]) -> str:
+    """A cycle name, CSV path, or DataFrame (written to a temporary CSV with its columns as
+    they are: ``time_s`` and ``speed_kmh``, or a rig cycle's columns)."""
+    if hasattr(cycle, "to_csv"):
+        d = tempfile.mkdtemp(prefix="geartherm-cycle-")
+        tmp.append(d)
+        path = os.path.join(d, "dataframe.csv")
+        cycle.to_csv(path, index=False)
+        return path
+    if hasattr(cycle, "write_csv"):  # polars
+        d = tempfile.mkdtemp(prefix="geartherm-cycle-")
+        tmp.append(d)
+        path = os.path.join(d, "dataframe.csv")
+        cycle.write_csv(path)
+        return path
+    return os.fspath(cycle)
 
 
 # --- calibrate -------------------------------------------------------------------------------
@@ -152,30 +198,71 @@ class CalibrationResult:
 
 
 class Model:
-    """A checked gearbox model (immutable: :meth:`override` returns a new one)."""
+    """A checked gearbox model (immutable: :meth:`override` returns a new one).
+
+    Build one with :meth:`load` (a model file) or :meth:`from_text`. Every method solves on the
+    native library with the GIL released; a Model pickles as its text, file name and overrides
+    and is checked again on arrival.
+    """
 
     def __init__(self, native: "_native.Model"):
         self._m = native
 
     @classmethod
-    def load(cls, path: Union[str, os.PathLike]) -> "Model":
-        """Read and check a model file (raises :class:`ModelError` listing every problem)."""
+    def load(cls, path: Union[str, "os.PathLike[str]"]) -> "Model":
+        """Read and check a model file (docs/model-file.md).
+
+        Parameters
+        ----------
+        path : str or path-like
+            The model's TOML file.
+
+        Raises
+        ------
+        FileNotFoundError
+            No such file (``.filename`` is the path).
+        ModelError
+            An invalid model; ``.problems`` lists every problem as (key path, value, allowed).
+        """
         return cls(_native.Model.load(os.fspath(path)))
 
     @classmethod
     def from_text(cls, text: str, name: str = "model.toml") -> "Model":
-        """Check model text; ``name`` appears in messages."""
+        """Check model text; ``name`` is the file name its messages show.
+
+        Raises
+        ------
+        ModelError
+            An invalid model.
+        """
         return cls(_native.Model.from_text(text, name))
 
     def override(self, values: Mapping[str, Any]) -> "Model":
-        """A new model with values overridden by key path, e.g.
-        ``{"lubrication.oil_level_mm": 55, 'thermal.coolers["atf_cooler"].effectiveness': 0.8}``;
-        checked exactly like the file (a :class:`ModelError` names the path and the override)."""
+        """A new model with values overridden by key path, checked exactly like the file.
+
+        Parameters
+        ----------
+        values : mapping of key path to value
+            e.g. ``{"lubrication.oil_level_mm": 55, "oil.catalogue": "fva_3a",
+            'thermal.coolers["atf_cooler"].effectiveness': 0.8}``; an array entry is named by
+            index (``gears[2].teeth``) or by its name (``coolers["atf_cooler"]``).
+
+        Raises
+        ------
+        ModelError
+            An unknown path or an invalid value (``.path``, ``.value``, ``.allowed``).
+        """
         return Model(self._m.with_overrides([f"{k} = {toml_value(v)}" for k, v in values.items()]))
 
     @property
     def name(self) -> str:
+        """The model's name (``[model] name``)."""
         return self._m.name
+
+    @property
+    def file(self) -> str:
+        """The file name messages show."""
+        return self._m.file
 
     @property
     def text(self) -> str:
@@ -184,20 +271,55 @@ class Model:
 
     @property
     def overrides(self) -> List[str]:
+        """The overrides applied, as ``"path = toml value"`` lines."""
         return list(self._m.overrides)
 
     def check(self) -> Dict[str, Any]:
-        """Counts of the checked model (gears, meshes, gear states, thermal nodes)."""
+        """Counts of the checked model.
+
+        Returns
+        -------
+        dict
+            ``model``, ``gears``, ``meshes``, ``gear_states`` (names), ``thermal_nodes``,
+            ``vehicle`` (bool).
+        """
         return json.loads(self._m.check())
 
     def info(self) -> Dict[str, Any]:
-        """Gear states, ratios, member speeds, meshes, immersion (``geartherm info --json``)."""
+        """Gear states, ratios, member speeds, meshes and immersion (``geartherm info --json``)."""
         return json.loads(self._m.info())
 
     def losses(self, gear: str, speed_rpm: float, torque_nm: float, oil_temp_c: float) -> Dict[str, Any]:
-        """Every loss item at one operating point (``geartherm losses --json``)."""
+        """Every loss item at one operating point and oil temperature (``geartherm losses``).
+
+        Parameters
+        ----------
+        gear : str
+            Gear-state name (``"1"`` … ``"6"``, ``"R"``; see ``check()["gear_states"]``).
+        speed_rpm : float
+            Input speed, rpm.
+        torque_nm : float
+            Input torque, N·m.
+        oil_temp_c : float
+            Oil temperature, °C.
+
+        Returns
+        -------
+        dict
+            ``loss_<source>_w`` per source and ``loss_total_w`` (W), ``items`` (one per loss
+            item: ``source``, ``name``, ``w``), ``efficiency``, the oil's viscosity and density
+            at that temperature, ``skipped``, ``warnings`` (each also raised as a
+            :class:`RangeWarning`).
+
+        Raises
+        ------
+        InputError
+            An unknown gear or an option out of its range.
+        """
         o = {"gear": str(gear), "speed_rpm": float(speed_rpm), "torque_nm": float(torque_nm), "oil_temp_c": float(oil_temp_c)}
-        return json.loads(self._m.losses(o))
+        r = json.loads(self._m.losses(o))
+        _warn_ranges(r.get("warnings"))
+        return r
 
     def steady(
         self,
@@ -207,9 +329,37 @@ class Model:
         vehicle_speed_kmh: float = 0.0,
         ambient_c: Optional[float] = None,
     ) -> Dict[str, Any]:
-        """Equilibrium temperatures (°C), losses (W) and efficiency at one operating point."""
+        """The thermal equilibrium at one operating point (``geartherm steady``).
+
+        Parameters
+        ----------
+        gear : str
+            Gear-state name.
+        speed_rpm, torque_nm : float
+            Input speed (rpm) and torque (N·m).
+        vehicle_speed_kmh : float, default 0
+            Vehicle speed for the speed-dependent heat transfer h(v), km/h.
+        ambient_c : float, optional
+            Ambient temperature, °C (default: the model's).
+
+        Returns
+        -------
+        dict
+            ``temperatures_c`` (per node, °C), ``loss_<source>_w`` per source and
+            ``loss_total_w`` (W), ``losses_w`` per item, ``efficiency``, the Newton
+            iterations, ``warnings`` (each also raised as a :class:`RangeWarning`).
+
+        Raises
+        ------
+        InputError
+            An unknown gear or an option out of its range.
+        SolveError
+            No equilibrium (the message says why).
+        """
         p = _point(gear, speed_rpm, torque_nm, vehicle_speed_kmh, ambient_c)
-        return json.loads(self._m.steady(p))
+        r = json.loads(self._m.steady(p))
+        _warn_ranges(r.get("warnings"))
+        return r
 
     def map(
         self,
@@ -218,9 +368,33 @@ class Model:
         torque_nm: Sequence[float],
         vehicle_speed_kmh: float = 0.0,
         ambient_c: Optional[float] = None,
+        *,
+        backend: str = "pandas",
     ):
-        """Equilibria over speed × torque (``map.csv`` as a DataFrame), as ``geartherm map``: a
-        point without an equilibrium fails the whole map (:class:`SolveError` naming it)."""
+        """Equilibria over a speed × torque grid (``geartherm map``).
+
+        Parameters
+        ----------
+        gear : str
+            Gear-state name.
+        speed_rpm, torque_nm : sequence of float
+            The grid's input speeds (rpm) and torques (N·m).
+        vehicle_speed_kmh, ambient_c : float
+            As in :meth:`steady`.
+        backend : {"pandas", "polars"}
+
+        Returns
+        -------
+        DataFrame
+            ``map.csv``: ``speed_rpm``, ``torque_nm``, ``efficiency``, ``loss_total_w``,
+            ``loss_<source>_w``, ``oil_temp_c``, ``iterations``, ``converged`` (float64 for
+            every quantity).
+
+        Raises
+        ------
+        SolveError
+            A point without an equilibrium fails the whole map, naming it.
+        """
         o = {
             "gear": str(gear),
             "speed_rpm": [float(s) for s in speed_rpm],
@@ -228,7 +402,7 @@ class Model:
             "vehicle_speed_kmh": float(vehicle_speed_kmh),
             "ambient_c": None if ambient_c is None else float(ambient_c),
         }
-        return _frame(self._m.map(o))
+        return _frame(self._m.map(o), backend=backend)
 
     def rating(
         self,
@@ -241,9 +415,38 @@ class Model:
         torque_max_nm: Optional[float] = None,
     ) -> Dict[str, Any]:
         """Thermal rating, as ``geartherm rating``: at each input speed the highest input torque
-        whose equilibrium oil temperature stays at or below ``oil_limit_c`` (the ``rating.json``
-        document as a dict: ``points`` with ``rated_torque_nm``, ``rated_power_w``, ``status``, the
-        equilibrium at that torque)."""
+        whose equilibrium oil temperature stays at or below ``oil_limit_c``.
+
+        Parameters
+        ----------
+        gear : str
+            Gear-state name.
+        speed_rpm : float or sequence of float
+            Input speed(s), rpm, 0 … 50 000 (a sequence gives the rating curve).
+        oil_limit_c : float
+            Oil temperature limit, °C, −60 … 200.
+        vehicle_speed_kmh, ambient_c : float
+            As in :meth:`steady`.
+        torque_min_nm : float, default 0
+            Lowest torque searched, N·m.
+        torque_max_nm : float, optional
+            The ceiling, N·m (default 1e6: a model states no torque capacity).
+
+        Returns
+        -------
+        dict
+            The ``rating.json`` document: ``points`` with ``speed_rpm``, ``rated_torque_nm``,
+            ``rated_power_w``, ``oil_temp_c``, ``loss_total_w``, ``efficiency``, ``status``,
+            ``non_monotonic`` and the ``equilibrium`` at that torque (the :meth:`steady` dict);
+            ``warnings`` (each also raised as a :class:`RangeWarning`).
+
+        Raises
+        ------
+        InputError
+            An unknown gear or an option out of its range.
+        SolveError
+            No equilibrium at the lowest torque, or a jump across the limit.
+        """
         speeds = [float(speed_rpm)] if isinstance(speed_rpm, (int, float)) else [float(s) for s in speed_rpm]
         o = {
             "gear": str(gear),
@@ -254,11 +457,13 @@ class Model:
             "torque_min_nm": float(torque_min_nm),
             "torque_max_nm": None if torque_max_nm is None else float(torque_max_nm),
         }
-        return json.loads(self._m.rating(o))
+        r = json.loads(self._m.rating(o))
+        _warn_ranges(r.get("warnings"))
+        return r
 
     def run(
         self,
-        cycle: str = "wltc",
+        cycle: Any = "wltc",
         *,
         solver: str = "auto",
         rtol: Optional[float] = None,
@@ -270,9 +475,49 @@ class Model:
         frozen_viscosity_c: Optional[float] = None,
         evaluate_all: bool = False,
     ) -> RunResult:
-        """A drive-cycle transient (bundled cycle name or CSV file), as ``geartherm run``."""
+        """A drive-cycle transient (``geartherm run``).
+
+        Parameters
+        ----------
+        cycle : str, path or DataFrame, default "wltc"
+            A bundled cycle (:func:`cycles` lists them), a CSV file, or a DataFrame with the
+            CSV's columns (``time_s``, ``speed_kmh``; or a rig cycle's ``time_s``, ``gear``,
+            ``input_speed_rpm``, ``input_torque_nm``).
+        solver : {"auto", "ros3", "tr-bdf2", "esdirk34", "bdf", "tsit45"}, default "auto"
+            ``auto`` is ROS3 up to 24 capacity nodes, TR-BDF2 above (docs/numerics.md).
+        rtol : float, default 1e-4
+            Relative tolerance, in [1e-14, 0.1].
+        atol : float, default 1e-6
+            Absolute tolerance on temperatures, K, in [1e-14, 1].
+        initial_temp_c : float, optional
+            Initial temperature of every node, °C (default: the model's).
+        ambient_c : float, optional
+            Ambient temperature, °C (default: the model's ambient boundary).
+        max_steps : int, default 5 000 000
+            Step budget; the run fails beyond it.
+        summary_only : bool, default False
+            No time series (faster); the summary is complete.
+        frozen_viscosity_c : float, optional
+            Oil properties frozen at this temperature, °C (viscosity feedback off).
+        evaluate_all : bool, default False
+            No pruning of unused gear states and idle items (for measuring what it saves).
+
+        Returns
+        -------
+        RunResult
+            ``summary`` (dict) and ``timeseries`` (DataFrame, None with ``summary_only``);
+            each range warning is also raised as a :class:`RangeWarning`.
+
+        Raises
+        ------
+        InputError
+            An unknown cycle or solver, an option out of its range.
+        SolveError
+            A numerical failure (the message names the time, node or loss item).
+        """
+        tmp: List[str] = []
         o: Dict[str, Any] = {
-            "cycle": os.fspath(cycle),
+            "cycle": _cycle_arg(cycle, tmp),
             "solver": solver,
             "summary_only": bool(summary_only),
             "evaluate_all": bool(evaluate_all),
@@ -283,8 +528,16 @@ class Model:
                 o[k] = v
         o["initial_temp_c"] = initial_temp_c
         o["ambient_c"] = ambient_c
-        summary, csv = self._m.run(o)
-        return RunResult(summary, csv)
+        try:
+            summary, csv = self._m.run(o)
+        finally:
+            for d in tmp:
+                import shutil
+
+                shutil.rmtree(d, ignore_errors=True)
+        r = RunResult(summary, csv)
+        _warn_ranges(r.summary.get("warnings"))
+        return r
 
     # --- calibrate ---------------------------------------------------------------------------
     def calibrate(
@@ -325,6 +578,18 @@ class Model:
     def __reduce__(self):
         return (Model, (self._m,))
 
+    def _repr_html_(self) -> str:
+        c = self.check()
+        rows = [
+            ("file", self.file),
+            ("gears / meshes", f"{c['gears']} / {c['meshes']}"),
+            ("gear states", ", ".join(c["gear_states"])),
+            ("thermal nodes", c["thermal_nodes"]),
+            ("vehicle", c["vehicle"]),
+            ("overrides", "; ".join(self.overrides) or "none"),
+        ]
+        return _html_table(f"Model {self.name!r}", rows)
+
     def __repr__(self) -> str:
         return repr(self._m)
 
@@ -337,121 +602,3 @@ def _point(gear, speed_rpm, torque_nm, vehicle_speed_kmh, ambient_c) -> Dict[str
         "vehicle_speed_kmh": float(vehicle_speed_kmh),
         "ambient_c": None if ambient_c is None else float(ambient_c),
     }
-
-
-# ---------------------------------------------------------------------------------------------
-# Studies
-
-
-def _spec(
-    parameters,
-    job: Optional[Mapping[str, Any]],
-    sampling: Optional[Mapping[str, Any]],
-    name: str,
-) -> Dict[str, Any]:
-    if isinstance(parameters, Mapping):
-        params = [dict(spec, path=path) for path, spec in parameters.items()]
-    else:
-        params = [dict(p) for p in parameters]
-    return {
-        "study": {"name": name, "model": ""},
-        "job": dict(job) if job is not None else {"kind": "run", "cycles": ["wltc"]},
-        "sampling": dict(sampling) if sampling is not None else {"plan": "grid"},
-        "parameters": params,
-        "outputs": {},
-    }
-
-
-def _batch(spec_json: str, text: str, file: str, indices: List[int], threads: Optional[int]) -> str:
-    """One Dask task: solve a batch of cases from the shipped study and model text."""
-    return _native.run_cases(spec_json, text, file, indices, threads)
-
-
-def _rows_to_frame(rows: List[Dict[str, Any]]):
-    import pandas as pd
-
-    records = []
-    for r in rows:
-        rec: Dict[str, Any] = {"case": r["case"], "sample": r["sample"], "job": r["job"]}
-        for k, v in r["params"]:
-            rec[k] = v
-        rec["status"] = r["status"]
-        rec["message"] = r["message"]
-        for k, v in r["outputs"]:
-            rec[k] = math.nan if v is None else v
-        records.append(rec)
-    return pd.DataFrame.from_records(records)
-
-
-def study(
-    model: Union[Model, str, os.PathLike],
-    parameters: Union[Mapping[str, Mapping[str, Any]], Sequence[Mapping[str, Any]]],
-    job: Optional[Mapping[str, Any]] = None,
-    sampling: Optional[Mapping[str, Any]] = None,
-    *,
-    client=None,
-    batch_size: Optional[int] = None,
-    threads_per_task: Optional[int] = None,
-    cases: Optional[Sequence[int]] = None,
-    name: str = "study",
-):
-    """Run a design study and return one DataFrame row per case.
-
-    ``parameters``: ``{key_path: {"range": [lo, hi]} | {"values": [...]} | {"scale": [lo, hi]}}``
-    (``"levels": n`` for grid points of a range). ``job``: ``{"kind": "run", "cycles": ["wltc"]}``
-    (default), ``{"kind": "steady", "points": [{"gear": "3", "speed_rpm": 2000, "torque_nm":
-    100}]}`` or ``{"kind": "map", "gear": "3", "speed_rpm": [...], "torque_nm": [...]}``.
-    ``sampling``: ``{"plan": "grid"}`` (default), ``{"plan": "lhs", "cases": 1000, "seed": 7}``
-    or ``{"plan": "list"}``. The same structure as a study file (``geartherm study``).
-
-    Without ``client`` the cases run on this machine's cores (rayon, GIL released). With a
-    ``distributed.Client`` the cases are cut into batches (``batch_size``, default about four
-    batches per worker thread), each batch is one task carrying the study and the model *text*
-    (nothing is read from the workers' disks), and the rows are gathered into one DataFrame in
-    case order. ``cases`` restricts the run to these positions in the study's case list (e.g.
-    to rerun failed cases, or to share a plan between machines). A failing case is a row with ``status`` ``failed`` or ``invalid`` and its
-    ``message``; it does not stop the study.
-    """
-    if not isinstance(model, Model):
-        model = Model.load(model)
-    if model.overrides:
-        raise InputError("study(): pass the base model without overrides; vary values through parameters")
-    spec_json = json.dumps(_spec(parameters, job, sampling, name))
-    text, file = model.text, model._m.file
-    _, ids = _native.study_cases(spec_json, text, file)
-    todo = list(range(len(ids))) if cases is None else [int(i) for i in cases]
-    n = len(todo)
-    if client is None:
-        rows = json.loads(_native.run_cases(spec_json, text, file, todo, threads_per_task))
-    else:
-        if batch_size is None:
-            workers = sum(client.nthreads().values()) or 1
-            batch_size = max(1, math.ceil(n / (4 * workers)))
-        batches = [todo[i : i + batch_size] for i in range(0, n, batch_size)]
-        futures = client.map(
-            _batch,
-            [spec_json] * len(batches),
-            [text] * len(batches),
-            [file] * len(batches),
-            batches,
-            [threads_per_task] * len(batches),
-            pure=False,
-        )
-        rows = []
-        for part in client.gather(futures):
-            rows.extend(json.loads(part))
-    return _rows_to_frame(rows)
-
-
-def study_commands(
-    model: Union[Model, str, os.PathLike],
-    parameters,
-    job: Optional[Mapping[str, Any]] = None,
-    sampling: Optional[Mapping[str, Any]] = None,
-) -> List[str]:
-    """The stand-alone ``geartherm run``/``steady`` command line of every case (for Slurm
-    arrays or HyperQueue without Python)."""
-    if not isinstance(model, Model):
-        model = Model.load(model)
-    spec_json = json.dumps(_spec(parameters, job, sampling, "study"))
-    return _native.study_commands(spec_json, model.text, model._m.file)

@@ -147,14 +147,14 @@ pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
     // The three gear sources are required; later sources are optional (older files).
     let mut c_src = [None; N_SOURCES];
     for s in Source::ALL {
-        let col = format!("{}_w", s.as_str());
+        let col = format!("loss_{}_w", s.as_str());
         c_src[s.index()] = if s.index() < 3 {
             Some(require(&col)?)
         } else {
             find(&col)
         };
     }
-    let c_total = require("total_loss_w")?;
+    let c_total = require("loss_total_w")?;
     let c_eff = require("efficiency")?;
 
     let mut ts = TimeSeries::default();
@@ -420,12 +420,16 @@ pub struct MapRow {
     /// Efficiency P_out/(P_out + P_loss) at the equilibrium, fraction (empty without one).
     pub efficiency: Option<f64>,
     /// Total loss at the equilibrium, W.
+    #[serde(rename = "loss_total_w")]
     pub total_loss_w: Option<f64>,
     /// Churning loss at the equilibrium, W.
+    #[serde(rename = "loss_churning_w")]
     pub churning_w: Option<f64>,
     /// Pocketing loss at the equilibrium, W.
+    #[serde(rename = "loss_pocketing_w")]
     pub pocketing_w: Option<f64>,
     /// Sliding (mesh friction) loss at the equilibrium, W.
+    #[serde(rename = "loss_sliding_w")]
     pub sliding_w: Option<f64>,
     /// Equilibrium temperature of the oil node, °C.
     pub oil_temp_c: Option<f64>,

@@ -1,5 +1,5 @@
 //! `losses.png`: loss power stacked by source (churning at the bottom, then pocketing, then
-//! sliding) vs time, with the file's `total_loss_w` drawn on top as a thin black line.
+//! sliding) vs time, with the file's `loss_total_w` drawn on top as a thin black line.
 
 use plotters::prelude::*;
 

@@ -29,6 +29,7 @@ pub mod index;
 pub mod losses;
 pub mod map_index;
 pub mod panel;
+pub mod quantity;
 pub mod rating;
 pub mod study;
 pub mod style;

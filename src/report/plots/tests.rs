@@ -94,7 +94,7 @@ fn write_run(dir: &Path, spec: &RunSpec) {
     for (s, n) in &items {
         let _ = write!(csv, ",loss_{}_{n}_w", SOURCES[*s]);
     }
-    csv.push_str(",churning_w,pocketing_w,sliding_w,total_loss_w,efficiency\n");
+    csv.push_str(",loss_churning_w,loss_pocketing_w,loss_sliding_w,loss_total_w,efficiency\n");
     let mut t: f64 = 0.0;
     for r in 0..spec.rows {
         // Non-uniform spacing: 1 s, with some 0.5 s steps.
@@ -280,7 +280,7 @@ fn run_edge_cases_do_not_panic() {
 fn efficiency_never_defined_and_minimal_summary() {
     let dir = tempfile::tempdir().unwrap();
     let csv = "time_s,vehicle_speed_kmh,gear,input_speed_rpm,input_torque_nm,output_power_w,temp_oil_c,\
-               churning_w,pocketing_w,sliding_w,total_loss_w,efficiency\n\
+               loss_churning_w,loss_pocketing_w,loss_sliding_w,loss_total_w,efficiency\n\
                0,0,N,800,0,0,20,0,0,0,0,\n10,0,N,800,0,0,21,1,0,0,1,\n20,0,N,800,0,0,22,1,0,0,1,\n";
     fs::write(dir.path().join("timeseries.csv"), csv).unwrap();
     fs::write(dir.path().join("summary.json"), "{}").unwrap();
@@ -381,7 +381,7 @@ fn write_map(dir: &Path, nx: usize, ny: usize, shuffle: bool) {
         rows.remove(1);
     }
     let mut csv = String::from(
-        "speed_rpm,torque_nm,efficiency,total_loss_w,churning_w,pocketing_w,sliding_w,oil_temp_c,iterations,converged\n",
+        "speed_rpm,torque_nm,efficiency,loss_total_w,loss_churning_w,loss_pocketing_w,loss_sliding_w,oil_temp_c,iterations,converged\n",
     );
     for r in rows {
         csv.push_str(&r);

@@ -1,0 +1,52 @@
+//! Study throughput: cases of the bundled AT6 WLTC study (`models/studies/at6_wltc_lhs.toml`)
+//! solved per second by the study runner that `geartherm study` and Python's local backend call
+//! (`study::runner::run`, nothing written), on every rayon thread, and one case on one thread
+//! split into its parts: the model with the sample's overrides (parse + checks), the scene
+//! compile, and the summary-only integration.
+//!
+//! Run: `cargo bench --bench throughput`. Figures are recorded in docs/performance.md.
+
+use std::hint::black_box;
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use geartherm::job::{self, RunOptions};
+use geartherm::study::{runner, Study};
+
+fn benches(c: &mut Criterion) {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let study = Study::from_file(&root.join("models/studies/at6_wltc_lhs.toml")).expect("bundled study");
+    let cases: Vec<_> = study.cases().into_iter().take(64).collect();
+    let mut g = c.benchmark_group("study");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(cases.len() as u64));
+    g.bench_function("at6_wltc/64_cases", |b| {
+        b.iter(|| {
+            runner::run(&study, black_box(&cases), None, &AtomicBool::new(false), &|_| {}).expect("run")
+        })
+    });
+    g.finish();
+
+    let (ovs, _) = study.overrides(0).expect("overrides");
+    let model = || job::Model::from_text(&study.model_text, &study.model_file, &ovs).expect("model");
+    let m = model();
+    let o = RunOptions {
+        summary_only: true,
+        ..RunOptions::default()
+    };
+    c.bench_function("study/case/model_with_overrides", |b| b.iter(model));
+    c.bench_function("study/case/scene_compile", |b| {
+        b.iter(|| {
+            black_box(&m)
+                .compile(&geartherm::scene::Needs::default())
+                .expect("scene")
+        })
+    });
+    c.bench_function("study/case/run_summary_only", |b| {
+        b.iter(|| job::run::run(black_box(&m), &o, &mut |_, _| {}).expect("run"))
+    });
+}
+
+criterion_group!(throughput, benches);
+criterion_main!(throughput);

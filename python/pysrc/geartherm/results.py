@@ -1,0 +1,113 @@
+"""Results of a drive-cycle run, and reading a run directory back."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any, Dict, Optional, Union
+
+from ._tables import frame, html_table
+
+__all__ = ["RunResult", "read_run"]
+
+
+class RunResult:
+    """A drive-cycle run.
+
+    Attributes
+    ----------
+    summary : dict
+        The ``summary.json`` contents (docs/outputs.md): ``energy_lost_j`` (J per source and
+        ``total``), ``energy_by_item_j``, ``output_energy_j``, ``cycle_efficiency``,
+        ``energy_efficiency``, ``temperatures_c`` (min/max/final per node, °C), ``warnings``,
+        the solver block.
+    timeseries : pandas.DataFrame or None
+        The ``timeseries.csv`` columns (units in the names: ``time_s``, ``temp_<node>_c``,
+        ``loss_<source>_w``, ``loss_<source>_<item>_w``, ``loss_total_w``, ``efficiency``);
+        None for a run with ``summary_only=True``.
+    """
+
+    def __init__(self, summary_json: str, timeseries_csv: Optional[str]):
+        self._summary_json = summary_json
+        self._csv = timeseries_csv
+        self.summary: Dict[str, Any] = json.loads(summary_json)
+        self._frame = None
+
+    @property
+    def timeseries(self):
+        if self._csv is None:
+            return None
+        if self._frame is None:
+            self._frame = frame(self._csv)
+        return self._frame
+
+    def to_polars(self):
+        """The time series as a polars DataFrame (needs ``polars``); None without one."""
+        return None if self._csv is None else frame(self._csv, backend="polars")
+
+    def write(self, directory: Union[str, "os.PathLike[str]"]) -> Path:
+        """Write ``summary.json`` and ``timeseries.csv`` (when present) into ``directory``, the
+        files ``geartherm run --out`` writes; :func:`read_run` reads them back."""
+        d = Path(directory)
+        d.mkdir(parents=True, exist_ok=True)
+        (d / "summary.json").write_text(json.dumps(self.summary, indent=2) + "\n")
+        if self._csv is not None:
+            (d / "timeseries.csv").write_text(self._csv)
+        return d
+
+    def plot(self, kind: str = "all"):
+        """Draw the run report's figures with matplotlib (``pip install "geartherm[plot]"``).
+
+        Parameters
+        ----------
+        kind : {"all", "temperatures", "losses", "energy"}
+            Temperatures of every capacity node over time (°C), loss per source over time
+            (stacked, W), energy per source (kJ); ``"all"`` draws the three on one figure.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from .plots import run_figure
+
+        return run_figure(self, kind)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, RunResult):
+            return NotImplemented
+        a, b = dict(self.summary), dict(other.summary)
+        # The integration's wall time is the one figure two equal runs do not share.
+        a.pop("wall_time_s", None)
+        b.pop("wall_time_s", None)
+        return a == b and self._csv == other._csv
+
+    def __reduce__(self):
+        return (RunResult, (self._summary_json, self._csv))
+
+    def _repr_html_(self) -> str:
+        s = self.summary
+        e = s.get("energy_lost_j", {})
+        rows = [("cycle", s.get("cycle")), ("duration", f"{s.get('duration_s', 0):.0f} s")]
+        rows += [(k, f"{v / 1e3:.2f} kJ") for k, v in e.items() if v]
+        for k in ("cycle_efficiency", "energy_efficiency"):
+            if s.get(k) is not None:
+                rows.append((k, f"{s[k]:.4f}"))
+        rows += [(f"{n} (max / final)", f"{t['max']:.1f} / {t['final']:.1f} °C") for n, t in s.get("temperatures_c", {}).items()]
+        rows.append(("warnings", len(s.get("warnings", []))))
+        return html_table(f"Run of {s.get('model')!r}", rows)
+
+    def __repr__(self) -> str:
+        s = self.summary
+        return f"RunResult({s.get('model')!r} over {s.get('cycle')!r}: {s['energy_lost_j']['total'] / 1e3:.1f} kJ lost)"
+
+
+def read_run(directory: Union[str, "os.PathLike[str]"]) -> RunResult:
+    """A run directory (``geartherm run --out DIR`` or :meth:`RunResult.write`) as the
+    :class:`RunResult` the run returned.
+
+    Raises :class:`FileNotFoundError` when ``summary.json`` is missing."""
+    d = Path(directory)
+    summary = (d / "summary.json").read_text()
+    ts = d / "timeseries.csv"
+    return RunResult(json.dumps(json.loads(summary)), ts.read_text() if ts.exists() else None)
