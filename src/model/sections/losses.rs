@@ -36,6 +36,24 @@ choice!(ChurningChoice {
     Off = "off",
 });
 
+/// `windage`: the drag of gears that run above the oil, in air (docs/physics.md §14).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum WindageChoice {
+    /// Seetharaman–Kahraman's drag terms (faces, periphery, tooth cavities) on a gear wholly in
+    /// air.
+    #[default]
+    Seetharaman,
+    /// Stavytskyi et al.'s model with the gear wholly immersed, in air.
+    Stavytskyi,
+    /// No windage loss.
+    Off,
+}
+choice!(WindageChoice {
+    Seetharaman = "seetharaman",
+    Stavytskyi = "stavytskyi",
+    Off = "off",
+});
+
 /// `pocketing`: pocketing of external meshes (docs/physics.md §6) on or off.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub enum PocketingChoice {
@@ -178,6 +196,9 @@ pub struct LossesSpec {
     /// Pocketing (default `on`).
     #[serde(default)]
     pub pocketing: Option<PocketingChoice>,
+    /// Windage of gears above the oil (default `seetharaman`).
+    #[serde(default)]
+    pub windage: Option<WindageChoice>,
     /// Sliding model (default `detailed`).
     #[serde(default)]
     pub sliding: Option<SlidingModelChoice>,
@@ -319,6 +340,8 @@ pub struct LossModels {
     pub pocketing: Option<PocketingOptions>,
     /// Sliding.
     pub sliding: SlidingChoice,
+    /// Windage of gears above the oil (None: off).
+    pub windage: Option<ChurningModel>,
 }
 
 /// Default discharge coefficient of pocketing (physics.md §6: 0.6–0.7).
@@ -340,10 +363,16 @@ pub fn validate_losses(
     if problems.len() > start {
         return None;
     }
+    let windage = match l.windage.unwrap_or_default() {
+        WindageChoice::Seetharaman => Some(ChurningModel::Seetharaman),
+        WindageChoice::Stavytskyi => Some(ChurningModel::Stavytskyi),
+        WindageChoice::Off => None,
+    };
     Some(LossModels {
         churning,
         pocketing,
         sliding,
+        windage,
     })
 }
 
