@@ -31,7 +31,7 @@ impl RangeLog {
         }
     }
 
-    /// Check every churning model of `scene` at `op`.
+    /// Check every churning model of `scene` at `op`, and every windage model in air.
     pub fn check(&mut self, scene: &LossScene, op: &OperatingPoint) {
         self.points += 1;
         let oil = OilState {
@@ -47,6 +47,15 @@ impl RangeLog {
                     e.0 += 1;
                 }
                 last = (item, c.index());
+                e.1 = e.1.min(v);
+                e.2 = e.2.max(v);
+            }
+        }
+        let air = crate::physics::losses::windage::AIR;
+        for (item, m, w) in scene.windage_models(op.state, op.input_speed) {
+            if let Some((c, v)) = m.out_of_range(w, &air) {
+                let e = &mut self.seen[item][c.index()];
+                e.0 += 1;
                 e.1 = e.1.min(v);
                 e.2 = e.2.max(v);
             }
