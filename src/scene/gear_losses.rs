@@ -321,6 +321,14 @@ pub(super) fn compile_windage(
         if g.is_immersed() {
             continue;
         }
+        // A gear on a member the housing holds never turns (nor does it in any state of the model).
+        if (0..gb.gear_states.len()).all(|st| gb.gear_speeds(st)[gi].absolute == 0.0) {
+            lists.skipped.push(Skipped {
+                what: format!("windage of gear {}", g.name),
+                why: "never turns (its member is held by the housing)".into(),
+            });
+            continue;
+        }
         let planets = match g.mount {
             GearMount::Planet { set, .. } => gb.planetary_sets[set].planets,
             GearMount::OnMember => 1,
