@@ -322,7 +322,7 @@ pub(super) fn compile_windage(
             continue;
         }
         // A gear on a member the housing holds never turns (nor does it in any state of the model).
-        if (0..gb.gear_states.len()).all(|st| gb.gear_speeds(st)[gi].absolute == 0.0) {
+        if (0..gb.gear_states.len()).all(|st| gb.gear_speeds(st)[gi].absolute.abs() < 1e-12) {
             lists.skipped.push(Skipped {
                 what: format!("windage of gear {}", g.name),
                 why: "never turns (its member is held by the housing)".into(),
