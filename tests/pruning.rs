@@ -372,8 +372,9 @@ fn per_state_idle_items_of_the_at6() {
     // 3rd: the 4 Ravigneaux sliding meshes, its 3 external pockets (fed by the circuit), the 2
     // Ravigneaux planet bearings and the drag of the engaged clutches A and B.
     assert_eq!(count("3"), Some(11));
-    // 2nd holds the large sun: its bearing stands still, and the engaged A and C have no drag.
-    assert_eq!(count("2"), Some(3));
+    // 2nd holds the large sun: its bearing and its windage stand still, and the engaged A and C
+    // have no drag.
+    assert_eq!(count("2"), Some(4));
     // every other state leaves one to four meshes unloaded, and in 1st, 6th and R one held
     // member's bearing still (in 6th also the held large sun's windage), plus the drag of its two
     // engaged shift elements
