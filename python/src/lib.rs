@@ -8,7 +8,9 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
-use geartherm::job::{self, ErrorKind, JobError, LossesOptions, MapOptions, RunOptions, SteadyOptions};
+use geartherm::job::{
+    self, ErrorKind, JobError, LossesOptions, MapOptions, RatingOptions, RunOptions, SteadyOptions,
+};
 use geartherm::model::Override;
 use geartherm::study::spec::StudySpec;
 use geartherm::study::{CaseRow, Study, StudyError};
@@ -237,6 +239,16 @@ impl Model {
         Ok(r.csv)
     }
 
+    /// A thermal rating (a mapping of `job::RatingOptions` in): the `rating.json` document.
+    fn rating(&self, py: Python<'_>, options: &Bound<'_, PyAny>) -> PyResult<String> {
+        let o: RatingOptions = self::options("rating", options)?;
+        let m = self.m.clone();
+        let r = py
+            .detach(|| job::rating::rating(&m, &o, &|| {}))
+            .map_err(job_error)?;
+        to_json(&r)
+    }
+
     /// A drive-cycle run (a mapping of `job::RunOptions` in): (`summary.json` text, `timeseries.csv`
     /// text or None).
     fn run(&self, py: Python<'_>, options: &Bound<'_, PyAny>) -> PyResult<(String, Option<String>)> {
@@ -247,6 +259,29 @@ impl Model {
             .map_err(job_error)?;
         Ok((to_json(&r.summary)?, r.timeseries_csv))
     }
+
+    // --- calibrate -----------------------------------------------------------------------
+    /// Calibrate against a trace given as CSV text (`trace_name` names it in messages; a
+    /// mapping of `job::CalibrateOptions` in): (`calibration.json`, `fit.csv`,
+    /// `calibrated.toml`, `cycle.csv`) texts.
+    fn calibrate(
+        &self,
+        py: Python<'_>,
+        trace_csv: &str,
+        trace_name: &str,
+        options: &Bound<'_, PyAny>,
+    ) -> PyResult<(String, String, String, String)> {
+        let mut o: job::CalibrateOptions = self::options("calibrate", options)?;
+        o.trace = trace_name.to_string();
+        let trace = job::calibrate::Trace::parse(trace_csv, trace_name)
+            .map_err(|e| job_error(JobError::invalid(e.to_string())))?;
+        let (m, text) = (self.m.clone(), self.state.text.clone());
+        let r = py
+            .detach(|| job::calibrate::calibrate(&m, &text, &trace, &o))
+            .map_err(job_error)?;
+        Ok((to_json(&r.summary)?, r.fit_csv, r.calibrated_model, r.cycle_csv))
+    }
+    // --- end calibrate -------------------------------------------------------------------
 
     /// Pickle support: rebuilt from its state (text, file name, overrides) as JSON.
     fn __reduce__(slf: &Bound<'_, Self>) -> PyResult<(Py<PyAny>, (String,))> {

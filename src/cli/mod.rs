@@ -8,8 +8,10 @@ use std::path::PathBuf;
 use clap::{Parser, Subcommand};
 
 mod bench;
+mod calibrate;
 mod check;
 mod output;
+mod rating;
 mod report;
 mod run;
 mod steady;
@@ -48,6 +50,9 @@ pub enum Command {
     Steady(steady::SteadyArgs),
     /// Equilibria over a speed × torque grid (map.csv and heat maps).
     Map(steady::MapArgs),
+    /// Thermal rating: the highest input torque whose equilibrium oil temperature stays at or
+    /// below a limit, at one speed or over a sweep (rating.csv, rating.json, rating.png).
+    Rating(rating::RatingArgs),
     /// Design study: every sample of a parameter plan on cycles or operating points, in
     /// parallel; resumable; writes study.csv, study.parquet, main_effects.png, pareto.png.
     Study(study::StudyArgs),
@@ -59,6 +64,9 @@ pub enum Command {
     Validate(validate::ValidateArgs),
     /// PNG plots and report.md from an existing output directory (a run, a map or a bench).
     Report(report::ReportArgs),
+    /// Fit model parameters (key paths with bounds) to a measured temperature trace: values with
+    /// 95 % intervals, correlations, errors on fitted and held-out rows, calibrated.toml.
+    Calibrate(calibrate::CalibrateArgs),
 }
 
 /// The model file and `--set PATH=VALUE` overrides, shared by every command that reads a model.
@@ -93,9 +101,11 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         Command::Run(a) => run::run(&a),
         Command::Steady(a) => steady::steady(&a),
         Command::Map(a) => steady::map(&a),
+        Command::Rating(a) => rating::rating(&a),
         Command::Study(a) => study::study(&a),
         Command::Bench(a) => bench::bench(&a),
         Command::Validate(a) => validate::validate(&a),
         Command::Report(a) => report::report(&a),
+        Command::Calibrate(a) => calibrate::calibrate(&a),
     }
 }

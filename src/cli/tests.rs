@@ -5,7 +5,9 @@ use std::path::Path;
 
 use clap::Parser;
 use geartherm::job::command::{command_line, split, validate_line, ToArgs};
-use geartherm::job::{BenchOptions, LossesOptions, MapOptions, RunOptions, SteadyOptions, ValidateOptions};
+use geartherm::job::{
+    BenchOptions, LossesOptions, MapOptions, RatingOptions, RunOptions, SteadyOptions, ValidateOptions,
+};
 use geartherm::model::Override;
 
 use super::{Cli, Command};
@@ -113,6 +115,30 @@ fn map_options_round_trip() {
 }
 
 #[test]
+fn rating_options_round_trip() {
+    for (speeds, torque_max_nm, ambient_c) in [
+        (vec![3000.0], None, None),
+        (vec![0.0, 1234.5, 1.0 / 3.0], Some(450.25), Some(-20.5)),
+    ] {
+        let o = RatingOptions {
+            gear: "D".into(),
+            speed_rpm: speeds,
+            oil_limit_c: 0.1 + 0.2,
+            vehicle_speed_kmh: 55.5,
+            ambient_c,
+            torque_min_nm: 12.125,
+            torque_max_nm,
+        };
+        let l = line(&o);
+        let Command::Rating(a) = parse(&l) else {
+            panic!("{l}")
+        };
+        check_source(&a.point.source);
+        assert_eq!(a.options().unwrap(), o, "{l}");
+    }
+}
+
+#[test]
 fn bench_options_round_trip() {
     let o = BenchOptions {
         cycle: "nedc".into(),
@@ -139,4 +165,36 @@ fn validate_options_round_trip() {
         panic!("{l}")
     };
     assert_eq!(a.options(), o, "{l}");
+}
+
+#[test]
+fn calibrate_options_round_trip() {
+    use geartherm::job::CalibrateOptions;
+    let all = [
+        CalibrateOptions {
+            trace: "traces/rig 1.csv".into(),
+            ..CalibrateOptions::default()
+        },
+        CalibrateOptions {
+            trace: "t.csv".into(),
+            fit: vec![
+                "thermal.links[\"oil-housing\"].h_w_per_m2k=50:2000".into(),
+                "thermal.nodes[\"oil\"].mass_kg".into(),
+            ],
+            holdout: vec!["0:600".into(), "3000:3600".into()],
+            rtol: 1.25e-7,
+            atol: 3e-9,
+            max_steps: 1234,
+            max_iterations: 7,
+            initial_from_trace: false,
+        },
+    ];
+    for o in all {
+        let l = line(&o);
+        let Command::Calibrate(a) = parse(&l) else {
+            panic!("{l}")
+        };
+        check_source(&a.source);
+        assert_eq!(a.options(), o, "{l}");
+    }
 }

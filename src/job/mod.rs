@@ -10,6 +10,7 @@
 //! | `run` | [`RunOptions`] | [`run::run`] | [`RunResult`] |
 //! | `steady` | [`SteadyOptions`] | [`steady::steady`] | [`SteadyResult`] |
 //! | `map` | [`MapOptions`] | [`map::map`] | [`MapResult`] |
+//! | `rating` | [`RatingOptions`] | [`rating::rating`] | [`RatingResult`] |
 //! | `bench` | [`BenchOptions`] | [`bench::bench`] | [`BenchResult`] |
 //! | `validate` | [`ValidateOptions`] | [`validate::validate`] | [`ValidateResult`] |
 //!
@@ -17,21 +18,25 @@
 //! line is rendered from its options by [`command`].
 
 pub mod bench;
+pub mod calibrate;
 pub mod command;
 pub mod error;
 pub mod limits;
 pub mod losses;
 pub mod map;
 pub mod model;
+pub mod rating;
 pub mod run;
 pub mod steady;
 pub mod validate;
 
 pub use bench::{BenchOptions, BenchResult};
+pub use calibrate::{CalibrateOptions, CalibrateResult};
 pub use error::{ErrorKind, JobError};
 pub use losses::LossesOptions;
 pub use map::{MapOptions, MapResult};
 pub use model::Model;
+pub use rating::{RatingOptions, RatingResult};
 pub use run::{RunOptions, RunResult};
 pub use steady::{SteadyOptions, SteadyResult};
 pub use validate::{ValidateOptions, ValidateResult};

@@ -71,6 +71,8 @@ pub struct LossScene {
     elements: super::element_losses::ElementLosses,
     /// The lubrication circuit and the items that follow its flows.
     pub circuit: CircuitScene,
+    /// Multiplier of each item (`[losses] multiplier`), when any is given.
+    factor: Option<Vec<f64>>,
 }
 
 impl LossScene {
@@ -125,7 +127,9 @@ impl LossScene {
             &mut skipped,
         );
         let circuit = CircuitScene::compile(gb, &mut items);
+        let factor = multipliers(&gb.losses.multipliers, &items)?;
         Ok(LossScene {
+            factor,
             items,
             skipped,
             churn,
@@ -155,6 +159,11 @@ impl LossScene {
     /// Evaluate every loss item (W) at `op` into `out` (length [`Self::len`]), everything in
     /// full. No allocation.
     pub fn evaluate(&self, op: &OperatingPoint, out: &mut [f64]) {
+        self.evaluate_unscaled(op, out);
+        self.scale(out);
+    }
+
+    fn evaluate_unscaled(&self, op: &OperatingPoint, out: &mut [f64]) {
         let auto = self.auto.sample(op.state, op.input_speed, op.input_torque, 0.0);
         let cs = self.circuit.sample(op.state, op.input_speed, &auto);
         self.evaluate_load_independent(op, None, &cs, out);
@@ -246,6 +255,18 @@ impl LossScene {
         if terms.key != Some((op.state, op.input_speed.to_bits(), op.input_torque.to_bits())) {
             return self.evaluate(op, out);
         }
+        self.evaluate_cached_unscaled(op, terms, out);
+        self.scale(out);
+    }
+
+    /// Apply the items' multipliers.
+    fn scale(&self, out: &mut [f64]) {
+        if let Some(f) = &self.factor {
+            out.iter_mut().zip(f).for_each(|(q, m)| *q *= m);
+        }
+    }
+
+    fn evaluate_cached_unscaled(&self, op: &OperatingPoint, terms: &SampleTerms, out: &mut [f64]) {
         let cs = &terms.circuit;
         self.evaluate_load_independent(op, Some(&terms.churn), cs, out);
         let flow = |c| self.circuit.flow(c, cs, op.oil.rho).0;
@@ -295,6 +316,20 @@ impl LossScene {
             .iter()
             .zip(&st.churn_speed)
             .flat_map(move |(e, k)| e.models.iter().map(move |(m, _)| (e.item, m, k * input_speed)))
+    }
+
+    /// Every churning item with its gear's pitch-line speed (m/s) at `input_speed` (rad/s) in
+    /// `state` (range warnings).
+    pub fn churning_pitch_speeds(
+        &self,
+        state: usize,
+        input_speed: f64,
+    ) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let st = &self.states[state];
+        self.churn
+            .iter()
+            .zip(&st.churn_speed)
+            .map(move |(e, k)| (e.item, k * input_speed * e.pitch_radius))
     }
 
     /// Mass flow (kg/s) of every circuit consumer at `op` into `mdot`, and its temperature
@@ -384,4 +419,43 @@ impl LossScene {
             out[e.item] = e.multiplicity * e.model.power(w1, rho);
         }
     }
+}
+
+/// Each item's multiplier from `[losses] multiplier` (sources, then items), or None when none
+/// is given; an item name that matches no item is an error naming the items of that source.
+fn multipliers(
+    given: &[(crate::model::source::Source, Option<String>, f64)],
+    items: &[LossItem],
+) -> Result<Option<Vec<f64>>, SceneError> {
+    if given.is_empty() {
+        return Ok(None);
+    }
+    let mut f = vec![1.0; items.len()];
+    for (source, _, m) in given.iter().filter(|g| g.1.is_none()) {
+        f.iter_mut()
+            .zip(items)
+            .filter(|(_, it)| it.source == *source)
+            .for_each(|(x, _)| *x *= m);
+    }
+    for (source, item, m) in given {
+        let Some(name) = item else { continue };
+        let k = items
+            .iter()
+            .position(|it| it.source == *source && it.name == *name)
+            .ok_or_else(|| SceneError {
+                what: format!("losses.multiplier.\"{}:{name}\"", source.as_str()),
+                why: format!(
+                    "no {} item named {name} (items: {})",
+                    source.as_str(),
+                    items
+                        .iter()
+                        .filter(|it| it.source == *source)
+                        .map(|it| it.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            })?;
+        f[k] *= m;
+    }
+    Ok(Some(f))
 }

@@ -6,6 +6,7 @@ pub mod equations;
 pub mod equilibrium;
 pub mod rosenbrock;
 pub mod rows;
+pub mod sensitivity;
 pub mod sparse_lu;
 pub mod steady;
 pub mod sweep;

@@ -28,6 +28,7 @@ from . import _native
 from ._native import GearthermError, InputError, ModelError, SolveError
 
 __all__ = [
+    "CalibrationResult",
     "Model",
     "RunResult",
     "study",
@@ -102,6 +103,52 @@ class RunResult:
             f"RunResult({s.get('model')!r} over {s.get('cycle')!r}: "
             f"{s['energy_lost_j']['total'] / 1e3:.1f} kJ lost)"
         )
+
+
+# --- calibrate -------------------------------------------------------------------------------
+class CalibrationResult:
+    """A calibration (``Model.calibrate``): ``summary`` (dict, ``calibration.json``),
+    ``parameters`` (DataFrame: key path, start, fitted value, bounds, 95 % interval),
+    ``correlation`` (DataFrame, parameters × parameters), ``errors`` (DataFrame: per measured
+    channel RMSE, largest error and bias on the fitted and the held-out rows, K), ``fit``
+    (DataFrame, ``fit.csv``: measured, simulated, residual at every row), ``warnings`` (list),
+    ``calibrated_text`` (the model text with the fitted values written in) and ``calibrated``
+    (that text as a :class:`Model`)."""
+
+    def __init__(self, summary_json: str, fit_csv: str, calibrated_text: str, cycle_csv: str):
+        import pandas as pd
+
+        self._args = (summary_json, fit_csv, calibrated_text, cycle_csv)
+        self.summary: Dict[str, Any] = json.loads(summary_json)
+        self.parameters = pd.DataFrame(self.summary["parameters"])
+        c = self.summary["correlation"]
+        self.correlation = pd.DataFrame(
+            [[math.nan if x is None else x for x in row] for row in c["matrix"]],
+            index=c["parameters"],
+            columns=c["parameters"],
+        )
+        rows = []
+        for ch in self.summary["channels"]:
+            for part in ("fitted", "holdout"):
+                e = ch[part]
+                if e is not None:
+                    rows.append({"node": ch["node"], "rows_of": part, **e})
+        self.errors = pd.DataFrame(rows)
+        self.fit = _frame(fit_csv)
+        self.warnings: List[str] = list(self.summary["warnings"])
+        self.calibrated_text = calibrated_text
+        self.cycle_csv = cycle_csv
+
+    @property
+    def calibrated(self) -> "Model":
+        return Model.from_text(self.calibrated_text, "calibrated.toml")
+
+    def __reduce__(self):
+        return (CalibrationResult, self._args)
+
+    def __repr__(self) -> str:
+        return f"CalibrationResult({len(self.summary['parameters'])} parameter(s), σ = {self.summary['fit']['sigma_k']:.3g} K)"
+# --- end calibrate ---------------------------------------------------------------------------
 
 
 class Model:
@@ -183,6 +230,32 @@ class Model:
         }
         return _frame(self._m.map(o))
 
+    def rating(
+        self,
+        gear: str,
+        speed_rpm: Union[float, Sequence[float]],
+        oil_limit_c: float,
+        vehicle_speed_kmh: float = 0.0,
+        ambient_c: Optional[float] = None,
+        torque_min_nm: float = 0.0,
+        torque_max_nm: Optional[float] = None,
+    ) -> Dict[str, Any]:
+        """Thermal rating, as ``geartherm rating``: at each input speed the highest input torque
+        whose equilibrium oil temperature stays at or below ``oil_limit_c`` (the ``rating.json``
+        document as a dict: ``points`` with ``rated_torque_nm``, ``rated_power_w``, ``status``, the
+        equilibrium at that torque)."""
+        speeds = [float(speed_rpm)] if isinstance(speed_rpm, (int, float)) else [float(s) for s in speed_rpm]
+        o = {
+            "gear": str(gear),
+            "speed_rpm": speeds,
+            "oil_limit_c": float(oil_limit_c),
+            "vehicle_speed_kmh": float(vehicle_speed_kmh),
+            "ambient_c": None if ambient_c is None else float(ambient_c),
+            "torque_min_nm": float(torque_min_nm),
+            "torque_max_nm": None if torque_max_nm is None else float(torque_max_nm),
+        }
+        return json.loads(self._m.rating(o))
+
     def run(
         self,
         cycle: str = "wltc",
@@ -212,6 +285,42 @@ class Model:
         o["ambient_c"] = ambient_c
         summary, csv = self._m.run(o)
         return RunResult(summary, csv)
+
+    # --- calibrate ---------------------------------------------------------------------------
+    def calibrate(
+        self,
+        trace,
+        fit: Sequence[str] = (),
+        holdout: Optional[Sequence[Any]] = None,
+        *,
+        rtol: Optional[float] = None,
+        atol: Optional[float] = None,
+        max_steps: Optional[int] = None,
+        max_iterations: Optional[int] = None,
+        initial_from_trace: bool = True,
+        name: str = "trace",
+    ) -> "CalibrationResult":
+        """Fit parameters (``fit``: key paths, ``"KEYPATH=LO:HI"`` with bounds) to a measured
+        trace, as ``geartherm calibrate``. ``trace``: a DataFrame (or a CSV file path) with the
+        cycle's columns (``time_s`` and ``speed_kmh`` or ``input_speed_rpm``,
+        ``input_torque_nm``, ``gear``), ``boundary:NAME`` and ``node:NAME`` temperature columns
+        in °C; ``holdout``: time windows ``(t0, t1)`` in s (or ``"t0:t1"``) predicted, not
+        fitted."""
+        if isinstance(trace, (str, os.PathLike)):
+            name = os.fspath(trace)
+            with open(name, encoding="utf-8") as fh:
+                text = fh.read()
+        else:
+            text = trace.to_csv(index=False)
+        windows = []
+        for h in holdout or ():
+            windows.append(h if isinstance(h, str) else f"{float(h[0])!r}:{float(h[1])!r}")
+        o: Dict[str, Any] = {"fit": [str(f) for f in fit], "holdout": windows, "initial_from_trace": bool(initial_from_trace)}
+        for k, v in (("rtol", rtol), ("atol", atol), ("max_steps", max_steps), ("max_iterations", max_iterations)):
+            if v is not None:
+                o[k] = v
+        return CalibrationResult(*self._m.calibrate(text, name, o))
+    # --- end calibrate -----------------------------------------------------------------------
 
     def __reduce__(self):
         return (Model, (self._m,))

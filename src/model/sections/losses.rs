@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::model::choice::choice;
 use crate::model::problems::Problems;
+use crate::model::source::Source;
 use crate::physics::losses::churning::{
     changenet::ChangenetParams, seetharaman::CavityTerm, ChurningConfig, ChurningModel,
 };
@@ -253,6 +254,9 @@ pub struct LossesSpec {
     /// Changenet–Velex high-Re law [factor, exp(h/D), exp(V0/D³), exp(Fr), exp(b/D)] \[recalled\].
     #[serde(default)]
     pub changenet_high: Option<[f64; 5]>,
+    /// Loss multipliers: a source (`churning = 1.3`) or one item (`"bearing:hss_a" = 0.8`).
+    #[serde(default)]
+    pub multiplier: Option<std::collections::BTreeMap<String, f64>>,
 }
 
 impl ContactLineLoadChoice {
@@ -342,6 +346,9 @@ pub struct LossModels {
     pub sliding: SlidingChoice,
     /// Windage of gears above the oil (None: off).
     pub windage: Option<ChurningModel>,
+    /// Loss multipliers `[losses] multiplier`: (source, None) for a source, (source, Some(item))
+    /// for one item; each multiplies the item's loss (default 1).
+    pub multipliers: Vec<(Source, Option<String>, f64)>,
 }
 
 /// Default discharge coefficient of pocketing (physics.md §6: 0.6–0.7).
@@ -360,6 +367,7 @@ pub fn validate_losses(
     let churning = churning(l, sump_volume_l, problems);
     let pocketing = pocketing(l, problems);
     let sliding = sliding(l, oil_lubricant_factor, problems);
+    let multipliers = multipliers(l, problems);
     if problems.len() > start {
         return None;
     }
@@ -373,7 +381,38 @@ pub fn validate_losses(
         pocketing,
         sliding,
         windage,
+        multipliers,
     })
+}
+
+/// Largest loss multiplier.
+pub const MAX_MULTIPLIER: f64 = 100.0;
+
+/// `[losses] multiplier = { SOURCE = m, "SOURCE:ITEM" = m }`: each m in (0, 100]; the item
+/// names are checked when the scene is compiled (they depend on what reaches the oil).
+fn multipliers(l: &LossesSpec, problems: &mut Problems) -> Vec<(Source, Option<String>, f64)> {
+    let mut out = Vec::new();
+    for (key, &m) in l.multiplier.iter().flatten() {
+        let path = format!("losses.multiplier.\"{key}\"");
+        let (src, item) = match key.split_once(':') {
+            Some((s, i)) => (s, Some(i.to_string())),
+            None => (key.as_str(), None),
+        };
+        let Some(source) = Source::parse(src) else {
+            problems.push(
+                path,
+                key,
+                format!("must name a source ({}) or SOURCE:ITEM", Source::names()),
+            );
+            continue;
+        };
+        if !(m.is_finite() && m > 0.0 && m <= MAX_MULTIPLIER) {
+            problems.push(path, m, format!("must lie in (0, {MAX_MULTIPLIER}]"));
+            continue;
+        }
+        out.push((source, item, m));
+    }
+    out
 }
 
 /// The churning model with its coefficients (None: churning off).

@@ -1,0 +1,104 @@
+//! `geartherm calibrate`: fit model parameters to a measured temperature trace; writes
+//! `calibration.json`, `fit.csv`, `calibrated.toml`, `cycle.csv` and `calibration.png`.
+
+use std::path::PathBuf;
+
+use geartherm::job::calibrate::{self, CalibrateOptions, Trace};
+use geartherm::report::calibration::to_text;
+use geartherm::report::files::OutputDir;
+
+use super::output::{emit, emit_json, invalid, io_failure, warn};
+use super::{Failure, ModelSource};
+
+/// Arguments of `calibrate`.
+#[derive(clap::Args, Debug)]
+pub struct CalibrateArgs {
+    #[command(flatten)]
+    pub source: ModelSource,
+    /// Trace CSV: a cycle's columns (time_s and speed_kmh[,gear], or input_speed_rpm,
+    /// input_torque_nm,gear), boundary:NAME and node:NAME temperature columns in °C.
+    #[arg(long)]
+    pub trace: PathBuf,
+    /// A parameter to fit, by key path, with optional bounds: KEYPATH[=LO:HI] (repeatable;
+    /// positive values are fitted on a log scale). Without --fit the model is only compared.
+    #[arg(long, value_name = "KEYPATH[=LO:HI]")]
+    pub fit: Vec<String>,
+    /// A time window T0:T1 (s) whose rows are predicted, not fitted (repeatable).
+    #[arg(long, value_name = "T0:T1")]
+    pub holdout: Vec<String>,
+    /// Output directory (default: runs/<model>_calibration).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Relative tolerance of the integrations (1e-14 … 0.1).
+    #[arg(long, default_value_t = calibrate::DEFAULT_RTOL)]
+    pub rtol: f64,
+    /// Absolute tolerance, K (1e-14 … 1).
+    #[arg(long, default_value_t = geartherm::job::run::DEFAULT_ATOL)]
+    pub atol: f64,
+    /// Step budget of one integration.
+    #[arg(long, default_value_t = geartherm::job::run::DEFAULT_MAX_STEPS)]
+    pub max_steps: usize,
+    /// Most evaluations with sensitivities (1 … 1000).
+    #[arg(long, default_value_t = calibrate::DEFAULT_MAX_ITERATIONS)]
+    pub max_iterations: usize,
+    /// Start from the model's initial temperatures instead of the trace's first row.
+    #[arg(long)]
+    pub keep_initial: bool,
+    /// Print calibration.json on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl CalibrateArgs {
+    /// The job's options.
+    pub fn options(&self) -> CalibrateOptions {
+        CalibrateOptions {
+            trace: self.trace.display().to_string(),
+            fit: self.fit.clone(),
+            holdout: self.holdout.clone(),
+            rtol: self.rtol,
+            atol: self.atol,
+            max_steps: self.max_steps,
+            max_iterations: self.max_iterations,
+            initial_from_trace: !self.keep_initial,
+        }
+    }
+}
+
+/// Check the model, the trace and the options (exit 1 before anything is touched), lock the
+/// output directory, fit, write, render, print, commit.
+pub fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
+    let m = args.source.load()?;
+    let text = std::fs::read_to_string(&args.source.model)
+        .map_err(|e| io_failure(format!("{}: {e}", args.source.model.display())))?;
+    let trace = Trace::load(&args.trace)
+        .map_err(|e| io_failure(format!("{}: {e}", args.trace.display())))?
+        .map_err(|e| invalid(e.to_string()))?;
+    let o = args.options();
+    let prepared = calibrate::prepare(&m, &text, &trace, &o)?;
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("runs").join(format!("{}_calibration", m.stem())));
+    let out = OutputDir::begin(&dir)?;
+    let result = calibrate::fit(&m, &prepared, &o)?;
+    for (name, bytes) in result.files()? {
+        out.write(name, &bytes)?;
+    }
+    geartherm::report::plots::calibration::render_calibration(out.path())
+        .map_err(|e| io_failure(format!("calibration.png: {e}")))?;
+    for w in &result.summary.warnings {
+        warn(w);
+    }
+    if args.json {
+        emit_json(&result.summary)?;
+    } else {
+        emit(&format!(
+            "{}outputs in {}\n",
+            to_text(&result.summary),
+            out.target().display()
+        ))?;
+    }
+    out.commit()?;
+    Ok(())
+}

@@ -1,0 +1,578 @@
+//! `calibrate`: fit model parameters (key paths with bounds) to a measured temperature trace by
+//! least squares, with the Jacobian from the forward sensitivities of the integration
+//! ([`crate::solve::sensitivity`]), and report the fitted values with 95 % intervals, their
+//! correlations, the errors per channel on the fitted and the held-out rows, and the model file
+//! with the fitted values written in (docs/calibration.md).
+//!
+//! - [`trace`]: the trace reader (line and column of every problem);
+//! - [`params`]: `KEYPATH[=LO:HI]`, the fitted coordinate (ln p or p), the overrides;
+//! - [`problem`]: the trace mapped onto the model, the simulation at a parameter point;
+//! - [`lm`]: Levenberg–Marquardt with box bounds;
+//! - [`stats`]: covariance, t quantile, correlations;
+//! - [`model_file`]: the calibrated model text.
+
+pub mod lm;
+pub mod model_file;
+pub mod params;
+pub mod problem;
+pub mod stats;
+pub mod trace;
+
+use std::time::Instant;
+
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+use crate::model::overrides;
+use crate::model::parse::parse_document;
+use crate::model::Problems;
+use crate::report::calibration::{
+    fit_csv, CalibrationSummary, ChannelErrors, Correlation, Errors, FitStats, FittedParameter,
+};
+use crate::solve::sensitivity::SensitivityOptions;
+
+use super::limits::{self, Limit};
+use super::{JobError, Model};
+use lm::{Evaluation, LmOptions};
+use params::{FitSpec, Parameter};
+use problem::{initial_overrides, Problem};
+pub use trace::Trace;
+
+/// Default relative tolerance of a calibration's integrations (that of `run`: the fit and its
+/// sensitivities are those of the discrete solution `run` computes).
+pub const DEFAULT_RTOL: f64 = crate::solve::transient::DEFAULT_RTOL;
+/// Default most evaluations with sensitivities.
+pub const DEFAULT_MAX_ITERATIONS: usize = 30;
+/// A parameter that moves no fitted temperature by more than this per unit of its coordinate
+/// (a factor e on a log scale, 1 K on a temperature) has no influence, K.
+pub const MIN_INFLUENCE_K: f64 = 1e-6;
+/// Correlation above which two parameters are reported as not told apart by the trace.
+pub const CORRELATION_WARNING: f64 = 0.95;
+
+/// Most evaluations with sensitivities.
+pub const MAX_ITERATIONS: Limit = Limit {
+    name: "max_iterations",
+    flag: "--max-iterations",
+    lo: 1.0,
+    hi: 1000.0,
+    unit: "",
+};
+
+/// Options of a calibration (`geartherm calibrate`, `Model.calibrate` in Python).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CalibrateOptions {
+    /// Trace file (the CLI) or the name given to trace text (Python).
+    pub trace: String,
+    /// Parameters: `KEYPATH[=LO:HI]`.
+    pub fit: Vec<String>,
+    /// Held-out time windows `T0:T1`, s (their rows are predicted, not fitted).
+    pub holdout: Vec<String>,
+    /// Relative tolerance of the integrations.
+    pub rtol: f64,
+    /// Absolute tolerance, K.
+    pub atol: f64,
+    /// Step budget of one integration.
+    pub max_steps: usize,
+    /// Most evaluations with sensitivities.
+    pub max_iterations: usize,
+    /// Start every measured node at its first measured value and the others at their mean
+    /// (else at the model's initial temperatures).
+    pub initial_from_trace: bool,
+}
+
+impl Default for CalibrateOptions {
+    fn default() -> Self {
+        CalibrateOptions {
+            trace: String::new(),
+            fit: Vec::new(),
+            holdout: Vec::new(),
+            rtol: DEFAULT_RTOL,
+            atol: crate::solve::transient::DEFAULT_ATOL,
+            max_steps: super::run::DEFAULT_MAX_STEPS,
+            max_iterations: DEFAULT_MAX_ITERATIONS,
+            initial_from_trace: true,
+        }
+    }
+}
+
+/// Parse one holdout window `T0:T1` (s).
+fn window(s: &str) -> Result<(f64, f64), JobError> {
+    let bad = || {
+        JobError::option(
+            "holdout",
+            s,
+            "T0:T1 in s, T0 < T1",
+            format!("holdout (--holdout) = {s}: must be T0:T1, two finite times in s with T0 < T1"),
+        )
+    };
+    let (a, b) = s.split_once(':').ok_or_else(bad)?;
+    let (a, b): (f64, f64) = (
+        a.trim().parse().map_err(|_| bad())?,
+        b.trim().parse().map_err(|_| bad())?,
+    );
+    if a.is_finite() && b.is_finite() && a < b {
+        Ok((a, b))
+    } else {
+        Err(bad())
+    }
+}
+
+/// The parsed `--fit` specs and `--holdout` windows (s).
+pub type Checked = (Vec<FitSpec>, Vec<(f64, f64)>);
+
+impl CalibrateOptions {
+    /// Range checks; the parsed fit specs and holdout windows.
+    pub fn check(&self) -> Result<Checked, JobError> {
+        limits::RTOL.check(self.rtol)?;
+        limits::ATOL.check(self.atol)?;
+        limits::MAX_STEPS.check(self.max_steps as f64)?;
+        MAX_ITERATIONS.check(self.max_iterations as f64)?;
+        let mut specs: Vec<FitSpec> = Vec::with_capacity(self.fit.len());
+        for f in &self.fit {
+            let s: FitSpec = f
+                .parse()
+                .map_err(|e: String| JobError::option("fit", f, "KEYPATH[=LO:HI]", e))?;
+            if specs.iter().any(|x| x.path == s.path) {
+                let msg = format!("fit (--fit) = {f}: {} is fitted twice", s.path);
+                return Err(JobError::option("fit", f, "each key path once", msg));
+            }
+            specs.push(s);
+        }
+        let windows = self
+            .holdout
+            .iter()
+            .map(|h| window(h))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok((specs, windows))
+    }
+}
+
+/// A finished calibration.
+#[derive(Debug, Clone)]
+pub struct CalibrateResult {
+    /// `calibration.json`.
+    pub summary: CalibrationSummary,
+    /// `fit.csv`.
+    pub fit_csv: String,
+    /// `calibrated.toml`: the model text with the fitted values, the trace's initial
+    /// temperatures and boundary series written in.
+    pub calibrated_model: String,
+    /// `cycle.csv`: the trace's input columns (`geartherm run calibrated.toml --cycle cycle.csv`
+    /// reproduces the fitted trajectory).
+    pub cycle_csv: String,
+}
+
+impl CalibrateResult {
+    /// The files of the output directory.
+    pub fn files(&self) -> Result<Vec<(&'static str, Vec<u8>)>, JobError> {
+        let json = serde_json::to_vec_pretty(&self.summary)
+            .map_err(|e| JobError::numerical(format!("cannot serialise the calibration: {e}")))?;
+        Ok(vec![
+            ("calibration.json", json),
+            ("fit.csv", self.fit_csv.clone().into_bytes()),
+            ("calibrated.toml", self.calibrated_model.clone().into_bytes()),
+            ("cycle.csv", self.cycle_csv.clone().into_bytes()),
+        ])
+    }
+}
+
+/// The model document with the base overrides applied (for the parameters' start values).
+fn document(m: &Model, text: &str, base: &[crate::model::Override]) -> Result<toml::Table, JobError> {
+    let mut problems = Problems::default();
+    let mut doc = parse_document(text, &mut problems)
+        .ok_or_else(|| JobError::invalid(format!("{}: the model text does not parse", m.label())))?;
+    for ov in base {
+        overrides::apply(&mut doc, ov).map_err(|e| JobError::invalid(format!("{}: {e}", m.label())))?;
+    }
+    Ok(doc)
+}
+
+/// A checked, mapped calibration problem, ready to fit.
+pub struct Prepared<'a> {
+    /// The problem.
+    pub problem: Problem<'a>,
+    /// Held-out windows, s.
+    pub windows: Vec<(f64, f64)>,
+    /// Per trace row: held out.
+    pub held: Vec<bool>,
+}
+
+/// Check the options and map the trace onto the model: every invalid input fails here.
+pub fn prepare<'a>(
+    m: &Model,
+    text: &'a str,
+    trace: &'a Trace,
+    o: &CalibrateOptions,
+) -> Result<Prepared<'a>, JobError> {
+    let (specs, windows) = o.check()?;
+    problem::check_names(m, trace)?;
+    let mut base = m.overrides.clone();
+    if o.initial_from_trace {
+        base.extend(initial_overrides(trace));
+    }
+    let doc = document(m, text, &base)?;
+    let params = specs
+        .iter()
+        .map(|s| {
+            Parameter::resolve(s, &doc)
+                .map_err(|e| JobError::option("fit", s.to_string(), "a number in the model", e))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let opts = SensitivityOptions {
+        rtol: o.rtol,
+        atol: o.atol,
+        max_steps: o.max_steps,
+        initial: None,
+    };
+    let problem = Problem::new(m, text, trace, params, base, opts)?;
+    let held: Vec<bool> = trace
+        .times
+        .iter()
+        .map(|t| windows.iter().any(|(a, b)| (a..=b).contains(&t)))
+        .collect();
+    let fitted = held.iter().filter(|h| !**h).count() * trace.measured.len();
+    if !problem.params.is_empty() && fitted <= problem.params.len() {
+        return Err(JobError::invalid(format!(
+            "{}: {fitted} fitted values (rows outside --holdout × measured columns) for {} parameters: \
+             a fit needs more values than parameters",
+            trace.source,
+            problem.params.len()
+        )));
+    }
+    // The model at the start point must check (bounds written into the file are checked there).
+    problem.gearbox_at(&start(&problem.params))?;
+    Ok(Prepared {
+        problem,
+        windows,
+        held,
+    })
+}
+
+fn start(params: &[Parameter]) -> Vec<f64> {
+    params.iter().map(|p| p.theta(p.start)).collect()
+}
+
+/// Residuals (simulated − measured, K) and their Jacobian over the fitted rows.
+fn evaluate(p: &Prepared<'_>, theta: &[f64]) -> Result<Evaluation, JobError> {
+    let pr = &p.problem;
+    let sim = pr.simulate(theta, true)?;
+    let (nc, np) = (pr.channels.len(), pr.params.len());
+    let rows: Vec<usize> = (0..p.held.len()).filter(|&r| !p.held[r]).collect();
+    let m = rows.len() * nc;
+    let mut r = DVector::zeros(m);
+    let mut j = DMatrix::zeros(m, np);
+    for (i, &row) in rows.iter().enumerate() {
+        for c in 0..nc {
+            let k = i * nc + c;
+            r[k] = sim.temps_c[row][c] - pr.trace.measured[c].values_c[row];
+            for q in 0..np {
+                j[(k, q)] = sim.sens[row][c * np + q];
+            }
+        }
+    }
+    Ok(Evaluation { r, j })
+}
+
+/// Calibrate: fit the parameters of `o.fit` to the trace. `text` is the model file's text (`m`
+/// is it checked with its overrides).
+pub fn calibrate(
+    m: &Model,
+    text: &str,
+    trace: &Trace,
+    o: &CalibrateOptions,
+) -> Result<CalibrateResult, JobError> {
+    let p = prepare(m, text, trace, o)?;
+    fit(m, &p, o)
+}
+
+/// Fit a prepared problem and assemble the result (the second half of [`calibrate`]).
+pub fn fit(m: &Model, p: &Prepared<'_>, o: &CalibrateOptions) -> Result<CalibrateResult, JobError> {
+    let clock = Instant::now();
+    let pr = &p.problem;
+    let theta0 = start(&pr.params);
+    let at0 = evaluate(p, &theta0)?;
+    let influence: Vec<f64> = (0..pr.params.len())
+        .map(|k| at0.j.column(k).iter().fold(0.0, |a: f64, x| a.max(x.abs())))
+        .collect();
+    let free: Vec<bool> = influence.iter().map(|&x| x > MIN_INFLUENCE_K).collect();
+    let bounds: Vec<(f64, f64)> = pr.params.iter().map(Parameter::theta_bounds).collect();
+    let lmo = LmOptions {
+        max_iterations: o.max_iterations,
+        ..LmOptions::default()
+    };
+    let res = lm::minimise(|th| evaluate(p, th), &theta0, at0, &bounds, &free, &lmo)?;
+    let wall = clock.elapsed().as_secs_f64();
+    assemble(m, p, o, &res, &influence, &free, wall)
+}
+
+/// A fitted coordinate within 1e-6 of the bounds' width of a bound.
+fn at_bound(theta: f64, (lo, hi): (f64, f64)) -> bool {
+    let w = 1e-6 * (hi - lo);
+    theta <= lo + w || theta >= hi - w
+}
+
+/// The parameters with their intervals, and the warnings about them.
+fn parameters(
+    pr: &Problem<'_>,
+    res: &lm::LmResult,
+    influence: &[f64],
+    identifiable: &[bool],
+    lin: &stats::Linearised,
+    t: f64,
+    warnings: &mut Vec<String>,
+) -> Vec<FittedParameter> {
+    let mut out = Vec::with_capacity(pr.params.len());
+    for (k, par) in pr.params.iter().enumerate() {
+        let th = res.theta[k];
+        if influence[k] <= MIN_INFLUENCE_K {
+            warnings.push(format!(
+                "{}: the trace does not influence this parameter (no fitted temperature moves by more than \
+                 {MIN_INFLUENCE_K:e} K): left at {}, not identifiable",
+                par.name(),
+                par.start
+            ));
+        } else if !identifiable[k] {
+            warnings.push(format!(
+                "{}: at its bound ({}): no interval; widen the bounds or fix the parameter",
+                par.name(),
+                par.value(th)
+            ));
+        }
+        let se = lin.std_err[k];
+        out.push(FittedParameter {
+            key_path: par.name(),
+            start: par.start,
+            value: par.value(th),
+            lower_bound: par.lo,
+            upper_bound: par.hi,
+            scale: if par.log { "log" } else { "linear" },
+            std_error: se,
+            ci95_low: se.map(|s| par.value(th - t * s)),
+            ci95_high: se.map(|s| par.value(th + t * s)),
+            influence_k: influence[k],
+        });
+    }
+    out
+}
+
+fn correlation(pr: &Problem<'_>, lin: &stats::Linearised, warnings: &mut Vec<String>) -> Correlation {
+    let names: Vec<String> = pr.params.iter().map(Parameter::name).collect();
+    let np = names.len();
+    for a in 0..np {
+        for b in a + 1..np {
+            let r = lin.correlation[a][b];
+            if r.is_finite() && r.abs() > CORRELATION_WARNING {
+                warnings.push(format!(
+                    "{} and {}: correlation {r:.3}: the trace cannot tell them apart (fit one, fix the other, \
+                     or add a trace that separates them)",
+                    names[a], names[b]
+                ));
+            }
+        }
+    }
+    let matrix = lin
+        .correlation
+        .iter()
+        .map(|row| row.iter().map(|&x| x.is_finite().then_some(x)).collect())
+        .collect();
+    Correlation {
+        parameters: names,
+        matrix,
+    }
+}
+
+/// Errors per channel on the fitted and the held-out rows.
+fn channel_errors(p: &Prepared<'_>, temps_c: &[Vec<f64>]) -> Vec<ChannelErrors> {
+    let pr = &p.problem;
+    pr.trace
+        .measured
+        .iter()
+        .enumerate()
+        .map(|(c, ch)| {
+            let res = |held: bool| -> Vec<f64> {
+                (0..p.held.len())
+                    .filter(|&r| p.held[r] == held)
+                    .map(|r| temps_c[r][c] - ch.values_c[r])
+                    .collect()
+            };
+            ChannelErrors {
+                column: ch.column.clone(),
+                node: ch.name.clone(),
+                fitted: Errors::of(&res(false)),
+                holdout: Errors::of(&res(true)),
+            }
+        })
+        .collect()
+}
+
+/// The cycle columns of the trace as a cycle file.
+fn cycle_csv(trace: &Trace) -> String {
+    use crate::cycle::parse::{KMH, RPM};
+    use crate::cycle::CycleKind;
+    let c = &trace.cycle;
+    let mut s = match (c.kind, c.has_gear) {
+        (CycleKind::Rig, _) => String::from("time_s,input_speed_rpm,input_torque_nm,gear\n"),
+        (CycleKind::Vehicle, true) => String::from("time_s,speed_kmh,gear\n"),
+        (CycleKind::Vehicle, false) => String::from("time_s,speed_kmh\n"),
+    };
+    for r in &c.rows {
+        let gear = r.gear.as_deref().unwrap_or("");
+        match (c.kind, c.has_gear) {
+            (CycleKind::Rig, _) => s.push_str(&format!(
+                "{},{},{},{gear}\n",
+                r.time,
+                r.input_speed / RPM,
+                r.input_torque
+            )),
+            (CycleKind::Vehicle, true) => {
+                s.push_str(&format!("{},{},{gear}\n", r.time, r.vehicle_speed / KMH))
+            }
+            (CycleKind::Vehicle, false) => s.push_str(&format!("{},{}\n", r.time, r.vehicle_speed / KMH)),
+        }
+    }
+    s
+}
+
+fn assemble(
+    m: &Model,
+    p: &Prepared<'_>,
+    o: &CalibrateOptions,
+    res: &lm::LmResult,
+    influence: &[f64],
+    free: &[bool],
+    wall: f64,
+) -> Result<CalibrateResult, JobError> {
+    let pr = &p.problem;
+    let bounds: Vec<(f64, f64)> = pr.params.iter().map(Parameter::theta_bounds).collect();
+    let identifiable: Vec<bool> = (0..free.len())
+        .map(|k| free[k] && !at_bound(res.theta[k], bounds[k]))
+        .collect();
+    let ssr = res.at.r.norm_squared();
+    let lin = stats::linearised(&res.at.j, ssr, &identifiable);
+    let t = stats::t975(lin.dof);
+    let mut warnings = Vec::new();
+    let parameters = parameters(pr, res, influence, &identifiable, &lin, t, &mut warnings);
+    let correlation = correlation(pr, &lin, &mut warnings);
+    if res.stop == lm::Stop::Budget {
+        warnings.push(format!(
+            "the fit stopped after {} evaluations (max_iterations) before converging",
+            res.evaluations
+        ));
+    }
+    let sim = pr.simulate(&res.theta, false)?;
+    let channels = channel_errors(p, &sim.temps_c);
+    let nodes: Vec<String> = pr.trace.measured.iter().map(|c| c.name.clone()).collect();
+    let measured: Vec<Vec<f64>> = pr.trace.measured.iter().map(|c| c.values_c.clone()).collect();
+    let csv = fit_csv(&pr.trace.times, &p.held, &nodes, &measured, &sim.temps_c);
+    let series: Vec<(String, Vec<(f64, f64)>)> = pr
+        .trace
+        .boundaries
+        .iter()
+        .map(|c| {
+            (
+                c.name.clone(),
+                pr.trace
+                    .times
+                    .iter()
+                    .copied()
+                    .zip(c.values_c.iter().copied())
+                    .collect(),
+            )
+        })
+        .collect();
+    let calibrated = model_file::calibrated_text(pr.text, &pr.overrides_at(&res.theta), &series)
+        .map_err(|e| JobError::invalid(format!("{}: {e}", m.label())))?;
+    let summary = CalibrationSummary {
+        model: m.gearbox.name.clone(),
+        trace: pr.trace.source.clone(),
+        rows: pr.trace.len(),
+        holdout_s: p.windows.clone(),
+        parameters,
+        correlation,
+        channels,
+        fit: FitStats {
+            evaluations: res.evaluations,
+            iterations: res.iterations,
+            stop: serde_json::to_value(res.stop)
+                .ok()
+                .and_then(|v| v.as_str().map(String::from))
+                .unwrap_or_default(),
+            sigma_k: lin.sigma2.sqrt(),
+            dof: lin.dof,
+            t975: t,
+            rtol: o.rtol,
+            atol: o.atol,
+            wall_time_s: wall,
+        },
+        warnings,
+    };
+    check_finite(&summary)?;
+    Ok(CalibrateResult {
+        summary,
+        fit_csv: csv,
+        calibrated_model: calibrated,
+        cycle_csv: cycle_csv(pr.trace),
+    })
+}
+
+/// No NaN reaches a file: every number of the summary must be finite.
+fn check_finite(s: &CalibrationSummary) -> Result<(), JobError> {
+    let bad = |what: &str| {
+        JobError::numerical(format!(
+            "calibration of {} on {}: {what} is not finite",
+            s.model, s.trace
+        ))
+    };
+    for p in &s.parameters {
+        let vals = [
+            Some(p.value),
+            p.std_error,
+            p.ci95_low,
+            p.ci95_high,
+            Some(p.influence_k),
+        ];
+        if vals.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(bad(&p.key_path));
+        }
+    }
+    for c in &s.channels {
+        for e in [c.fitted, c.holdout].iter().flatten() {
+            if !(e.rmse_k.is_finite() && e.max_abs_k.is_finite() && e.bias_k.is_finite()) {
+                return Err(bad(&c.column));
+            }
+        }
+    }
+    if !s.fit.sigma_k.is_finite() {
+        return Err(bad("σ"));
+    }
+    Ok(())
+}
+
+/// The limits a calibration's options are checked against.
+pub const LIMITS: [Limit; 4] = [limits::RTOL, limits::ATOL, limits::MAX_STEPS, MAX_ITERATIONS];
+
+impl super::command::ToArgs for CalibrateOptions {
+    const COMMAND: &'static str = "calibrate";
+    fn to_args(&self) -> Vec<String> {
+        let mut a = vec!["--trace".to_string(), self.trace.clone()];
+        for f in &self.fit {
+            a.extend(["--fit".to_string(), f.clone()]);
+        }
+        for h in &self.holdout {
+            a.extend(["--holdout".to_string(), h.clone()]);
+        }
+        a.extend([
+            "--rtol".into(),
+            format!("{}", self.rtol),
+            "--atol".into(),
+            format!("{}", self.atol),
+        ]);
+        a.extend(["--max-steps".into(), self.max_steps.to_string()]);
+        a.extend(["--max-iterations".into(), self.max_iterations.to_string()]);
+        if !self.initial_from_trace {
+            a.push("--keep-initial".into());
+        }
+        a
+    }
+}

@@ -1,0 +1,190 @@
+//! Outputs of a calibration: `calibration.json` (fitted values with 95 % intervals, correlation
+//! matrix, errors per channel on the fitted and the held-out rows, warnings) and `fit.csv`
+//! (measured and simulated temperatures and residuals at every trace row).
+
+use serde::Serialize;
+
+/// A fitted parameter.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FittedParameter {
+    /// Key path in the model.
+    pub key_path: String,
+    /// Value before the fit (the model's, or the mean of the bounds).
+    pub start: f64,
+    /// Fitted value.
+    pub value: f64,
+    /// Lower bound.
+    pub lower_bound: f64,
+    /// Upper bound.
+    pub upper_bound: f64,
+    /// `log` (fitted on ln p) or `linear`.
+    pub scale: &'static str,
+    /// Standard error in the fitted coordinate (ln p or p); null when not identifiable.
+    pub std_error: Option<f64>,
+    /// 95 % interval, lower end (through the coordinate: asymmetric on a log scale).
+    pub ci95_low: Option<f64>,
+    /// 95 % interval, upper end.
+    pub ci95_high: Option<f64>,
+    /// Largest change of a fitted temperature per unit of the coordinate, K.
+    pub influence_k: f64,
+}
+
+/// Errors of one measured channel on a set of rows.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Errors {
+    /// Rows.
+    pub rows: usize,
+    /// Root-mean-square of simulated − measured, K.
+    pub rmse_k: f64,
+    /// Largest |simulated − measured|, K.
+    pub max_abs_k: f64,
+    /// Mean of simulated − measured, K.
+    pub bias_k: f64,
+}
+
+impl Errors {
+    /// Errors of the residuals `r` (None when empty).
+    pub fn of(r: &[f64]) -> Option<Errors> {
+        if r.is_empty() {
+            return None;
+        }
+        let n = r.len() as f64;
+        Some(Errors {
+            rows: r.len(),
+            rmse_k: (r.iter().map(|x| x * x).sum::<f64>() / n).sqrt(),
+            max_abs_k: r.iter().fold(0.0, |m, x| m.max(x.abs())),
+            bias_k: r.iter().sum::<f64>() / n,
+        })
+    }
+}
+
+/// One measured channel.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ChannelErrors {
+    /// Trace column.
+    pub column: String,
+    /// Node.
+    pub node: String,
+    /// On the fitted rows.
+    pub fitted: Option<Errors>,
+    /// On the held-out rows.
+    pub holdout: Option<Errors>,
+}
+
+/// The correlation matrix of the fitted coordinates.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Correlation {
+    /// Parameter key paths (rows and columns).
+    pub parameters: Vec<String>,
+    /// r_ij (null where undefined: a parameter not identifiable).
+    pub matrix: Vec<Vec<Option<f64>>>,
+}
+
+/// How the fit went.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FitStats {
+    /// Evaluations with sensitivities.
+    pub evaluations: usize,
+    /// Accepted steps.
+    pub iterations: usize,
+    /// Why it stopped.
+    pub stop: String,
+    /// Residual standard deviation σ = √(SSR/(m − P)), K.
+    pub sigma_k: f64,
+    /// Degrees of freedom m − P.
+    pub dof: usize,
+    /// Student's t(0.975, dof).
+    pub t975: f64,
+    /// Relative and absolute tolerance of the integration.
+    pub rtol: f64,
+    /// Absolute tolerance, K.
+    pub atol: f64,
+    /// Wall time, s.
+    pub wall_time_s: f64,
+}
+
+/// `calibration.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CalibrationSummary {
+    /// Model name.
+    pub model: String,
+    /// Trace source.
+    pub trace: String,
+    /// Trace rows.
+    pub rows: usize,
+    /// Held-out time windows, s.
+    pub holdout_s: Vec<(f64, f64)>,
+    /// Fitted parameters.
+    pub parameters: Vec<FittedParameter>,
+    /// Their correlations.
+    pub correlation: Correlation,
+    /// Errors per measured channel.
+    pub channels: Vec<ChannelErrors>,
+    /// The fit.
+    pub fit: FitStats,
+    /// What the user should know: pairs the trace cannot tell apart, parameters without
+    /// influence or at a bound, a fit that ran out of iterations.
+    pub warnings: Vec<String>,
+}
+
+/// `fit.csv`: `time_s,holdout`, then per channel `<node>_measured_c,<node>_simulated_c,
+/// <node>_residual_k`.
+pub fn fit_csv(
+    times: &[f64],
+    holdout: &[bool],
+    nodes: &[String],
+    measured: &[Vec<f64>],
+    simulated: &[Vec<f64>],
+) -> String {
+    let mut s = String::from("time_s,holdout");
+    for n in nodes {
+        s.push_str(&format!(",{n}_measured_c,{n}_simulated_c,{n}_residual_k"));
+    }
+    s.push('\n');
+    for (r, t) in times.iter().enumerate() {
+        s.push_str(&format!("{t},{}", u8::from(holdout[r])));
+        for c in 0..nodes.len() {
+            let (m, x) = (measured[c][r], simulated[r][c]);
+            s.push_str(&format!(",{m},{x:.6},{:.6}", x - m));
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// Human-readable summary.
+pub fn to_text(s: &CalibrationSummary) -> String {
+    let mut t = format!(
+        "{} on {} ({} rows): {} evaluations, {} steps accepted, stopped on {}, σ = {:.3} K ({} dof), {:.2} s\n",
+        s.model, s.trace, s.rows, s.fit.evaluations, s.fit.iterations, s.fit.stop, s.fit.sigma_k, s.fit.dof,
+        s.fit.wall_time_s
+    );
+    if !s.parameters.is_empty() {
+        t.push_str("parameter                                   start        fitted     95 % interval\n");
+    }
+    for p in &s.parameters {
+        let ci = match (p.ci95_low, p.ci95_high) {
+            (Some(a), Some(b)) => format!("[{a:.5}, {b:.5}]"),
+            _ => "not identifiable".into(),
+        };
+        t.push_str(&format!(
+            "  {:<40} {:>10.5} {:>12.5}   {ci}\n",
+            p.key_path, p.start, p.value
+        ));
+    }
+    t.push_str("channel               fitted rmse / max, K    held-out rmse / max, K\n");
+    for c in &s.channels {
+        let e = |x: &Option<Errors>| {
+            x.map_or("—".to_string(), |e| {
+                format!("{:.3} / {:.3}", e.rmse_k, e.max_abs_k)
+            })
+        };
+        t.push_str(&format!(
+            "  {:<20} {:>22} {:>24}\n",
+            c.node,
+            e(&c.fitted),
+            e(&c.holdout)
+        ));
+    }
+    t
+}
