@@ -101,7 +101,11 @@ fn at6_has_clutch_drag_pump_and_converter_items_that_heat_the_oil() {
         ("D", w3[m("rav_carrier")].abs()),
         ("E", (w3[m("input")] - w3[m("rav_carrier")]).abs()),
     ] {
-        let pack = gb.clutch_packs.iter().find(|c| c.name == e).unwrap().pack;
+        let mut pack = gb.clutch_packs.iter().find(|c| c.name == e).unwrap().pack;
+        // the circuit feeds every AT6 pack: its flow replaces the pack's own
+        let feed = gb.circuit.consumers.iter().position(|c| c.name == format!("{e}_feed")).unwrap();
+        pack.oil_flow = scene.losses.circuit.flow(feed, &work.terms.circuit, oil.rho).0;
+        assert!(pack.oil_flow > 0.0);
         let want = pack.drag(slip * 2000.0 * RPM, oil.mu, oil.rho).power;
         assert!(
             (work.q[ix(Source::ClutchDrag, e)] - want).abs() <= 1e-12 * want.max(1.0),
@@ -308,10 +312,11 @@ fn at6_gearbox_loss_against_the_co2mpas_default_for_automatics() {
     // constants are one generic law for every automatic (fitted by the JRC; no gear, no
     // transmission design), the AT6's parts are assumed (model file); the AT6 is never adjusted
     // to this source. The band stated before the comparison, AT6/CO2MPAS within 0.5…2, holds at
-    // 21 of the 24 points; at 40 °C, 1500 rpm, 50 N·m the AT6 loses 2.0–2.3× the peer (its open
-    // packs in 40 °C oil). What this test holds is the difference as docs/validation.md states
-    // it: warm (80 °C) the AT6 loses less than the peer (0.5…0.85×), at 40 °C more (1.0…2.4×),
-    // and its loss grows far more from 80 to 40 °C than the peer's (clutch drag ∝ μ).
+    // every point. What this test holds is the difference as docs/validation.md states it: warm
+    // (80 °C) the AT6 loses less than the peer (0.5…0.85×), at 40 °C about as much or more
+    // (0.95…1.6×: its packs' lubrication follows the pump speed through the [circuit], so the
+    // open packs in 40 °C oil drag 1.0–2.0 kW), and its loss grows far more from 80 to 40 °C than
+    // the peer's (clutch drag ∝ μ).
     let (gb, scene) = scene_of("models/at6_lepelletier.toml");
     for gear in ["3", "4", "6"] {
         // rows 0..4 at 40 °C, rows 4..8 the same points at 80 °C
@@ -327,7 +332,7 @@ fn at6_gearbox_loss_against_the_co2mpas_default_for_automatics() {
                 );
             let at = format!("gear {gear}, {rpm} rpm, {tq} N·m");
             assert!((0.5..=0.85).contains(&rh), "{at}, 80 °C: {rh}");
-            assert!((1.0..=2.4).contains(&rc), "{at}, 40 °C: {rc}");
+            assert!((0.9..=1.6).contains(&rc), "{at}, 40 °C: {rc}");
             // the AT6's warm-to-cold growth exceeds the peer's, by its clutch drag
             assert!(ours_cold / ours_hot > 1.5 * peer_cold / peer_hot, "{at}");
             assert!(by_c[1] > by_c[0] + by_c[2], "{at}: drag dominates at 40 °C");

@@ -252,7 +252,7 @@ fn a_bad_choice_lists_the_allowed_names_at_its_key_path() {
         ),
         (
             "thermal.heat[0].source",
-            "must be one of: churning, pocketing, sliding, bearing, seal, clutch_drag, pump, converter",
+            "must be one of: churning, pocketing, sliding, bearing, seal, clutch_drag, pump, converter, windage, jet, fling",
         ),
         ("vehicle.overrun", "must be one of: zero, transmit"),
         ("oil.walther", "must be one of: astm_d341, c06, c08"),

@@ -25,6 +25,7 @@ pub const SECTIONS: &[&str] = &[
     "launch",
     "bearings",
     "seals",
+    "circuit",
 ];
 
 /// The whole model file.
@@ -80,4 +81,7 @@ pub struct ModelFile {
     /// `[[seals]]`.
     #[serde(default)]
     pub seals: Vec<seals::SealSpec>,
+    /// `[circuit]`: the lubrication circuit (sources and consumers).
+    #[serde(default)]
+    pub circuit: Option<circuit::CircuitSpec>,
 }

@@ -7,6 +7,7 @@ use crate::physics::kinematics::GearTrain;
 use crate::physics::oil::Oil;
 
 pub use super::sections::bearings::Bearing;
+pub use super::sections::circuit::{Circuit, Consumer, FlowSource, SourceKind, Split, Target};
 pub use super::sections::clutch_packs::ClutchPackModel;
 pub use super::sections::gear_states::GearState;
 pub use super::sections::gears::{Gear, GearMount};
@@ -75,6 +76,8 @@ pub struct Gearbox {
     pub bearings: Vec<Bearing>,
     /// Shaft seals (`[[seals]]`).
     pub seals: Vec<Seal>,
+    /// The lubrication circuit (`[circuit]`; empty without one).
+    pub circuit: Circuit,
 }
 
 impl Gearbox {

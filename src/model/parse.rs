@@ -251,6 +251,7 @@ pub fn parse_table(mut table: Table, problems: &mut Problems) -> Option<ModelFil
     let launch = section::<launch::LaunchSpec>(&mut table, "launch", false, problems);
     let bearings = array::<bearings::BearingSpec>(&mut table, "bearings", false, problems);
     let seals = array::<seals::SealSpec>(&mut table, "seals", false, problems);
+    let circuit = section::<circuit::CircuitSpec>(&mut table, "circuit", false, problems);
     if problems.len() > before || !problems.is_empty() {
         return None;
     }
@@ -273,6 +274,7 @@ pub fn parse_table(mut table: Table, problems: &mut Problems) -> Option<ModelFil
         launch,
         bearings,
         seals,
+        circuit,
     })
 }
 

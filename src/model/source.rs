@@ -27,6 +27,12 @@ pub enum Source {
     Pump,
     /// Torque-converter slip (engine side minus turbine side power).
     Converter,
+    /// Air drag of a gear running above the oil (load-independent).
+    Windage,
+    /// Impulse of a lubricating jet: bringing its oil to the pitch-line speed.
+    Jet,
+    /// Oil fed through a shaft and flung out through a rotating planet carrier.
+    Fling,
 }
 choice!(Source {
     Churning = "churning",
@@ -37,6 +43,9 @@ choice!(Source {
     ClutchDrag = "clutch_drag",
     Pump = "pump",
     Converter = "converter",
+    Windage = "windage",
+    Jet = "jet",
+    Fling = "fling",
 });
 
 /// Number of loss sources.
@@ -47,7 +56,7 @@ pub type PerSource = [f64; N_SOURCES];
 
 impl Source {
     /// Every source in output order (the order of per-source arrays and columns).
-    pub const ALL: [Source; 8] = [
+    pub const ALL: [Source; 11] = [
         Source::Churning,
         Source::Pocketing,
         Source::Sliding,
@@ -56,6 +65,9 @@ impl Source {
         Source::ClutchDrag,
         Source::Pump,
         Source::Converter,
+        Source::Windage,
+        Source::Jet,
+        Source::Fling,
     ];
 
     /// Position in per-source arrays (the order of [`Source::ALL`]).
@@ -90,7 +102,7 @@ mod tests {
             assert_eq!(s.index(), k);
             assert_eq!(Source::parse(s.as_str()), Some(s));
         }
-        assert_eq!(Source::parse("windage"), None);
+        assert_eq!(Source::parse("splash"), None);
         // The model file reads a source by the same name (heat rules `source = "…"`).
         for s in Source::ALL {
             let v: Source = serde_json::from_value(serde_json::Value::from(s.as_str())).unwrap();

@@ -81,11 +81,24 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         packs: clutch_packs.iter().map(|c| c.name.as_str()).collect(),
         pump: file.pump.is_some(),
         converter: file.launch.is_some(),
+        circuit: file.circuit.as_ref(),
     };
     let thermal = file
         .thermal
         .as_ref()
         .and_then(|spec| check_thermal(spec, &items, problems));
+    let circuit = file.circuit.as_ref().and_then(|spec| {
+        let names = circuit::CircuitNames {
+            gears: s.gears.iter().map(|g| g.name.as_str()).collect(),
+            meshes: s.meshes.iter().map(|m| m.name.as_str()).collect(),
+            sets: s.sets.iter().map(|x| x.name.as_str()).collect(),
+            packs: clutch_packs.iter().map(|c| c.name.as_str()).collect(),
+            bearings: bearings.iter().map(|b| b.name.as_str()).collect(),
+            nodes: &nodes,
+            pump: file.pump.is_some(),
+        };
+        circuit::validate_circuit(spec, &names, problems)
+    });
     let vehicle = file
         .vehicle
         .as_ref()
@@ -118,6 +131,7 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         launch,
         bearings,
         seals,
+        circuit: circuit.unwrap_or_default(),
     })
 }
 
@@ -188,6 +202,8 @@ struct ItemNames<'a> {
     packs: Vec<&'a str>,
     pump: bool,
     converter: bool,
+    /// `[circuit]` consumer names by kind (jets, sets) and electric-pump source names.
+    circuit: Option<&'a circuit::CircuitSpec>,
 }
 
 /// `[thermal]` against the checked gears and the loss items of the model.
@@ -210,7 +226,25 @@ fn check_thermal(
     names.set(Source::Pocketing, it.meshes.iter().map(|m| m.name.as_str()));
     names.set(Source::Sliding, it.meshes.iter().map(|m| m.name.as_str()));
     names.set(Source::ClutchDrag, it.packs.iter().copied());
-    names.set(Source::Pump, it.pump.then_some("pump"));
+    let consumers = |k: circuit::ConsumerKindChoice| -> Vec<&str> {
+        it.circuit
+            .map(|c| c.consumers.iter().filter(|x| x.kind == k).map(|x| x.name.as_str()).collect())
+            .unwrap_or_default()
+    };
+    let e_pumps: Vec<&str> = it
+        .circuit
+        .map(|c| {
+            c.sources
+                .iter()
+                .filter(|x| x.kind == circuit::SourceKindChoice::ElectricPump)
+                .map(|x| x.name.as_str())
+                .collect()
+        })
+        .unwrap_or_default();
+    names.set(Source::Pump, it.pump.then_some("pump").into_iter().chain(e_pumps));
+    names.set(Source::Windage, it.gears.iter().map(|g| g.name.as_str()));
+    names.set(Source::Jet, consumers(circuit::ConsumerKindChoice::Jet));
+    names.set(Source::Fling, consumers(circuit::ConsumerKindChoice::Set));
     names.set(Source::Converter, it.converter.then_some("converter"));
     names.set(Source::Bearing, it.bearings.iter().map(|b| b.name.as_str()));
     names.set(Source::Seal, it.seals.iter().map(|s| s.name.as_str()));

@@ -3,5 +3,6 @@ pub mod efficiency;
 pub mod geometry;
 pub mod kinematics;
 pub mod losses;
+pub mod lubrication;
 pub mod oil;
 pub mod thermal;

@@ -26,6 +26,12 @@ pub enum Quantity {
     Pump,
     /// Torque-converter slip loss.
     Converter,
+    /// Windage of gears above the oil.
+    Windage,
+    /// Impulse of lubricating jets.
+    Jet,
+    /// Oil flung through planet carriers.
+    Fling,
     /// Efficiency 1 − ΣP_loss/P_in over the case's `sources` (all by default).
     Efficiency,
 }
@@ -58,6 +64,9 @@ impl Quantity {
             Quantity::ClutchDrag => Source::ClutchDrag,
             Quantity::Pump => Source::Pump,
             Quantity::Converter => Source::Converter,
+            Quantity::Windage => Source::Windage,
+            Quantity::Jet => Source::Jet,
+            Quantity::Fling => Source::Fling,
             Quantity::Efficiency => return None,
         })
     }
@@ -90,9 +99,20 @@ impl Quantity {
                     (m, k)
                 })
                 .collect(),
-            Quantity::Seal | Quantity::ClutchDrag | Quantity::Pump | Quantity::Converter => {
-                vec![("default", gear_losses_off())]
-            }
+            Quantity::Windage => ["seetharaman", "stavytskyi"]
+                .into_iter()
+                .map(|m| {
+                    let mut k = gear_losses_off();
+                    k.push(("windage", s(m)));
+                    (m, k)
+                })
+                .collect(),
+            Quantity::Seal
+            | Quantity::ClutchDrag
+            | Quantity::Pump
+            | Quantity::Converter
+            | Quantity::Jet
+            | Quantity::Fling => vec![("default", gear_losses_off())],
             Quantity::Efficiency => efficiency_choices(),
         }
     }

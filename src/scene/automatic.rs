@@ -20,6 +20,8 @@ use super::items::{DefaultHeat, LossItem, Skipped, Source};
 struct PackEntry {
     item: usize,
     pack: ClutchPack,
+    /// The `[circuit]` consumer that feeds it (its flow replaces the pack's own), if any.
+    feed: Option<usize>,
     /// Per gear state: |slip| per unit input speed.
     slip: Vec<f64>,
 }
@@ -51,6 +53,10 @@ pub struct AutoSample {
     key: Option<(usize, u64, u64, u64)>,
     /// Pump drive power, W.
     pub pump: f64,
+    /// Pump delivered flow, m³/s.
+    pub pump_flow: f64,
+    /// Line pressure, Pa.
+    pub line_pressure: f64,
     /// Converter slip loss, W.
     pub converter: f64,
     /// Engine-side speed, rad/s.
@@ -70,7 +76,7 @@ impl AutoLosses {
         let n = gb.gear_states.len();
         let clean = |v: f64| if v.abs() < 1e-12 { 0.0 } else { v.abs() };
         let mut packs = Vec::new();
-        for cp in &gb.clutch_packs {
+        for (k, cp) in gb.clutch_packs.iter().enumerate() {
             let el = &gb.shift_elements[cp.element];
             let slip: Vec<f64> = (0..n)
                 .map(|si| {
@@ -90,9 +96,15 @@ impl AutoLosses {
                 });
                 continue;
             }
+            let feed = gb
+                .circuit
+                .consumers
+                .iter()
+                .position(|c| c.target == crate::model::gearbox::Target::ClutchPack(k));
             packs.push(PackEntry {
                 item: items.len(),
                 pack: cp.pack,
+                feed,
                 slip,
             });
             items.push(LossItem {
@@ -172,12 +184,12 @@ impl AutoLosses {
             }
             None => (w, 0.0),
         };
-        let pump = self.pump.as_ref().map_or(0.0, |p| {
+        let pump = self.pump.as_ref().map(|p| {
             let speed = match p.model.drive {
                 PumpDrive::Engine => engine_speed,
                 PumpDrive::Member(_) => p.speed[state] * w,
             };
-            p.model.pump.point(speed, input_torque).power
+            p.model.pump.point(speed, input_torque)
         });
         AutoSample {
             key: Some((
@@ -186,7 +198,9 @@ impl AutoLosses {
                 input_torque.to_bits(),
                 vehicle_speed.to_bits(),
             )),
-            pump,
+            pump: pump.map_or(0.0, |p| p.power),
+            pump_flow: pump.map_or(0.0, |p| p.flow),
+            line_pressure: pump.map_or(0.0, |p| p.pressure),
             converter,
             engine_speed,
         }
@@ -212,10 +226,11 @@ impl AutoLosses {
         }
     }
 
-    /// Write every item's loss (W) into `out`: pack drags at `oil`, pump and converter from the
-    /// prepared sample `s` if it is for `state`, `input_speed` and `input_torque`, else computed
-    /// (vehicle speed from the input speed when the model has a vehicle, else 0: lock-up open).
-    /// No allocation.
+    /// Write every item's loss (W) into `out`: pack drags at `oil` (a pack fed by the circuit with
+    /// the flow `feed_flow(consumer)`, m³/s), pump and converter from the prepared sample `s` if it
+    /// is for `state`, `input_speed` and `input_torque`, else computed (vehicle speed from the
+    /// input speed when the model has a vehicle, else 0: lock-up open). No allocation.
+    #[allow(clippy::too_many_arguments)]
     pub fn evaluate(
         &self,
         state: usize,
@@ -223,11 +238,16 @@ impl AutoLosses {
         input_torque: f64,
         oil: &OilProperties,
         s: &AutoSample,
+        feed_flow: impl Fn(usize) -> f64,
         out: &mut [f64],
     ) {
         let w = input_speed.abs();
         for p in &self.packs {
-            out[p.item] = p.pack.drag(p.slip[state] * w, oil.mu, oil.rho).power;
+            let mut pack = p.pack;
+            if let Some(c) = p.feed {
+                pack.oil_flow = feed_flow(c);
+            }
+            out[p.item] = pack.drag(p.slip[state] * w, oil.mu, oil.rho).power;
         }
         if self.pump.is_none() && self.converter.is_none() {
             return;

@@ -3,13 +3,14 @@
 //! the model (skipping items idle in every needed gear state), and the per-state kinematic factors
 //! [`super::losses::LossScene`] evaluates them with.
 
-use crate::model::gearbox::{GearMount, Gearbox, SlidingChoice};
+use crate::model::gearbox::{GearMount, Gearbox, SlidingChoice, Target};
 use crate::physics::geometry::MeshKind;
 use crate::physics::losses::churning::ranges as churning_ranges;
 use crate::physics::losses::churning::{ChangenetSum, ChurningGear, ChurningModel, GearChurning};
 use crate::physics::losses::pocketing::{PocketMeshInput, PocketingMesh};
 use crate::physics::losses::sliding::friction::Schlenk;
 use crate::physics::losses::sliding::{OilState as SlideOil, PowerLaw, SlidingMesh, SlidingMeshInput};
+use crate::physics::losses::windage::GearWindage;
 
 use super::churn_sample;
 use super::items::{DefaultHeat, LossItem, SceneError, Skipped, Source};
@@ -30,6 +31,8 @@ pub(super) struct StateFactors {
     pub(super) pocket_speed: Vec<f64>,
     /// Per sliding entry: torque on gear 1 (one mesh), carrier-frame ω1, ω2.
     pub(super) slide: Vec<[f64; 3]>,
+    /// Per windage entry: its gear's speed relative to the air (planets: spin; others: absolute).
+    pub(super) wind_speed: Vec<f64>,
     /// Per sliding entry with a power law: loss (W, multiplicity included) at input speed
     /// 1 rad/s, η = 1 Pa·s and input torque +1 N·m / −1 N·m (the two power-flow directions).
     pub(super) slide_unit: Vec<[f64; 2]>,
@@ -56,6 +59,17 @@ pub(super) struct PocketEntry {
     pub(super) multiplicity: f64,
     /// Fraction of the time the mesh zone is below the oil level (0..1).
     pub(super) wet_fraction: f64,
+    /// Circuit consumers that deliver oil to one of its instances: (consumer, fraction of the
+    /// consumer's flow each instance receives).
+    pub(super) feeds: Vec<(usize, f64)>,
+}
+
+#[derive(Debug, Clone)]
+pub(super) struct WindEntry {
+    pub(super) item: usize,
+    pub(super) model: GearWindage,
+    /// Planets of the set (1 for a gear on a member).
+    pub(super) multiplicity: f64,
 }
 
 #[derive(Debug, Clone)]
@@ -215,7 +229,9 @@ pub(super) fn compile_pocketing(
         return Ok((pocket, pocket_meshes));
     };
     for (mi, m) in gb.meshes.iter().enumerate() {
-        let Some(wet) = pocket_wet_fraction(gb, mi, opt.mixture_density.is_some(), lists) else {
+        let feeds = mesh_feeds(gb, mi);
+        let known = opt.mixture_density.is_some() || !feeds.is_empty();
+        let Some(wet) = pocket_wet_fraction(gb, mi, known, lists) else {
             continue;
         };
         if !usage.any(|u, st| u.speeds[st][m.gear1].relative != 0.0) {
@@ -250,6 +266,7 @@ pub(super) fn compile_pocketing(
             model,
             multiplicity: m.multiplicity as f64,
             wet_fraction: wet,
+            feeds,
         });
         pocket_meshes.push(mi);
         lists.items.push(LossItem {
@@ -261,6 +278,98 @@ pub(super) fn compile_pocketing(
         });
     }
     Ok((pocket, pocket_meshes))
+}
+
+/// The circuit consumers that deliver oil to mesh `mi`, with the fraction of their flow one
+/// instance of the mesh receives: a mesh or jet consumer splits its flow over the mesh's
+/// instances (planets), a set consumer over every mesh instance of its set.
+pub(super) fn mesh_feeds(gb: &Gearbox, mi: usize) -> Vec<(usize, f64)> {
+    let m = &gb.meshes[mi];
+    let set_instances = |set: usize| -> f64 {
+        gb.meshes
+            .iter()
+            .filter(|x| x.set == Some(set))
+            .map(|x| x.multiplicity as f64)
+            .sum()
+    };
+    gb.circuit
+        .consumers
+        .iter()
+        .enumerate()
+        .filter_map(|(c, x)| match x.target {
+            Target::Mesh(k) | Target::Jet { mesh: k, .. } if k == mi => Some((c, 1.0 / m.multiplicity as f64)),
+            Target::Set { set, .. } if m.set == Some(set) => Some((c, 1.0 / set_instances(set))),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Windage: one item per gear that does not reach the oil and turns (relative to the air) in a
+/// needed state. Returns the entries and their gears.
+pub(super) fn compile_windage(
+    gb: &Gearbox,
+    usage: &Usage,
+    lists: &mut Lists,
+) -> Result<(Vec<WindEntry>, Vec<usize>), SceneError> {
+    let (mut wind, mut gears) = (Vec::new(), Vec::new());
+    let Some(model) = gb.losses.windage else {
+        lists.skipped.push(Skipped {
+            what: "windage".into(),
+            why: "switched off ([losses] windage = \"off\")".into(),
+        });
+        return Ok((wind, gears));
+    };
+    let cfg = gb.losses.churning.unwrap_or_default();
+    for (gi, g) in gb.gears.iter().enumerate() {
+        if g.is_immersed() {
+            continue;
+        }
+        // A gear on a member the housing holds never turns (nor does it in any state of the model).
+        if (0..gb.gear_states.len()).all(|st| gb.gear_speeds(st)[gi].absolute.abs() < 1e-12) {
+            lists.skipped.push(Skipped {
+                what: format!("windage of gear {}", g.name),
+                why: "never turns (its member is held by the housing)".into(),
+            });
+            continue;
+        }
+        let planets = match g.mount {
+            GearMount::Planet { set, .. } => gb.planetary_sets[set].planets,
+            GearMount::OnMember => 1,
+        };
+        if !usage.any(|u, st| air_speed(&u.speeds[st][gi], g.mount) != 0.0) {
+            lists
+                .skipped
+                .push(usage.idle(format!("windage of gear {}", g.name), "stands still"));
+            continue;
+        }
+        let model = GearWindage::new(model, &cfg, &churning_gear(gb, gi)).map_err(|e| SceneError {
+            what: format!("windage of gear {}", g.name),
+            why: e.to_string(),
+        })?;
+        wind.push(WindEntry {
+            item: lists.items.len(),
+            model,
+            multiplicity: f64::from(planets),
+        });
+        gears.push(gi);
+        lists.items.push(LossItem {
+            source: Source::Windage,
+            name: g.name.clone(),
+            gears: vec![(gi, 1.0)],
+            heat: DefaultHeat::Oil,
+            engine_side: false,
+        });
+    }
+    Ok((wind, gears))
+}
+
+/// Speed of a gear relative to the air around it: a planet's spin (the air in a carrier turns
+/// with it), else its absolute speed.
+fn air_speed(w: &crate::model::gearbox::GearSpeed, mount: GearMount) -> f64 {
+    match mount {
+        GearMount::Planet { .. } => w.relative,
+        GearMount::OnMember => w.absolute,
+    }
 }
 
 /// The wet fraction of mesh `mi`'s zone, or `None` when the mesh has no pocketing item (an
@@ -390,6 +499,7 @@ pub(super) struct Compiled<'a> {
     pub(super) pocket_meshes: &'a [usize],
     pub(super) slide_meshes: &'a [usize],
     pub(super) slide: &'a [SlideEntry],
+    pub(super) wind_gears: &'a [usize],
 }
 
 impl Compiled<'_> {
@@ -415,6 +525,11 @@ impl Compiled<'_> {
                     let m = &gb.meshes[mi];
                     [torques[mi], speeds[m.gear1].relative, speeds[m.gear2].relative]
                 })
+                .collect(),
+            wind_speed: self
+                .wind_gears
+                .iter()
+                .map(|&gi| air_speed(&speeds[gi], gb.gears[gi].mount).abs())
                 .collect(),
             slide_unit: Vec::new(),
         };

@@ -10,10 +10,13 @@ use crate::model::gearbox::Gearbox;
 use crate::physics::losses::churning::{GearChurning, OilState as ChurnOil};
 
 use super::churn_sample::{ChurnSample, InputSpeedPowers};
+use super::circuit::{CircuitSample, CircuitScene};
 use super::gear_losses::{
-    compile_churning, compile_pocketing, compile_sliding, sliding, with_ratio_terms, ChurnEntry, Compiled,
-    Lists, PocketEntry, SlideEntry, StateFactors,
+    compile_churning, compile_pocketing, compile_sliding, compile_windage, sliding, with_ratio_terms, ChurnEntry,
+    Compiled, Lists, PocketEntry, SlideEntry, StateFactors, WindEntry,
 };
+use crate::physics::lubrication::{mixture_density, oil_fraction};
+use crate::physics::losses::windage::AIR;
 use super::usage::Usage;
 use super::warning::RangeWarning;
 
@@ -41,6 +44,8 @@ pub struct SampleTerms {
     pub prepared: usize,
     /// Pump and converter values of the sample (they need the vehicle speed too).
     pub auto: super::automatic::AutoSample,
+    /// What the circuit's sources deliver in this sample.
+    pub circuit: CircuitSample,
 }
 
 /// Compiled loss models of a gearbox.
@@ -53,6 +58,7 @@ pub struct LossScene {
     churn: Vec<ChurnEntry>,
     pocket: Vec<PocketEntry>,
     slide: Vec<SlideEntry>,
+    wind: Vec<WindEntry>,
     states: Vec<StateFactors>,
     /// Density pumped by the part of a mesh zone above the oil (`None`: unknown, not counted).
     mixture_density: Option<f64>,
@@ -63,6 +69,8 @@ pub struct LossScene {
     auto: super::automatic::AutoLosses,
     /// Bearings and seals.
     elements: super::element_losses::ElementLosses,
+    /// The lubrication circuit and the items that follow its flows.
+    pub circuit: CircuitScene,
     /// Multiplier of each item (`[losses] multiplier`), when any is given.
     factor: Option<Vec<f64>>,
 }
@@ -82,11 +90,13 @@ impl LossScene {
         let (churn, churn_gears) = compile_churning(gb, needs, &usage, &mut lists)?;
         let (pocket, pocket_meshes) = compile_pocketing(gb, &usage, &mut lists)?;
         let (slide, slide_meshes) = compile_sliding(gb, needs, &usage, &mut lists)?;
+        let (wind, wind_gears) = compile_windage(gb, &usage, &mut lists)?;
         let compiled = Compiled {
             churn_gears: &churn_gears,
             pocket_meshes: &pocket_meshes,
             slide_meshes: &slide_meshes,
             slide: &slide,
+            wind_gears: &wind_gears,
         };
         let states = (0..gb.gear_states.len())
             .map(|si| compiled.state_factors(gb, &usage, si))
@@ -116,6 +126,7 @@ impl LossScene {
             &mut items,
             &mut skipped,
         );
+        let circuit = CircuitScene::compile(gb, &mut items);
         let factor = multipliers(&gb.losses.multipliers, &items)?;
         Ok(LossScene {
             factor,
@@ -124,12 +135,14 @@ impl LossScene {
             churn,
             pocket,
             slide,
+            wind,
             states,
             mixture_density,
             warnings,
             state_names: gb.gear_states.iter().map(|s| s.name.clone()).collect(),
             auto,
             elements,
+            circuit,
         })
     }
 
@@ -151,10 +164,13 @@ impl LossScene {
     }
 
     fn evaluate_unscaled(&self, op: &OperatingPoint, out: &mut [f64]) {
-        self.evaluate_load_independent(op, None, out);
-        let none = super::automatic::AutoSample::default();
+        let auto = self.auto.sample(op.state, op.input_speed, op.input_torque, 0.0);
+        let cs = self.circuit.sample(op.state, op.input_speed, &auto);
+        self.evaluate_load_independent(op, None, &cs, out);
+        let flow = |c| self.circuit.flow(c, &cs, op.oil.rho).0;
         self.auto
-            .evaluate(op.state, op.input_speed, op.input_torque, &op.oil, &none, out);
+            .evaluate(op.state, op.input_speed, op.input_torque, &op.oil, &auto, flow, out);
+        self.circuit.evaluate(op.state, op.input_speed, &op.oil, &cs, out);
         let st = &self.states[op.state];
         for (e, f) in self.slide.iter().zip(&st.slide) {
             out[e.item] = sliding(e, f, op.input_torque, op.input_speed, op.oil.mu, op.oil.rho);
@@ -172,6 +188,7 @@ impl LossScene {
             churn: vec![ChurnSample::Direct; self.churn.len()],
             prepared: 0,
             auto: Default::default(),
+            circuit: Default::default(),
         }
     }
 
@@ -193,6 +210,7 @@ impl LossScene {
     ) {
         self.auto
             .prepare(state, input_speed, input_torque, vehicle_speed, &mut terms.auto);
+        terms.circuit = self.circuit.sample(state, input_speed, &terms.auto);
         let key = (state, input_speed.to_bits(), input_torque.to_bits());
         if terms.key == Some(key) {
             return;
@@ -249,15 +267,19 @@ impl LossScene {
     }
 
     fn evaluate_cached_unscaled(&self, op: &OperatingPoint, terms: &SampleTerms, out: &mut [f64]) {
-        self.evaluate_load_independent(op, Some(&terms.churn), out);
+        let cs = &terms.circuit;
+        self.evaluate_load_independent(op, Some(&terms.churn), cs, out);
+        let flow = |c| self.circuit.flow(c, cs, op.oil.rho).0;
         self.auto.evaluate(
             op.state,
             op.input_speed,
             op.input_torque,
             &op.oil,
             &terms.auto,
+            flow,
             out,
         );
+        self.circuit.evaluate(op.state, op.input_speed, &op.oil, cs, out);
         let st = &self.states[op.state];
         let mut memo = (f64::NAN, 0.0);
         for ((e, f), u) in self.slide.iter().zip(&st.slide).zip(&terms.slide_unit) {
@@ -310,9 +332,52 @@ impl LossScene {
             .map(move |(e, k)| (e.item, k * input_speed * e.pitch_radius))
     }
 
-    /// Churning and pocketing at `op` into `out`; churning from the sample's laws `churn` when
-    /// given (prepared for `op`'s state and speed).
-    fn evaluate_load_independent(&self, op: &OperatingPoint, churn: Option<&[ChurnSample]>, out: &mut [f64]) {
+    /// Mass flow (kg/s) of every circuit consumer at `op` into `mdot`, and its temperature
+    /// derivative (kg/s/K) from d ln ρ/dT `dln_rho` into `dmdot`; from the prepared `terms` when
+    /// they are for `op`'s sample. No allocation.
+    pub fn consumer_flows(
+        &self,
+        op: &OperatingPoint,
+        terms: &SampleTerms,
+        dln_rho: f64,
+        mdot: &mut [f64],
+        dmdot: &mut [f64],
+    ) {
+        let fresh;
+        let cs = if terms.key == Some((op.state, op.input_speed.to_bits(), op.input_torque.to_bits())) {
+            &terms.circuit
+        } else {
+            let auto = self.auto.sample(op.state, op.input_speed, op.input_torque, 0.0);
+            fresh = self.circuit.sample(op.state, op.input_speed, &auto);
+            &fresh
+        };
+        self.circuit.mass_flows(cs, op.oil.rho, dln_rho, mdot, dmdot);
+    }
+
+    /// Every windage model with its loss item and its gear's speed relative to the air (rad/s) in
+    /// gear state `state` at input speed `input_speed` (for range checks, with the air state).
+    pub fn windage_models(
+        &self,
+        state: usize,
+        input_speed: f64,
+    ) -> impl Iterator<Item = (usize, &crate::physics::losses::churning::GearChurning, f64)> + '_ {
+        let st = &self.states[state];
+        self.wind
+            .iter()
+            .zip(&st.wind_speed)
+            .map(move |(e, k)| (e.item, e.model.model(), k * input_speed))
+    }
+
+    /// Churning, windage and pocketing at `op` into `out`; churning from the sample's laws `churn`
+    /// when given (prepared for `op`'s state and speed); pocketing of fed meshes with the oil the
+    /// circuit delivers in sample `cs`.
+    fn evaluate_load_independent(
+        &self,
+        op: &OperatingPoint,
+        churn: Option<&[ChurnSample]>,
+        cs: &CircuitSample,
+        out: &mut [f64],
+    ) {
         let st = &self.states[op.state];
         let w_in = op.input_speed;
         let churn_oil = ChurnOil {
@@ -332,12 +397,26 @@ impl LossScene {
                 }
             }
         }
+        for (e, k) in self.wind.iter().zip(&st.wind_speed) {
+            out[e.item] = e.multiplicity * e.model.power(k * w_in);
+        }
         for (e, k) in self.pocket.iter().zip(&st.pocket_speed) {
-            // The share above the oil pumps an unknown density unless the model file gives one;
-            // it is then not counted (and reported in `warnings`).
-            let rho =
-                e.wet_fraction * op.oil.rho + (1.0 - e.wet_fraction) * self.mixture_density.unwrap_or(0.0);
-            out[e.item] = e.multiplicity * e.model.power(k * w_in, rho);
+            let w1 = k * w_in;
+            // The share above the oil pumps the oil–air mixture the circuit's flow makes; without
+            // a feed, the density the model file gives, else it is not counted (and reported in
+            // `warnings`).
+            let dry = if e.feeds.is_empty() {
+                self.mixture_density.unwrap_or(0.0)
+            } else {
+                let q: f64 = e
+                    .feeds
+                    .iter()
+                    .map(|&(c, f)| f * self.circuit.flow(c, cs, op.oil.rho).0)
+                    .sum();
+                mixture_density(oil_fraction(q, e.model.swept_flow(w1)), op.oil.rho, AIR.density)
+            };
+            let rho = e.wet_fraction * op.oil.rho + (1.0 - e.wet_fraction) * dry;
+            out[e.item] = e.multiplicity * e.model.power(w1, rho);
         }
     }
 }

@@ -3,6 +3,7 @@
 pub mod automatic;
 pub mod bearing_loads;
 pub mod churn_sample;
+pub mod circuit;
 pub mod element_losses;
 pub mod gear_losses;
 pub mod items;

@@ -32,8 +32,8 @@ impl RangeLog {
         }
     }
 
-    /// Check every churning model of `scene` at `op`, and every churning gear's pitch-line speed
-    /// against the dip-lubrication range.
+    /// Check every churning model of `scene` at `op`, every churning gear's pitch-line speed
+    /// against the dip-lubrication range, and every windage model in air.
     pub fn check(&mut self, scene: &LossScene, op: &OperatingPoint) {
         self.points += 1;
         let oil = OilState {
@@ -55,6 +55,15 @@ impl RangeLog {
         }
         for (item, speed) in scene.churning_pitch_speeds(op.state, op.input_speed) {
             if let Some((c, v)) = above_dip_speed(speed) {
+                let e = &mut self.seen[item][c.index()];
+                e.0 += 1;
+                e.1 = e.1.min(v);
+                e.2 = e.2.max(v);
+            }
+        }
+        let air = crate::physics::losses::windage::AIR;
+        for (item, m, w) in scene.windage_models(op.state, op.input_speed) {
+            if let Some((c, v)) = m.out_of_range(w, &air) {
                 let e = &mut self.seen[item][c.index()];
                 e.0 += 1;
                 e.1 = e.1.min(v);

@@ -97,6 +97,10 @@ pub struct Work {
     /// Their temperature derivatives, W/K² (as `oil_g` and `oil_g2`).
     oil_dg: Vec<f64>,
     oil_dg2: Vec<f64>,
+    /// Mass flow of every circuit consumer (kg/s) and its temperature derivative (kg/s/K), scratch
+    /// for the advection links' conductances.
+    mdot: Vec<f64>,
+    dmdot: Vec<f64>,
     /// ∂f/∂T_oil for the whole state (column of the Jacobian), cached.
     oil_col: Vec<f64>,
     col_key: Option<(u64, u64)>,
@@ -242,6 +246,8 @@ impl Scene {
             oil_g2: vec![0.0; self.thermal.oil_link_count()],
             oil_dg: vec![0.0; self.thermal.oil_link_count()],
             oil_dg2: vec![0.0; self.thermal.oil_link_count()],
+            mdot: vec![0.0; self.losses.circuit.consumers()],
+            dmdot: vec![0.0; self.losses.circuit.consumers()],
             oil_col: vec![0.0; self.n_states()],
             col_key: None,
             sample_id: 0,
@@ -319,14 +325,18 @@ impl Scene {
         net: &NetworkWork,
         q: &mut [f64],
         oil_g: (&mut [f64], &mut [f64]),
+        flows: (&mut [f64], &mut [f64]),
         heat: &mut [f64],
     ) -> f64 {
         let n = self.nodes();
         let (oil, slopes) = self.thermal.oil_properties_and_slopes(t_oil);
-        self.losses.evaluate_cached(&self.op(inputs, oil), terms, q);
+        let op = self.op(inputs, oil);
+        self.losses.evaluate_cached(&op, terms, q);
         let (g, dg) = oil_g;
+        let (m, dm) = flows;
+        self.losses.consumer_flows(&op, terms, slopes.rho, m, dm);
         self.thermal
-            .oil_link_conductances(&oil, &slopes, &Self::operating(inputs), g, dg);
+            .oil_link_conductances(&oil, &slopes, &Self::operating(inputs), m, dm, g, dg);
         let to_b = self.thermal.network_heat(&y[..n], g, net, heat);
         for (qk, dest) in q.iter().zip(&self.thermal.heat) {
             for &(node, f) in dest {
@@ -398,9 +408,7 @@ impl Scene {
         let oil_i = self.thermal.oil;
         let t_oil = self.oil_temp(y);
         let (oil, slopes) = self.thermal.oil_properties_and_slopes(t_oil);
-        let op = Self::operating(&work.inputs);
-        self.thermal
-            .oil_link_conductances(&oil, &slopes, &op, &mut work.oil_g, &mut work.oil_dg);
+        self.oil_link_state(oil, &slopes, work, false);
         let to_b = self
             .thermal
             .network_heat_jvp(&y[..n], &work.oil_g, &work.net, &v[..n], &mut work.heat);
@@ -436,7 +444,8 @@ impl Scene {
         } else {
             (&mut w.q, &mut w.oil_g, &mut w.oil_dg, &mut w.heat)
         };
-        self.heat_balance(y, t_oil, &w.inputs, &w.terms, &w.net, q, (g, dg), heat)
+        let flows = (&mut w.mdot[..], &mut w.dmdot[..]);
+        self.heat_balance(y, t_oil, &w.inputs, &w.terms, &w.net, q, (g, dg), flows, heat)
     }
 
     /// ∂f/∂T_oil through the oil properties (all rows of the state), by a forward difference,
@@ -514,10 +523,31 @@ impl Scene {
             return true;
         }
         let (oil, slopes) = self.thermal.oil_properties_and_slopes(self.oil_temp(y));
-        let op = Self::operating(&work.inputs);
-        self.thermal
-            .oil_link_conductances(&oil, &slopes, &op, &mut work.oil_g2, &mut work.oil_dg2);
+        self.oil_link_state(oil, &slopes, work, true);
         false
+    }
+
+    /// The oil-state-dependent links' conductances and derivatives at oil state `oil` with the
+    /// work area's inputs, into `oil_g`/`oil_dg` or, with `scratch`, `oil_g2`/`oil_dg2` (the
+    /// circuit's flows into `mdot`/`dmdot` on the way).
+    fn oil_link_state(&self, oil: OilProperties, slopes: &crate::physics::oil::OilLogSlopes, work: &mut Work, scratch: bool) {
+        let op = self.op(&work.inputs, oil);
+        self.losses
+            .consumer_flows(&op, &work.terms, slopes.rho, &mut work.mdot, &mut work.dmdot);
+        let (g, dg) = if scratch {
+            (&mut work.oil_g2, &mut work.oil_dg2)
+        } else {
+            (&mut work.oil_g, &mut work.oil_dg)
+        };
+        self.thermal.oil_link_conductances(
+            &oil,
+            slopes,
+            &Self::operating(&work.inputs),
+            &work.mdot,
+            &work.dmdot,
+            g,
+            dg,
+        );
     }
 
     /// Values of the Jacobian entries of [`Self::jacobian_pattern`], in its order, at (t, y):

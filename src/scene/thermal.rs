@@ -69,14 +69,27 @@ struct SampleLink {
     law: SampleLaw,
 }
 
-/// A rotating part in oil: h depends on the gear speed and on ν(T_oil).
+/// A link whose conductance depends on the oil state: a rotating part in oil (h follows the gear
+/// speed and ν(T_oil)) or the oil a circuit consumer carries through a node back to the oil node.
 #[derive(Debug, Clone)]
 struct OilLink {
     a: End,
     b: End,
-    area: f64,
-    radius: f64,
-    speed_per_input: Vec<f64>,
+    law: OilLaw,
+}
+
+#[derive(Debug, Clone)]
+enum OilLaw {
+    /// Rotating-disc correlation in oil.
+    Rotating {
+        area: f64,
+        radius: f64,
+        speed_per_input: Vec<f64>,
+    },
+    /// Advection by the flow of circuit consumer `consumer` \[std\]: the oil enters the node at
+    /// the oil node's temperature and leaves it at the node's, so the heat it carries from a to b
+    /// is `ṁ c_p (T_a − T_b)`: a conductance ṁ c_p that follows the flow (and the oil's density).
+    Advection { consumer: usize },
 }
 
 #[derive(Debug, Clone)]
@@ -235,14 +248,53 @@ impl Links {
                 } => links.oil.push(OilLink {
                     a,
                     b,
-                    area: *area,
-                    radius: *radius,
-                    speed_per_input: per_state(*gear),
+                    law: OilLaw::Rotating {
+                        area: *area,
+                        radius: *radius,
+                        speed_per_input: per_state(*gear),
+                    },
                 }),
                 LinkLaw::Radiation(k) => links.radiation.push(Radiation { a, b, k: *k }),
             }
         }
         links
+    }
+}
+
+/// One advection link per circuit consumer whose oil flows through a capacity node other than the
+/// oil node: from that node to the oil node.
+fn advection_links(gb: &Gearbox, net: &ThermalNetwork) -> Vec<OilLink> {
+    gb.circuit
+        .consumers
+        .iter()
+        .enumerate()
+        .filter_map(|(c, x)| {
+            let node = consumer_node(gb, net, x)?;
+            (node != net.oil_node).then_some(OilLink {
+                a: End::Node(node),
+                b: End::Node(net.oil_node),
+                law: OilLaw::Advection { consumer: c },
+            })
+        })
+        .collect()
+}
+
+/// The capacity node the oil of consumer `x` flows through: the node it names, else the node
+/// that lumps its target's gears (mesh, jet: gear 1 then gear 2; set: its gears in role order);
+/// none for packs and bearings without a named node.
+fn consumer_node(gb: &Gearbox, net: &ThermalNetwork, x: &crate::model::gearbox::Consumer) -> Option<usize> {
+    use crate::model::gearbox::Target;
+    if let Some(n) = &x.node {
+        return net.nodes.iter().position(|m| &m.name == n);
+    }
+    let body = |g: usize| net.nodes.iter().position(|m| m.gears.contains(&g));
+    match x.target {
+        Target::Mesh(k) | Target::Jet { mesh: k, .. } => {
+            let m = &gb.meshes[k];
+            body(m.gear1).or_else(|| body(m.gear2))
+        }
+        Target::Set { set, .. } => gb.planetary_sets[set].gears.iter().find_map(|&g| body(g)),
+        Target::ClutchPack(_) | Target::Bearing(_) => None,
     }
 }
 
@@ -342,7 +394,8 @@ impl ThermalScene {
             .iter()
             .map(|x| x.initial_temp.unwrap_or(net.initial_temp))
             .collect();
-        let links = Links::compile(net, &fluid_speeds(gb));
+        let mut links = Links::compile(net, &fluid_speeds(gb));
+        links.oil.extend(advection_links(gb, net));
         debug_assert!(net.oil_node < n);
         let mut scene = ThermalScene {
             names: net.nodes.iter().map(|x| x.name.clone()).collect(),
@@ -508,27 +561,52 @@ impl ThermalScene {
         to_b
     }
 
-    /// Conductances of the rotating-in-oil links (W/K) at the oil state `oil` into `g`, and their
-    /// temperature derivatives (W/K², analytic, from the oil's logarithmic slopes) into `dg`: one
-    /// per link, in the order [`Self::network_heat`] and its derivatives take them.
+    /// Conductances of the oil-state-dependent links (W/K) at the oil state `oil` into `g`, and
+    /// their temperature derivatives (W/K², analytic, from the oil's logarithmic slopes) into `dg`:
+    /// one per link, in the order [`Self::network_heat`] and its derivatives take them. Advection
+    /// links take the consumers' mass flows `mdot` (kg/s) and their temperature derivatives
+    /// `dmdot` (kg/s/K).
+    #[allow(clippy::too_many_arguments)]
     pub fn oil_link_conductances(
         &self,
         oil: &OilProperties,
         slopes: &OilLogSlopes,
         op: &Operating,
+        mdot: &[f64],
+        dmdot: &[f64],
         g: &mut [f64],
         dg: &mut [f64],
     ) {
         let fluid = oil_fluid(oil);
         let dln_pr = slopes.nu + slopes.rho;
         for ((g, dg), l) in g.iter_mut().zip(dg.iter_mut()).zip(&self.oil_links) {
-            let w = l.speed_per_input[op.state] * op.input_speed;
-            let (h, dh) = rotating_disc_h_slope(w, l.radius, &fluid, slopes.nu, dln_pr);
-            (*g, *dg) = (l.area * h, l.area * dh);
+            (*g, *dg) = match &l.law {
+                OilLaw::Rotating {
+                    area,
+                    radius,
+                    speed_per_input,
+                } => {
+                    let w = speed_per_input[op.state] * op.input_speed;
+                    let (h, dh) = rotating_disc_h_slope(w, *radius, &fluid, slopes.nu, dln_pr);
+                    (area * h, area * dh)
+                }
+                OilLaw::Advection { consumer } => (
+                    mdot[*consumer] * OIL_SPECIFIC_HEAT,
+                    dmdot[*consumer] * OIL_SPECIFIC_HEAT,
+                ),
+            };
         }
     }
 
-    /// Number of rotating-in-oil links.
+    /// Number of advection links (circuit consumers' oil through a node).
+    pub fn advection_link_count(&self) -> usize {
+        self.oil_links
+            .iter()
+            .filter(|l| matches!(l.law, OilLaw::Advection { .. }))
+            .count()
+    }
+
+    /// Number of oil-state-dependent links (rotating parts in oil and advection).
     pub fn oil_link_count(&self) -> usize {
         self.oil_links.len()
     }

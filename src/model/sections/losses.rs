@@ -37,6 +37,24 @@ choice!(ChurningChoice {
     Off = "off",
 });
 
+/// `windage`: the drag of gears that run above the oil, in air (docs/physics.md §14).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum WindageChoice {
+    /// Seetharaman–Kahraman's drag terms (faces, periphery, tooth cavities) on a gear wholly in
+    /// air.
+    #[default]
+    Seetharaman,
+    /// Stavytskyi et al.'s model with the gear wholly immersed, in air.
+    Stavytskyi,
+    /// No windage loss.
+    Off,
+}
+choice!(WindageChoice {
+    Seetharaman = "seetharaman",
+    Stavytskyi = "stavytskyi",
+    Off = "off",
+});
+
 /// `pocketing`: pocketing of external meshes (docs/physics.md §6) on or off.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub enum PocketingChoice {
@@ -179,6 +197,9 @@ pub struct LossesSpec {
     /// Pocketing (default `on`).
     #[serde(default)]
     pub pocketing: Option<PocketingChoice>,
+    /// Windage of gears above the oil (default `seetharaman`).
+    #[serde(default)]
+    pub windage: Option<WindageChoice>,
     /// Sliding model (default `detailed`).
     #[serde(default)]
     pub sliding: Option<SlidingModelChoice>,
@@ -323,6 +344,8 @@ pub struct LossModels {
     pub pocketing: Option<PocketingOptions>,
     /// Sliding.
     pub sliding: SlidingChoice,
+    /// Windage of gears above the oil (None: off).
+    pub windage: Option<ChurningModel>,
     /// Loss multipliers `[losses] multiplier`: (source, None) for a source, (source, Some(item))
     /// for one item; each multiplies the item's loss (default 1).
     pub multipliers: Vec<(Source, Option<String>, f64)>,
@@ -348,10 +371,16 @@ pub fn validate_losses(
     if problems.len() > start {
         return None;
     }
+    let windage = match l.windage.unwrap_or_default() {
+        WindageChoice::Seetharaman => Some(ChurningModel::Seetharaman),
+        WindageChoice::Stavytskyi => Some(ChurningModel::Stavytskyi),
+        WindageChoice::Off => None,
+    };
     Some(LossModels {
         churning,
         pocketing,
         sliding,
+        windage,
         multipliers,
     })
 }

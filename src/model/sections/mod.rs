@@ -5,6 +5,7 @@
 
 pub mod bearing_friction;
 pub mod bearings;
+pub mod circuit;
 pub mod clutch_packs;
 pub mod common;
 pub mod gear_states;

@@ -110,6 +110,9 @@ impl SourceColour for Source {
             Source::ClutchDrag => RGBColor(86, 180, 233),
             Source::Pump => RGBColor(240, 228, 66),
             Source::Converter => RGBColor(0, 0, 0),
+            Source::Windage => RGBColor(120, 120, 120),
+            Source::Jet => RGBColor(153, 0, 76),
+            Source::Fling => RGBColor(102, 51, 0),
         }
     }
 }
@@ -706,6 +709,6 @@ mod tests {
         for s in Source::ALL {
             assert_eq!(Source::parse(s.as_str()), Some(s));
         }
-        assert_eq!(Source::parse("windage"), None);
+        assert_eq!(Source::parse("splash"), None);
     }
 }

@@ -282,6 +282,12 @@ impl PocketTable {
         self.phi_max
     }
 
+    /// Volume one pocket of this family expels while it closes (m³): face width × (A(φ_max) − A(0)).
+    /// A helical pocket expels the same volume (its slices pass the same areas, shifted in phase).
+    pub fn displaced_volume(&self) -> f64 {
+        self.face_width * (self.eval(self.phi_max).0 - self.eval(0.0).0).max(0.0)
+    }
+
     /// Number of Chebyshev panels (diagnostics).
     pub fn panel_count(&self) -> usize {
         self.panels.len()

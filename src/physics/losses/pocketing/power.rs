@@ -38,6 +38,9 @@ pub struct PocketingMesh {
     k: [f64; 2],
     /// z1/(4π).
     z1_over_4pi: f64,
+    /// Volume the closing pockets of both families expel per radian of gear 1, m³/rad:
+    /// z1 (ΔV_1 + ΔV_2)/(2π).
+    swept_per_rad: f64,
     /// Discharge coefficient used.
     cd: f64,
 }
@@ -72,12 +75,14 @@ impl PocketingMesh {
         let mp = MeshProfiles::new(input)?;
         let dphi_dy = input.helix_angle.tan() / mp.gear1.r_ref;
         let mut k = [0.0; 2];
+        let mut displaced = 0.0;
         for (i, kind) in [PocketFamilyKind::SpaceOfGear2, PocketFamilyKind::SpaceOfGear1]
             .into_iter()
             .enumerate()
         {
             let fam = PocketFamily::from_profiles(&mp, kind)?;
             let table = PocketTable::new(&fam)?;
+            displaced += table.displaced_volume();
             k[i] = match opts.helix_slices {
                 _ if input.helix_angle == 0.0 => table.k_spur(cd),
                 None => table.k_helical_continuum(cd, dphi_dy),
@@ -90,8 +95,16 @@ impl PocketingMesh {
         Ok(Self {
             k,
             z1_over_4pi: input.z1 as f64 / (4.0 * std::f64::consts::PI),
+            swept_per_rad: input.z1 as f64 * displaced / (2.0 * std::f64::consts::PI),
             cd,
         })
+    }
+
+    /// Volume flow the closing pockets of both families expel at gear-1 speed `omega1` (rad/s,
+    /// magnitude used), m³/s: `z1 |ω1| (ΔV_1 + ΔV_2)/(2π)` (the swept flow of
+    /// [`crate::physics::lubrication`]).
+    pub fn swept_flow(&self, omega1: f64) -> f64 {
+        self.swept_per_rad * omega1.abs()
     }
 
     /// K of the two families (m⁵): [space of gear 2, space of gear 1].
@@ -137,6 +150,16 @@ mod tests {
         // cubic in speed, linear in density
         assert!((m.power(2.0 * w, rho) - 8.0 * m.power(w, rho)).abs() < 1e-12 * p * 8.0);
         assert!((m.power(w, 2.0 * rho) - 2.0 * m.power(w, rho)).abs() < 1e-12 * p * 2.0);
+    }
+
+    #[test]
+    fn swept_flow_is_the_volume_the_closing_pockets_lose() {
+        // FZG C (docs/physics.md §6 table): A(φ_max) 68.30 / 68.33 mm², A(0) 5.723 / 5.635 mm²,
+        // b 14 mm, z1 16: ΔV = 14 × (A(φ_max) − A(0)) per family.
+        let m = PocketingMesh::new(&cases::fzg_c(), 0.65).unwrap();
+        let dv = 14.0 * ((68.30 - 5.723) + (68.33 - 5.635)) * 1e-9;
+        let expect = 16.0 * dv / (2.0 * PI);
+        assert!((m.swept_flow(-1.0) / expect - 1.0).abs() < 2e-4, "{}", m.swept_flow(1.0) / expect);
     }
 
     #[test]
