@@ -2,6 +2,7 @@
 //! differently (`--speed-rpm` on the command line, `speed_rpm` in a study file and in Python);
 //! the message names both, so that it reads the same from each.
 
+use super::envelope::OIL_RANGE_C;
 use super::JobError;
 
 /// A closed range of a numeric option.
@@ -97,22 +98,23 @@ pub const DRIVE_TORQUE_NM: Limit = Limit {
     unit: "N m",
 };
 
-/// Oil temperature of a loss evaluation, °C (the oil catalogue's Walther fits are stated from
-/// −60 °C; above 250 °C every gear oil has cracked).
+/// Oil temperature of a loss evaluation, °C: the widest oil range of the envelope
+/// ([`OIL_RANGE_C`]); each job narrows it to its oil's range
+/// ([`super::envelope::OilRange`]), where the Walther fit holds.
 pub const OIL_TEMP_C: Limit = Limit {
     name: "oil_temp_c",
     flag: "--oil-temp-c",
-    lo: -60.0,
-    hi: 250.0,
+    lo: OIL_RANGE_C.0,
+    hi: OIL_RANGE_C.1,
     unit: "°C",
 };
 
-/// Initial temperature of every node, °C.
+/// Initial temperature of every node (the oil's among them), °C: as [`OIL_TEMP_C`].
 pub const INITIAL_TEMP_C: Limit = Limit {
     name: "initial_temp_c",
     flag: "--initial-temp-c",
-    lo: -60.0,
-    hi: 250.0,
+    lo: OIL_RANGE_C.0,
+    hi: OIL_RANGE_C.1,
     unit: "°C",
 };
 
@@ -125,12 +127,12 @@ pub const AMBIENT_C: Limit = Limit {
     unit: "°C",
 };
 
-/// Temperature at which the oil properties are frozen, °C.
+/// Temperature at which the oil properties are frozen, °C: as [`OIL_TEMP_C`].
 pub const FROZEN_VISCOSITY_C: Limit = Limit {
     name: "frozen_viscosity_c",
     flag: "--frozen-viscosity-c",
-    lo: -60.0,
-    hi: 250.0,
+    lo: OIL_RANGE_C.0,
+    hi: OIL_RANGE_C.1,
     unit: "°C",
 };
 
