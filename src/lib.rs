@@ -7,7 +7,8 @@
 //! | [`study`] | design studies: study files, sampling plans, many jobs in parallel, journals |
 //! | [`job`] | the use-case layer: one options struct per job, every range and post-solve check, typed results and errors |
 //! | [`report`] | text, JSON, CSV, Parquet and PNG outputs; transactional output directories |
-//! | [`solve`] | transient integration (ROS3, diffsol), steady equilibria, maps, reference cases |
+//! | [`reference`] | reference cases (peers, standards, measurements) and their comparison (`geartherm validate`) |
+//! | [`solve`] | transient integration (ROS3, diffsol), steady equilibria, maps, work-precision |
 //! | [`scene`] | the compile step: a checked model and a scenario become flat, precomputed arrays |
 //! | [`cycle`] | drive and rig cycles, vehicle longitudinal dynamics, shift schedules |
 //! | [`model`] | the model file: serde schema, key-path overrides, every check with its key path |
@@ -23,6 +24,7 @@ pub mod cycle;
 pub mod job;
 pub mod model;
 pub mod physics;
+pub mod reference;
 pub mod report;
 pub mod scene;
 pub mod solve;

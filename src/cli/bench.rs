@@ -2,9 +2,9 @@
 
 use std::path::PathBuf;
 
+use geartherm::job::bench::BenchRow;
 use geartherm::job::bench::{bench as run_bench, BenchOptions};
 use geartherm::report::files::OutputDir;
-use geartherm::solve::work_precision::BenchRow;
 
 use super::output::{emit, io_failure, warn};
 use super::{Failure, ModelSource};

@@ -93,7 +93,7 @@ pub fn warn(line: &str) {
 }
 
 /// Each out-of-range warning as one stderr line (the scene only collects them).
-pub fn warnings(w: &[geartherm::scene::RangeWarning]) {
+pub fn warnings(w: &[geartherm::job::RangeWarning]) {
     for x in w {
         warn(&x.to_string());
     }

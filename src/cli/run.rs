@@ -2,10 +2,9 @@
 
 use std::path::PathBuf;
 
-use geartherm::job::run::{prepare, solve, RunOptions};
+use geartherm::job::run::{prepare, solve, RunOptions, DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL};
 use geartherm::job::{self, RunResult};
 use geartherm::report::files::OutputDir;
-use geartherm::solve::transient::{DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL};
 
 use super::output::{emit, emit_json, io_failure, progress_bar, warnings};
 use super::{Failure, ModelSource};

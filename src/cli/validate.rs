@@ -5,10 +5,12 @@
 use std::path::PathBuf;
 
 use geartherm::job::validate::{validate as run_validate, ValidateOptions};
-use geartherm::report::files::OutputDir;
-use geartherm::report::validation::{rows_csv, summary_csv, summary_markdown, ValidationReport};
+use geartherm::report::files::{write_all_atomic, OutputDir};
+use geartherm::report::validation::{
+    doc_block, rows_csv, splice_doc, summary_csv, summary_markdown, ValidationReport,
+};
 
-use super::output::{emit, emit_json, io_failure};
+use super::output::{emit, emit_json, invalid, io_failure};
 use super::Failure;
 
 /// Arguments of `validate`.
@@ -23,6 +25,29 @@ pub struct ValidateArgs {
     /// Print rows and summary as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Also write the summary tables into this Markdown file, between its
+    /// `<!-- geartherm validate: begin -->` and `<!-- geartherm validate: end -->` markers
+    /// (docs/validation.md).
+    #[arg(long)]
+    pub doc: Option<PathBuf>,
+}
+
+/// The Markdown file `path` with its generated block replaced, written in place atomically.
+fn write_doc(path: &std::path::Path, block: &str) -> Result<(), Failure> {
+    let text =
+        std::fs::read_to_string(path).map_err(|e| io_failure(format!("--doc {}: {e}", path.display())))?;
+    let new = splice_doc(&text, block).map_err(|e| invalid(format!("--doc {}: {e}", path.display())))?;
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    write_all_atomic(dir, &[(&name, new.as_bytes())])
+        .map_err(|e| io_failure(format!("--doc {}: {e}", path.display())))?;
+    Ok(())
 }
 
 impl ValidateArgs {
@@ -47,6 +72,9 @@ pub fn validate(a: &ValidateArgs) -> Result<(), Failure> {
     ];
     geartherm::report::plots::render_validation(out.path(), &r.rows, &texts)
         .map_err(|e| io_failure(format!("validate: {e}")))?;
+    if let Some(doc) = &a.doc {
+        write_doc(doc, &doc_block(&r.rows, &r.summary))?;
+    }
     if a.json {
         emit_json(&ValidationReport {
             rows: &r.rows,

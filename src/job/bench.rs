@@ -4,7 +4,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::solve::transient::{Method, DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL};
-use crate::solve::work_precision::{pareto, reference, sweep, to_csv, BenchRow, Reference};
+use crate::solve::work_precision::{pareto, reference, sweep, to_csv};
+pub use crate::solve::work_precision::{BenchRow, Reference};
 
 use super::limits;
 use super::run::{method, prepare, RunOptions};

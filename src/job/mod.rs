@@ -39,3 +39,6 @@ pub use model::Model;
 pub use run::{RunOptions, RunResult};
 pub use steady::{SteadyOptions, SteadyResult};
 pub use validate::{ValidateOptions, ValidateResult};
+
+/// A loss model used outside its fitted range (every job's results carry these).
+pub use crate::scene::RangeWarning;

@@ -9,13 +9,14 @@ use crate::report::run::{check_finite, summary, timeseries_csv, Summary};
 use crate::scene::{Needs, Scene};
 use crate::solve::drive::{row_inputs, segments};
 use crate::solve::transient::{
-    check_stored_values, integrate, Method, Restart, Segment, Trajectory, TransientOptions, DEFAULT_ATOL,
-    DEFAULT_METHOD, DEFAULT_RTOL,
+    check_stored_values, integrate, Method, Restart, Segment, Trajectory, TransientOptions,
 };
 
 use super::envelope::{Envelope, OilRange};
 use super::limits::{self, Limit};
 use super::{JobError, Model};
+
+pub use crate::solve::transient::{DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL};
 
 /// Largest relative energy-balance residual a run may return (a converged integration closes
 /// it to about 1e-7; a residual near 1 means the numbers are meaningless).

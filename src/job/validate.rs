@@ -5,8 +5,7 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use crate::solve::validation::stats::SummaryRow;
-use crate::solve::validation::{run_all, summarise, Row};
+use crate::reference::{run_all, summarise, Row, SummaryRow};
 
 use super::JobError;
 

@@ -184,6 +184,19 @@ pub struct BearingSpec {
     /// Lubrication: `oil_bath` (default; K_rs 3e-8) or `grease` (K_rs 6e-8, no drag).
     #[serde(default)]
     pub lubrication: Option<String>,
+    /// SKF μ_bl (default: the catalogue oil's fitted value for this kind of bearing, else 0.12).
+    #[serde(default)]
+    pub mu_bl: Option<f64>,
+    /// SKF μ_EHL (default: the oil's fitted value, else SKF's by type: 0.05 balls, 0.02
+    /// cylindrical, 0.002 tapered).
+    #[serde(default)]
+    pub mu_ehl: Option<f64>,
+    /// SKF drag term: `skf_current` (default) or `skf_older` (docs/physics.md §Bearings).
+    #[serde(default)]
+    pub drag_form: Option<String>,
+    /// V_M of the drag term (default: SKF's diagram at the bearing's oil height).
+    #[serde(default)]
+    pub drag_vm: Option<f64>,
     /// Thermal nodes that receive the heat with fractions (default: the member's or planet's
     /// body node, else the oil).
     #[serde(default)]

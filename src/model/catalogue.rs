@@ -28,6 +28,24 @@ pub struct CatalogueOil {
     /// Why the density is what it is, when assumed.
     #[serde(default)]
     pub density_note: Option<String>,
+    /// Base stock (absent: not stated by the source).
+    #[serde(default)]
+    pub base: Option<crate::physics::oil::BaseOil>,
+    /// Lubricant factor X_L measured for this oil.
+    #[serde(default)]
+    pub lubricant_factor: Option<f64>,
+    /// Where the X_L comes from (required with `lubricant_factor`).
+    #[serde(default)]
+    pub lubricant_factor_source: Option<String>,
+    /// Fitted SKF (μ_bl, μ_EHL) of roller bearings in this oil.
+    #[serde(default)]
+    pub bearing_mu_roller: Option<[f64; 2]>,
+    /// Fitted SKF (μ_bl, μ_EHL) of ball bearings in this oil.
+    #[serde(default)]
+    pub bearing_mu_ball: Option<[f64; 2]>,
+    /// Where the bearing μ come from.
+    #[serde(default)]
+    pub bearing_mu_source: Option<String>,
     /// Where the data come from.
     pub source: String,
 }
@@ -66,11 +84,30 @@ mod tests {
     #[test]
     fn catalogue_parses_and_has_every_oil() {
         let all: Vec<CatalogueOil> = toml::from_str::<CatalogueFile>(OILS_TOML).unwrap().oil;
-        assert_eq!(all.len(), 19);
+        assert_eq!(all.len(), 26);
         for o in &all {
             assert!(o.nu40_cst > o.nu100_cst && o.nu100_cst > 0.0, "{}", o.key);
             assert!((700.0..1100.0).contains(&o.rho15_kg_m3), "{}", o.key);
             assert!(!o.source.is_empty());
+            // a measured X_L carries its source
+            assert_eq!(
+                o.lubricant_factor.is_some(),
+                o.lubricant_factor_source.is_some(),
+                "{}",
+                o.key
+            );
+        }
+        // the FZG group's tested oils, by GEARpie's names, with their fitted X_L
+        for (k, xl) in [
+            ("m100", 0.846),
+            ("m320", 0.846),
+            ("e320", 0.65),
+            ("g320", 0.585),
+            ("p150", 0.65),
+            ("p320", 0.65),
+            ("prp", 0.65),
+        ] {
+            assert_eq!(find(k).and_then(|o| o.lubricant_factor), Some(xl), "{k}");
         }
         assert!(find("w211").is_some() && find("W326").is_some());
         assert!(find("FVA 3A reference oil").is_some());

@@ -6,7 +6,9 @@ use super::schema::LossesSpec;
 use crate::physics::losses::churning::{
     changenet::ChangenetParams, seetharaman::CavityTerm, ChurningConfig, ChurningModel,
 };
-use crate::physics::losses::sliding::friction::{BenedictKelley, FrictionLaw, IsoTc60, Schlenk};
+use crate::physics::losses::sliding::friction::{
+    BenedictKelley, ContactLineLoad, FrictionLaw, IsoTc60, Schlenk,
+};
 use crate::physics::losses::sliding::helical::HelicalDistribution;
 use crate::physics::losses::sliding::load_sharing::LoadSharing;
 use crate::physics::losses::sliding::moment_balance::LossForm;
@@ -16,6 +18,9 @@ use crate::physics::losses::sliding::SlidingOptions;
 pub const DEFAULT_FRICTION: &str = "schlenk";
 /// Default line-load distribution of helical meshes (docs/validation.md, "Defaults").
 pub const DEFAULT_HELICAL_DISTRIBUTION: &str = "uniform";
+/// Default load per length of Schlenk's μ (docs/validation.md, "Contact-line load"): the FZG
+/// group's F_bn/l_min, with which their oils' X_L were fitted.
+pub const DEFAULT_CONTACT_LINE_LOAD: &str = "contact_line";
 
 /// Default discharge coefficient of pocketing (physics.md §6: 0.6–0.7).
 pub const DEFAULT_DISCHARGE_COEFFICIENT: f64 = 0.65;
@@ -45,6 +50,7 @@ fn choice<'a>(
 pub fn validate_losses(
     l: &LossesSpec,
     sump_volume_l: Option<f64>,
+    oil_lubricant_factor: f64,
     problems: &mut Problems,
 ) -> Option<LossModels> {
     let start = problems.len();
@@ -143,10 +149,22 @@ pub fn validate_losses(
     };
 
     // Sliding.
-    let xl = l.lubricant_factor.unwrap_or(1.0);
+    // X_L: the key when given, else the oil's (its measured value, else its base's).
+    let xl = l.lubricant_factor.unwrap_or(oil_lubricant_factor);
     problems.in_range("losses.lubricant_factor", xl, 0.3, 2.0, "");
+    let line_load = match choice(
+        problems,
+        "losses.contact_line_load",
+        &l.contact_line_load,
+        &["contact_line", "face_width"],
+        DEFAULT_CONTACT_LINE_LOAD,
+    ) {
+        Some("face_width") => ContactLineLoad::FaceWidth,
+        _ => ContactLineLoad::ContactLine,
+    };
     let schlenk = Schlenk {
         x_l: xl,
+        line_load,
         ..Schlenk::default()
     };
     let friction = match choice(

@@ -44,6 +44,12 @@ pub struct OilSpec {
     /// Walther constant: `astm_d341` (0.7, default), `c06` (0.6, seed 001), `c08` (0.8, DIN 51563).
     #[serde(default)]
     pub walther: Option<WaltherVariant>,
+    /// Base stock (`mineral`, `pao`, `ester`, `pag`, ...): sets the default lubricant factor.
+    #[serde(default)]
+    pub base: Option<crate::physics::oil::BaseOil>,
+    /// Lubricant factor X_L measured for this oil (default: the base's standard value).
+    #[serde(default)]
+    pub lubricant_factor: Option<f64>,
 }
 
 /// What kind of rotating member (informational; kinematics treats all alike).
@@ -278,9 +284,13 @@ pub struct LossesSpec {
     /// μ for `friction = "constant"`.
     #[serde(default)]
     pub friction_coefficient: Option<f64>,
-    /// Lubricant factor X_L of the Schlenk / ISO/TR 14179-2 law (1.0 mineral, 0.8 PAO, ...).
+    /// Lubricant factor X_L of the Schlenk / ISO/TR 14179-2 law (default: the oil's).
     #[serde(default)]
     pub lubricant_factor: Option<f64>,
+    /// Load per length in Schlenk's μ: `contact_line` (default, F_bn/l_min) or `face_width`
+    /// (F_bt/b, ISO/TR 14179-2).
+    #[serde(default)]
+    pub contact_line_load: Option<String>,
     /// Spur load sharing: `uniform` (default), `33:67`, `45:55`, `ramp`.
     #[serde(default)]
     pub load_sharing: Option<String>,

@@ -195,6 +195,98 @@ pub struct OilLogSlopes {
     pub rho: f64,
 }
 
+/// Base stock of an oil, for the lubricant factor X_L of the mesh friction coefficient.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BaseOil {
+    /// Mineral oil.
+    Mineral,
+    /// Polyalphaolefin.
+    Pao,
+    /// Ester (other than phosphate ester).
+    Ester,
+    /// Polyglycol, not water-soluble.
+    Pag,
+    /// Polyglycol, water-soluble.
+    PagWaterSoluble,
+    /// Phosphate ester.
+    PhosphateEster,
+    /// Traction fluid.
+    TractionFluid,
+}
+
+impl BaseOil {
+    /// Every base, in the order of [`Self::as_str`]'s names.
+    pub const ALL: [BaseOil; 7] = [
+        BaseOil::Mineral,
+        BaseOil::Pao,
+        BaseOil::Ester,
+        BaseOil::Pag,
+        BaseOil::PagWaterSoluble,
+        BaseOil::PhosphateEster,
+        BaseOil::TractionFluid,
+    ];
+
+    /// Name in model files.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            BaseOil::Mineral => "mineral",
+            BaseOil::Pao => "pao",
+            BaseOil::Ester => "ester",
+            BaseOil::Pag => "pag",
+            BaseOil::PagWaterSoluble => "pag_water_soluble",
+            BaseOil::PhosphateEster => "phosphate_ester",
+            BaseOil::TractionFluid => "traction_fluid",
+        }
+    }
+
+    /// The base named `s` (a model-file name).
+    pub fn parse(s: &str) -> Option<BaseOil> {
+        BaseOil::ALL.into_iter().find(|b| b.as_str() == s)
+    }
+
+    /// The standard's lubricant factor X_L of this base [std]: ISO/TR 15144-1:2014 table 3
+    /// ("the same values the scuffing parts use", ISO/TS 6336-20/-21), as tabulated by an open
+    /// implementation of that standard (search-index file 59400697189; the standard's own text
+    /// was not readable): mineral 1.0, PAO 0.8, polyglycol 0.7 (water-soluble 0.6), phosphate
+    /// ester 1.3, traction fluid 1.5. The table read has no row for other esters: `None`
+    /// (docs/physics.md §7).
+    pub fn standard_lubricant_factor(self) -> Option<f64> {
+        match self {
+            BaseOil::Mineral => Some(1.0),
+            BaseOil::Pao => Some(0.8),
+            BaseOil::Pag => Some(0.7),
+            BaseOil::PagWaterSoluble => Some(0.6),
+            BaseOil::PhosphateEster => Some(1.3),
+            BaseOil::TractionFluid => Some(1.5),
+            BaseOil::Ester => None,
+        }
+    }
+}
+
+/// Where an oil's lubricant factor X_L comes from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LubricantFactorSource {
+    /// Measured (fitted to efficiency tests of this oil) or given for this oil.
+    Oil,
+    /// The standard's value of the oil's base ([`BaseOil::standard_lubricant_factor`]).
+    BaseStandard,
+    /// No base and no value known: 1 (the factor's reference, mineral oil).
+    Unknown,
+}
+
+/// X_L of an oil with measured or given factor `given` and base `base`: `given`, else the
+/// standard's value of the base, else 1; with where it came from.
+pub fn lubricant_factor(given: Option<f64>, base: Option<BaseOil>) -> (f64, LubricantFactorSource) {
+    if let Some(x) = given {
+        return (x, LubricantFactorSource::Oil);
+    }
+    match base.and_then(BaseOil::standard_lubricant_factor) {
+        Some(x) => (x, LubricantFactorSource::BaseStandard),
+        None => (1.0, LubricantFactorSource::Unknown),
+    }
+}
+
 /// A lubricant: Walther viscosity law plus linear density law.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Oil {
@@ -210,6 +302,10 @@ pub struct Oil {
     pub nu40: f64,
     /// ν at 100 °C, m²/s (as given).
     pub nu100: f64,
+    /// Base stock, when known.
+    pub base: Option<BaseOil>,
+    /// Lubricant factor X_L measured or given for this oil (not the base's standard value).
+    pub lubricant_factor: Option<f64>,
 }
 
 /// Oil properties at one temperature.
@@ -244,7 +340,21 @@ impl Oil {
             alpha_t,
             nu40,
             nu100,
+            base: None,
+            lubricant_factor: None,
         })
+    }
+
+    /// The oil with its base stock and its own lubricant factor X_L (either may be unknown).
+    pub fn with_lubricant(mut self, base: Option<BaseOil>, lubricant_factor: Option<f64>) -> Self {
+        self.base = base;
+        self.lubricant_factor = lubricant_factor;
+        self
+    }
+
+    /// X_L of this oil and where it comes from ([`lubricant_factor`]).
+    pub fn lubricant_factor_or_default(&self) -> (f64, LubricantFactorSource) {
+        lubricant_factor(self.lubricant_factor, self.base)
     }
 
     /// Kinematic viscosity at `t_k` (K), m²/s.
@@ -416,5 +526,24 @@ mod tests {
         assert!(Oil::new("x", v, -1.0, 1e-6, 800.0, -6.5e-4).is_err());
         assert!(Oil::new("x", v, 5e-6, 10e-6, 800.0, -6.5e-4).is_err());
         assert!(Oil::new("x", v, 50e-6, 10e-6, 0.0, -6.5e-4).is_err());
+    }
+
+    #[test]
+    fn lubricant_factor_given_then_base_then_one() {
+        use LubricantFactorSource::*;
+        assert_eq!(
+            lubricant_factor(Some(0.846), Some(BaseOil::Mineral)),
+            (0.846, Oil)
+        );
+        assert_eq!(lubricant_factor(None, Some(BaseOil::Pao)), (0.8, BaseStandard));
+        assert_eq!(lubricant_factor(None, Some(BaseOil::Pag)), (0.7, BaseStandard));
+        // no standard row for esters: the reference value 1, marked unknown
+        assert_eq!(lubricant_factor(None, Some(BaseOil::Ester)), (1.0, Unknown));
+        assert_eq!(lubricant_factor(None, None), (1.0, Unknown));
+        for b in BaseOil::ALL {
+            assert_eq!(BaseOil::parse(b.as_str()), Some(b));
+        }
+        let oil = fva3a(WaltherVariant::AstmD341).with_lubricant(Some(BaseOil::Pag), None);
+        assert_eq!(oil.lubricant_factor_or_default(), (0.7, BaseStandard));
     }
 }

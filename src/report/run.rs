@@ -85,6 +85,10 @@ pub struct Summary {
     /// Cycle efficiency, energy-weighted: ∫P_out / ∫P_in over the driving time, with
     /// ∫P_in = ∫P_out + loss energy while driving (`physics::efficiency`).
     pub cycle_efficiency: Option<f64>,
+    /// All-in energy efficiency E_out/(E_out + E_loss), E_loss every loss item's energy over
+    /// the whole cycle (driving, coasting, standing; the engine side's converter and pump
+    /// included) (docs/outputs.md).
+    pub energy_efficiency: Option<f64>,
     /// Temperatures per node, °C.
     pub temperatures_c: BTreeMap<String, TempStats>,
     /// Nodes (capacity nodes then boundaries).
@@ -269,6 +273,7 @@ pub fn summary(
         energy_balance_relative: bal.relative,
         output_energy_j: out_e,
         cycle_efficiency: mean_eff,
+        energy_efficiency: crate::physics::efficiency::efficiency(out_e, by.iter().sum()),
         temperatures_c: temps,
         nodes,
         oil_node: scene.thermal.names[scene.thermal.oil].clone(),

@@ -9,5 +9,4 @@ pub mod sparse_lu;
 pub mod steady;
 pub mod sweep;
 pub mod transient;
-pub mod validation;
 pub mod work_precision;

@@ -8,7 +8,7 @@ use super::Ctx;
 use crate::model::bearings::*;
 use crate::model::gearbox::{Gear, GearMount, PlanetarySet};
 use crate::model::problems::Problems;
-use crate::physics::losses::bearings::skf::{Lubrication, SkfInput};
+use crate::physics::losses::bearings::skf::{DragForm, Lubrication, SkfInput};
 use crate::physics::losses::bearings::{BearingFriction, BearingSize, Palmgren, Skf, SkfConstants, SkfKind};
 use crate::physics::losses::seals::{LipSeal, SealLaw};
 
@@ -42,19 +42,51 @@ const DRAG_VM_ROLLER: [(f64, f64); 14] = [
     (1.20, 1.5e-3),
 ];
 
+/// V_M of the ball drag term against H/d_m: the same digitised diagram of peer [P5] (its ball
+/// curve; numbers read from a figure), linear in between, constant beyond 1.2.
+const DRAG_VM_BALL: [(f64, f64); 14] = [
+    (0.0, 0.0),
+    (0.025, 2e-6),
+    (0.05, 1.2e-5),
+    (0.075, 3.0e-5),
+    (0.10, 6.5e-5),
+    (0.125, 1.0e-4),
+    (0.15, 1.45e-4),
+    (0.175, 1.95e-4),
+    (0.20, 2.45e-4),
+    (0.30, 3.8e-4),
+    (0.50, 5.5e-4),
+    (0.80, 8.0e-4),
+    (1.00, 1.0e-3),
+    (1.20, 1.25e-3),
+];
+
+/// V_M of the curve `table` at oil height `h_over_dm` (H/d_m).
+fn drag_vm_on(table: &[(f64, f64); 14], h_over_dm: f64) -> f64 {
+    let x = h_over_dm.clamp(0.0, 1.2);
+    table.windows(2).find(|w| x <= w[1].0).map_or(table[13].1, |w| {
+        w[0].1 + (w[1].1 - w[0].1) * (x - w[0].0) / (w[1].0 - w[0].0)
+    })
+}
+
 /// V_M of a roller bearing at oil height `h_over_dm` (H/d_m).
 fn drag_vm_roller(h_over_dm: f64) -> f64 {
-    let x = h_over_dm.clamp(0.0, 1.2);
-    DRAG_VM_ROLLER
-        .windows(2)
-        .find(|w| x <= w[1].0)
-        .map_or(DRAG_VM_ROLLER[13].1, |w| {
-            w[0].1 + (w[1].1 - w[0].1) * (x - w[0].0) / (w[1].0 - w[0].0)
-        })
+    drag_vm_on(&DRAG_VM_ROLLER, h_over_dm)
 }
-/// V_M of the SKF drag term, read from the SKF diagram at full immersion by the Python
-/// deep-groove peer (a number read from a figure), used for any immersion depth.
-const DRAG_VM: f64 = 0.0012;
+
+/// V_M of a ball bearing at oil height `h_over_dm` (H/d_m).
+fn drag_vm_ball(h_over_dm: f64) -> f64 {
+    drag_vm_on(&DRAG_VM_BALL, h_over_dm)
+}
+
+/// The drag form named in a model file.
+fn drag_form(s: Option<&str>) -> Option<DragForm> {
+    match s {
+        None | Some("skf_current") => Some(DragForm::Current),
+        Some("skf_older") => Some(DragForm::Older),
+        Some(_) => None,
+    }
+}
 
 /// SKF seal constants (K_S1, K_S2, β) by type and outside diameter D (mm): SKF, as listed by
 /// thermca `bearing.seal_heat_loss` [SKF06] (the 62 < D ≤ 80 mm row agrees with the
@@ -73,6 +105,17 @@ fn seal_constants(kind: BearingType, outside_mm: f64) -> Option<(f64, f64, f64)>
         BearingType::AngularContactBall => Some((0.014, 10.0, 2.0)),
         BearingType::CylindricalRoller => Some((0.032, 50.0, 2.0)),
         _ => None,
+    }
+}
+
+/// The fitted (μ_bl, μ_EHL) of the model's catalogue oil for roller or ball bearings, if it has
+/// them.
+fn oil_bearing_mu(file: &crate::model::schema::ModelFile, roller: bool) -> Option<[f64; 2]> {
+    let oil = crate::model::catalogue::find(file.oil.catalogue.as_deref()?)?;
+    if roller {
+        oil.bearing_mu_roller
+    } else {
+        oil.bearing_mu_ball
     }
 }
 
@@ -308,8 +351,26 @@ pub(super) fn validate_bearings(
                         },
                         drag_vm_roller(oil_above / size.mean()),
                     ),
-                    _ => (MU_EHL, DRAG_VM),
+                    _ => (MU_EHL, drag_vm_ball(oil_above / size.mean())),
                 };
+                // μ_bl, μ_EHL: the entry's, else the oil's fitted pair for this kind of bearing,
+                // else SKF's constants.
+                let oil_mu = oil_bearing_mu(file, entry.kind.is_roller());
+                let mu_bl = b.mu_bl.or(oil_mu.map(|m| m[0])).unwrap_or(MU_BL);
+                let mu_ehl = b.mu_ehl.or(oil_mu.map(|m| m[1])).unwrap_or(mu_ehl);
+                for (k, v) in [("mu_bl", mu_bl), ("mu_ehl", mu_ehl)] {
+                    problems.in_range(&format!("{p}.{k}"), v, 0.0, 0.5, "");
+                }
+                let Some(form) = drag_form(b.drag_form.as_deref()) else {
+                    problems.push(
+                        format!("{p}.drag_form"),
+                        q(b.drag_form.as_deref().unwrap_or_default()),
+                        "must be skf_current or skf_older",
+                    );
+                    continue;
+                };
+                let drag_vm = b.drag_vm.unwrap_or(drag_vm);
+                problems.in_range(&format!("{p}.drag_vm"), drag_vm, 0.0, 0.01, "");
                 let input = SkfInput {
                     kind,
                     constants: SkfConstants {
@@ -325,11 +386,12 @@ pub(super) fn validate_bearings(
                     size,
                     c0: entry.c0_kn * 1e3,
                     lubrication,
-                    mu_bl: MU_BL,
+                    mu_bl,
                     mu_ehl,
                     seal,
                     oil_level: oil_above,
                     drag_vm,
+                    drag_form: form,
                     rows: entry.rows.unwrap_or(1.0),
                     width: entry.b_mm * MM,
                     axial_factor_y: entry.y.unwrap_or(0.0),

@@ -26,6 +26,7 @@ pub(super) fn validate_gears<'a>(
     let mut gear_ix: HashMap<&str, usize> = HashMap::new();
     let mut geoms: Vec<Option<GearGeometry>> = Vec::new();
     let mut gear_member: Vec<Option<usize>> = Vec::new();
+    let roots = super::geometry::mating_tip_roots(file);
     for (i, g) in file.gears.iter().enumerate() {
         let p = format!("gears[{i}]");
         if g.name.trim().is_empty() {
@@ -34,7 +35,7 @@ pub(super) fn validate_gears<'a>(
             problems.push(format!("{p}.name"), q(&g.name), "duplicate gear name");
         }
         gear_member.push(member(&g.member, format!("{p}.member"), problems));
-        geoms.push(gear_geometry(g, &p, problems));
+        geoms.push(gear_geometry(g, &p, roots[i], problems));
     }
     if file.gears.is_empty() {
         problems.push("gears", "[]", "at least one [[gears]] entry is required");

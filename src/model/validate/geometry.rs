@@ -5,8 +5,67 @@ use crate::model::problems::Problems;
 use crate::model::schema::*;
 use crate::physics::geometry::{GearGeometry, GearSpec, MeshGeometry, MeshKind};
 
-/// Geometry of one `[[gears]]` entry at key path `p`.
-pub(super) fn gear_geometry(g: &GearSpecFile, p: &str, problems: &mut Problems) -> Option<GearGeometry> {
+/// Default dedendum factor h_fP of the generating rack, and its addendum h_aP: the basic rack's
+/// bottom clearance is c_P = h_fP − h_aP = 0.25 m_n.
+const RACK_DEDENDUM: f64 = 1.25;
+const RACK_ADDENDUM: f64 = 1.0;
+
+/// Root diameters (mm) that keep the basic rack's bottom clearance c_P·m_n under the mating tip,
+/// per gear, where the default rack's root would leave less [derived]: for an external mesh with
+/// its centre distance a_w and the mating gear's tip diameter d_a2 given, DIN 3960's tip
+/// clearance c = a_w − (d_a2 + d_f1)/2 ≥ c_P·m_n gives d_f1 ≤ 2a_w − d_a2 − 2c_P·m_n. Only gears
+/// whose file gives neither `root_diameter_mm` nor `dedendum_factor` (the rack is then assumed,
+/// not known); a gear in several meshes takes the deepest. `None`: the default rack's root.
+pub(super) fn mating_tip_roots(file: &ModelFile) -> Vec<Option<f64>> {
+    let mut roots: Vec<Option<f64>> = vec![None; file.gears.len()];
+    let ix = |n: &str| file.gears.iter().position(|g| g.name == n);
+    for m in &file.meshes {
+        let (Some(a_w), [n1, n2]) = (m.centre_distance_mm, m.gears.as_slice()) else {
+            continue;
+        };
+        let (Some(i1), Some(i2)) = (ix(n1), ix(n2)) else {
+            continue;
+        };
+        let (a, b) = (&file.gears[i1], &file.gears[i2]);
+        let same = |x: Option<f64>, y: Option<f64>, d: f64| (x.unwrap_or(d) - y.unwrap_or(d)).abs() <= 1e-9;
+        // Only a consistent external pair (a mismatch is reported by the mesh check).
+        if m.kind == Some(MeshKindSpec::Internal)
+            || a.internal
+            || b.internal
+            || (a.module_mm - b.module_mm).abs() > 1e-9 * a.module_mm
+            || !same(a.pressure_angle_deg, b.pressure_angle_deg, 20.0)
+            || !same(a.helix_angle_deg, b.helix_angle_deg, 0.0)
+        {
+            continue;
+        }
+        for (i, mate) in [(i1, i2), (i2, i1)] {
+            let (g, o) = (&file.gears[i], &file.gears[mate]);
+            let Some(da_mate) = o.tip_diameter_mm else {
+                continue;
+            };
+            if g.root_diameter_mm.is_some() || g.dedendum_factor.is_some() {
+                continue;
+            }
+            let mn = g.module_mm;
+            let d = g.teeth as f64 * mn / (g.helix_angle_deg.unwrap_or(0.0) * DEG).cos();
+            let df_rack = d + 2.0 * mn * (g.profile_shift.unwrap_or(0.0) - RACK_DEDENDUM);
+            let df_clear = 2.0 * a_w - da_mate - 2.0 * (RACK_DEDENDUM - RACK_ADDENDUM) * mn;
+            if df_clear.is_finite() && df_clear > 0.0 && df_clear < df_rack {
+                roots[i] = Some(roots[i].map_or(df_clear, |r: f64| r.min(df_clear)));
+            }
+        }
+    }
+    roots
+}
+
+/// Geometry of one `[[gears]]` entry at key path `p`; `root_default` (mm) replaces the default
+/// rack's root ([`mating_tip_roots`]).
+pub(super) fn gear_geometry(
+    g: &GearSpecFile,
+    p: &str,
+    root_default: Option<f64>,
+    problems: &mut Problems,
+) -> Option<GearGeometry> {
     let before = problems.len();
     let min_teeth = if g.internal { 20 } else { 5 };
     if g.teeth < min_teeth || g.teeth > 1000 {
@@ -32,7 +91,7 @@ pub(super) fn gear_geometry(g: &GearSpecFile, p: &str, problems: &mut Problems) 
     );
     let ha = g.addendum_factor.unwrap_or(1.0);
     problems.in_range(&format!("{p}.addendum_factor"), ha, 0.5, 1.5, "");
-    let hf = g.dedendum_factor.unwrap_or(1.25);
+    let hf = g.dedendum_factor.unwrap_or(RACK_DEDENDUM);
     problems.in_range(&format!("{p}.dedendum_factor"), hf, 0.8, 1.8, "");
     let rho = g.tool_tip_radius_factor.unwrap_or(0.25);
     problems.in_range(&format!("{p}.tool_tip_radius_factor"), rho, 0.0, 0.5, "");
@@ -61,7 +120,7 @@ pub(super) fn gear_geometry(g: &GearSpecFile, p: &str, problems: &mut Problems) 
     if let Some(d) = g.tip_diameter_mm {
         spec = spec.with_tip_diameter(d * MM);
     }
-    if let Some(d) = g.root_diameter_mm {
+    if let Some(d) = g.root_diameter_mm.or(root_default) {
         spec = spec.with_root_diameter(d * MM);
     }
     match GearGeometry::new(&spec) {

@@ -126,9 +126,11 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
     let (gears, level) = lubrication::validate_lubrication(&ctx, &sets, &meshes, &mounts, problems);
     let (bearings, seals) = bearings::validate_bearings(&ctx, &gears, &sets, level, problems);
     let lub = &file.lubrication;
+    let oil_x_l = oil.as_ref().map_or(1.0, |o| o.lubricant_factor_or_default().0);
     let losses = super::losses::validate_losses(
         &file.losses.clone().unwrap_or_default(),
         lub.sump_volume_l,
+        oil_x_l,
         problems,
     );
     let element_names: Vec<&str> = file.shift_elements.iter().map(|e| e.name.as_str()).collect();

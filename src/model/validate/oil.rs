@@ -10,7 +10,7 @@ use crate::physics::oil::{Oil, WaltherVariant, ALPHA_T_MINERAL, CST};
 pub(super) fn validate_oil(o: &OilSpec, problems: &mut Problems) -> Option<Oil> {
     let variant = o.walther.unwrap_or(WaltherVariant::AstmD341);
     let inline = o.nu40_cst.is_some() || o.nu100_cst.is_some() || o.rho15_kg_m3.is_some();
-    let (name, nu40, nu100, rho15, alpha) = match (&o.catalogue, inline) {
+    let (name, nu40, nu100, rho15, alpha, base, x_l) = match (&o.catalogue, inline) {
         (Some(_), true) => {
             problems.push(
                 "oil",
@@ -26,6 +26,8 @@ pub(super) fn validate_oil(o: &OilSpec, problems: &mut Problems) -> Option<Oil> 
                 e.nu100_cst,
                 e.rho15_kg_m3,
                 o.thermal_expansion_per_k.unwrap_or(e.thermal_expansion_per_k),
+                o.base.or(e.base),
+                o.lubricant_factor.or(e.lubricant_factor),
             ),
             None => {
                 let keys: Vec<String> = catalogue::oils().into_iter().map(|e| e.key).collect();
@@ -62,6 +64,8 @@ pub(super) fn validate_oil(o: &OilSpec, problems: &mut Problems) -> Option<Oil> 
                 o.nu100_cst.unwrap_or_default(),
                 o.rho15_kg_m3.unwrap_or_default(),
                 o.thermal_expansion_per_k.unwrap_or(ALPHA_T_MINERAL),
+                o.base,
+                o.lubricant_factor,
             )
         }
     };
@@ -69,6 +73,9 @@ pub(super) fn validate_oil(o: &OilSpec, problems: &mut Problems) -> Option<Oil> 
     ok &= problems.in_range("oil.nu100_cst", nu100, 0.5, 1000.0, " cSt");
     ok &= problems.in_range("oil.rho15_kg_m3", rho15, 600.0, 1200.0, " kg/m3");
     ok &= problems.in_range("oil.thermal_expansion_per_k", alpha, -2e-3, 0.0, " 1/K");
+    if let Some(x) = o.lubricant_factor {
+        ok &= problems.in_range("oil.lubricant_factor", x, 0.3, 2.0, "");
+    }
     if ok && nu40 <= nu100 {
         problems.push(
             "oil.nu100_cst",
@@ -81,7 +88,7 @@ pub(super) fn validate_oil(o: &OilSpec, problems: &mut Problems) -> Option<Oil> 
         return None;
     }
     match Oil::new(name, variant, nu40 * CST, nu100 * CST, rho15, alpha) {
-        Ok(oil) => Some(oil),
+        Ok(oil) => Some(oil.with_lubricant(base, x_l)),
         Err(e) => {
             problems.push("oil", "", e.to_string());
             None

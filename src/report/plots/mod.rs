@@ -224,16 +224,14 @@ pub fn render_map(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
 /// `error_vs_speed_sliding.png`, `error_vs_speed_churning.png`.
 pub fn render_validation(
     dir: &Path,
-    rows: &[crate::solve::validation::Row],
+    rows: &[crate::reference::Row],
     texts: &[(&str, String)],
 ) -> Result<Vec<PathBuf>, PlotError> {
     std::fs::create_dir_all(dir).map_err(|e| io_err(dir, e))?;
     style::ensure_fonts()?;
-    let pick = |q: &str| -> Vec<&crate::solve::validation::Row> {
-        rows.iter().filter(|r| r.quantity == q).collect()
-    };
+    let pick = |q: &str| -> Vec<&crate::reference::Row> { rows.iter().filter(|r| r.quantity == q).collect() };
     let (sl, ch) = (pick("sliding"), pick("churning"));
-    let el: Vec<&crate::solve::validation::Row> = rows
+    let el: Vec<&crate::reference::Row> = rows
         .iter()
         .filter(|r| !matches!(r.quantity, "sliding" | "churning" | "efficiency"))
         .collect();

@@ -6,7 +6,7 @@ use plotters::series::DashedLineSeries;
 
 use super::style::{self, LegendEntry, Marker, Swatch};
 use super::{Canvas, DrawResult};
-use crate::solve::validation::Row;
+use crate::reference::Row;
 
 /// Model choices in first-seen order (colour index).
 fn models(rows: &[&Row]) -> Vec<String> {

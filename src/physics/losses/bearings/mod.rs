@@ -11,7 +11,7 @@ pub mod palmgren;
 pub mod skf;
 
 pub use palmgren::Palmgren;
-pub use skf::{Skf, SkfConstants, SkfKind};
+pub use skf::{DragForm, Skf, SkfConstants, SkfKind};
 
 /// A bearing's boundary dimensions, m.
 #[derive(Debug, Clone, Copy, PartialEq)]

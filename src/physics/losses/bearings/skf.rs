@@ -138,6 +138,22 @@ fn dm_powers(kind: SkfKind, dm: f64) -> [f64; 4] {
     }
 }
 
+/// Which edition of SKF's oil-bath drag term.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DragForm {
+    /// The current SKF publication (module docs): `0.4·V_M·K_ball·d_m^5·n²` (balls) or
+    /// `4·V_M·K_roll·C_w·B·d_m^4·n²` (rollers), plus the rotating-volume term
+    /// `1.093e-7·n²·d_m³·(n·d_m²·f_t/ν)^−1.379·R_s`.
+    #[default]
+    Current,
+    /// The older edition, as the FZG group's bearing code writes it (cfernandesFEUP/
+    /// Gear-Calculation `GearC/bearings.py` @0e4a135, `beart`): `V_M·K_ball·d_m^5·n²` (balls,
+    /// K_ball without the row count: i_rw = 1 there) or `10·V_M·K_roll·B·d_m^4·n²` (rollers), no
+    /// rotating-volume term. The SKF catalogue edition itself was not readable. That code's `pl`
+    /// doubles the term (`Mdrag = 2*(Kdrag*n**2)`, reason not stated); this form does not.
+    Older,
+}
+
 /// Lubrication method (sets K_rs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Lubrication {
@@ -171,6 +187,8 @@ pub struct SkfInput {
     pub oil_level: f64,
     /// V_M of the drag term (SKF diagram; dimensionless).
     pub drag_vm: f64,
+    /// Edition of the drag term.
+    pub drag_form: DragForm,
     /// Rows of rolling elements i_rw.
     pub rows: f64,
     /// Width B, m (roller drag term; unused for ball bearings).
@@ -230,14 +248,26 @@ impl Skf {
                     )));
                 }
                 let k_roll = c.k_l * c.k_z * (d + big_d) / (big_d - d) * 1e-12;
-                let l_d = 5.0 * c.k_l * b / dm;
-                let c_w = (2.789e-10 * l_d.powi(3) - 2.786e-4 * l_d * l_d + 0.0195 * l_d + 0.6439).max(0.0);
-                4.0 * i.drag_vm * k_roll * c_w * b * dm.powi(4)
+                match i.drag_form {
+                    DragForm::Current => {
+                        let l_d = 5.0 * c.k_l * b / dm;
+                        let c_w =
+                            (2.789e-10 * l_d.powi(3) - 2.786e-4 * l_d * l_d + 0.0195 * l_d + 0.6439).max(0.0);
+                        4.0 * i.drag_vm * k_roll * c_w * b * dm.powi(4)
+                    }
+                    DragForm::Older => 10.0 * i.drag_vm * k_roll * b * dm.powi(4),
+                }
             } else {
                 let k_ball = i.rows * c.k_z * (d + big_d) / (big_d - d) * 1e-12;
-                0.4 * i.drag_vm * k_ball * dm.powi(5)
+                match i.drag_form {
+                    DragForm::Current => 0.4 * i.drag_vm * k_ball * dm.powi(5),
+                    DragForm::Older => i.drag_vm * k_ball * dm.powi(5),
+                }
             };
-            (first, 1.093e-7 * dm.powi(3) * r_s, dm * dm * f_t)
+            match i.drag_form {
+                DragForm::Current => (first, 1.093e-7 * dm.powi(3) * r_s, dm * dm * f_t),
+                DragForm::Older => (first, 0.0, 0.0),
+            }
         } else {
             (0.0, 0.0, 0.0)
         };

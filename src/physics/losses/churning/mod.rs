@@ -90,10 +90,10 @@ impl ChurningGear {
         if self.teeth < 3 {
             return Err(ChurningError::InvalidGear("teeth must be >= 3"));
         }
-        if !(self.root_radius < self.pitch_radius && self.pitch_radius < self.tip_radius) {
-            return Err(ChurningError::InvalidGear(
-                "radii must satisfy root < pitch < tip",
-            ));
+        // The pitch circle may lie outside [root, tip]: a profile shift above the rack's
+        // dedendum lifts the root over it (x > 1.25), below minus its addendum the tip under it.
+        if self.root_radius >= self.tip_radius {
+            return Err(ChurningError::InvalidGear("radii must satisfy root < tip"));
         }
         if !(self.helix_angle.is_finite() && self.helix_angle.abs() < 0.5 * PI - 1e-6) {
             return Err(ChurningError::InvalidGear("helix_angle must be in (-pi/2, pi/2)"));

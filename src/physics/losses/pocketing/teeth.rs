@@ -117,10 +117,12 @@ fn check_gear(
             format!("must be finite with |β| < 1.1 rad, got {helix_angle}"),
         ));
     }
-    if !(x.is_finite() && x.abs() <= 2.0) {
+    // The profile shift is limited by the geometry itself (pointed teeth, a tooth space closed
+    // at the form circle: `from_geometry`), not by a range of its own.
+    if !x.is_finite() {
         return Err(PocketingError::InvalidInput(
             "x",
-            format!("profile shift must be in [−2, 2], got {x}"),
+            format!("profile shift must be finite, got {x}"),
         ));
     }
     if !(rho_fp.is_finite() && (0.0..=1.0).contains(&rho_fp)) {

@@ -350,6 +350,40 @@ pub(crate) fn build_spur(
     Ok((samples, elements))
 }
 
+/// Minimum over a mesh cycle of the total length of the lines of contact, m [derived]: path of
+/// contact of length `path_length` g_α, transverse base pitch `p_bt`, face width `b`, base helix
+/// angle `beta_b`. A tooth whose line enters the zone at s (along the path) holds the part of
+/// [s, s + b·tan β_b] inside [0, g_α], of length overlap/sin β_b along the line (b for a spur
+/// tooth inside the zone); the total over the teeth k·p_bt apart is piecewise linear in s with
+/// its breakpoints at −b·tan β_b, g_α − b·tan β_b, 0 and g_α (mod p_bt), where its minimum lies.
+/// Spur: ⌊ε_α⌋·b. The same rigid line model as GEARpie's `LOAD_SHARING.LINES` (which samples it
+/// on a grid).
+pub fn min_contact_length(path_length: f64, p_bt: f64, b: f64, beta_b: f64) -> f64 {
+    if !(path_length > 0.0 && p_bt > 0.0 && b > 0.0) {
+        return 0.0;
+    }
+    if beta_b < super::SPUR_BETA_B {
+        return (path_length / p_bt).floor() * b;
+    }
+    let w = b * beta_b.tan();
+    let sin_b = beta_b.sin();
+    let total = |s: f64| -> f64 {
+        let k0 = ((-w - s) / p_bt).floor() as i64;
+        let k1 = ((path_length - s) / p_bt).ceil() as i64;
+        (k0..=k1)
+            .map(|k| {
+                let lo = s + k as f64 * p_bt;
+                ((lo + w).min(path_length) - lo.max(0.0)).max(0.0)
+            })
+            .sum::<f64>()
+            / sin_b
+    };
+    [-w, path_length - w, 0.0, path_length]
+        .into_iter()
+        .map(|x| total(x.rem_euclid(p_bt)))
+        .fold(f64::INFINITY, f64::min)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -457,5 +491,40 @@ mod tests {
         assert!(p.eps_alpha() > 1.6 && p.eps_alpha() < 2.0, "{}", p.eps_alpha());
         // concave-convex reduced radius is larger than ρ1
         assert!(p.reduced_radius_t(0.0) > p.rho1(0.0));
+    }
+
+    #[test]
+    fn min_contact_length_matches_a_fine_scan_and_the_spur_count() {
+        // spur: ⌊ε_α⌋ lines of length b
+        assert_eq!(min_contact_length(1.44, 1.0, 0.014, 0.0), 0.014);
+        assert_eq!(min_contact_length(2.1, 1.0, 0.014, 0.0), 0.028);
+        // helical: the breakpoint minimum equals a fine scan of the phase, and lies between the
+        // bounds (ε_α·ε_β − 1)·b/(ε_β cos β_b) … ε_α·b/cos β_b
+        for (g, p, b, bb) in [
+            (1.4, 1.0, 3.0, 0.25),
+            (1.7, 1.0, 0.9, 0.3),
+            (2.3, 1.0, 5.0, 0.2),
+            (1.1, 1.0, 0.5, 0.6),
+        ] {
+            let w = b * f64::tan(bb);
+            let scan = (0..20_000)
+                .map(|i| {
+                    let s = i as f64 / 20_000.0 * p;
+                    (-10..=10)
+                        .map(|k| {
+                            let lo = s + k as f64 * p;
+                            ((lo + w).min(g) - lo.max(0.0)).max(0.0)
+                        })
+                        .sum::<f64>()
+                        / f64::sin(bb)
+                })
+                .fold(f64::INFINITY, f64::min);
+            let exact = min_contact_length(g, p, b, bb);
+            assert!(
+                exact <= scan + 1e-12 && scan - exact < 1e-3 * scan,
+                "{exact} {scan}"
+            );
+            assert!(exact < g / p * b / f64::cos(bb));
+        }
     }
 }

@@ -137,14 +137,17 @@ impl IsoTc60 {
 
 /// Schlenk's mean coefficient, ISO/TR 14179-2 [std]:
 /// `μ_mz = 0.048·(F_bt/b/(v_ΣC·ρ_redC))^0.2·η^−0.05·Ra^0.25·X_L`,
-/// F_bt/b N/mm, v_ΣC m/s, ρ_redC mm, η mPa·s, Ra µm. X_L lubricant factor [recalled values]:
-/// 1.0 mineral oil, 0.8 PAO, ≈0.7 PAG (keep configurable).
+/// F_bt/b N/mm, v_ΣC m/s, ρ_redC mm, η mPa·s, Ra µm. X_L: the oil's lubricant factor
+/// (`physics::oil::lubricant_factor`). The load per length and the radius it is divided by
+/// follow [`ContactLineLoad`] (the mesh computes both: `SlidingMesh::mu_mz`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Schlenk {
     /// Coefficient (0.048).
     pub coefficient: f64,
     /// Lubricant factor X_L (1.0 mineral oil).
     pub x_l: f64,
+    /// Which load per length and radius enter the bracket.
+    pub line_load: ContactLineLoad,
 }
 
 impl Default for Schlenk {
@@ -152,8 +155,26 @@ impl Default for Schlenk {
         Self {
             coefficient: 0.048,
             x_l: 1.0,
+            line_load: ContactLineLoad::default(),
         }
     }
+}
+
+/// The load per length and the radius of curvature in Schlenk's bracket `w/(v_ΣC·ρ_C)`.
+///
+/// The two agree on spur gears with ε_α < 2 (l_min = b, β_b = 0); on a helical mesh the bracket
+/// of `FaceWidth` over that of `ContactLine` is cos²β_b·l_min/b (μ ∝ its 0.2 power).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ContactLineLoad {
+    /// ISO/TR 14179-2 [std]: w = F_bt/b (transverse load over the face width) with the
+    /// normal-section ρ_redC = ρ_t,C/cos β_b.
+    FaceWidth,
+    /// The FZG group's form, GEARpie `CLASSES/CONTACT.py` (cfernandesFEUP/GEARpie @cb30c91,
+    /// `CoF`): w = F_bn/l_min, the normal load over the minimum total length of the contact lines
+    /// over a mesh cycle, with the transverse ρ_t,C. Their lubricant factors X_L were fitted with
+    /// this form (docs/validation.md, "Contact-line load").
+    #[default]
+    ContactLine,
 }
 
 impl Schlenk {

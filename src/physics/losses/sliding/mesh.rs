@@ -2,7 +2,7 @@
 //! [`SlidingMesh::power`] evaluates them without allocating (physics.md §7).
 
 use super::contact::{self, ContactElement, ContactPath, Sample};
-use super::friction::{ContactState, FrictionLaw, Schlenk, SCHLENK_VISCOSITY_EXPONENT};
+use super::friction::{ContactLineLoad, ContactState, FrictionLaw, Schlenk, SCHLENK_VISCOSITY_EXPONENT};
 use super::helical::{self, HelicalDistribution};
 use super::moment_balance::{self, LossForm};
 use super::{
@@ -24,6 +24,8 @@ pub struct SlidingMesh {
     /// Σ weight·force·|s| (gear 1 / gear 2 driving), for the μ-independent fast path.
     unit_fwd: f64,
     unit_rev: f64,
+    /// Minimum total length of the contact lines over a mesh cycle, m.
+    min_contact_length: f64,
 }
 
 impl SlidingMesh {
@@ -100,6 +102,8 @@ impl SlidingMesh {
         };
         let unit_fwd = elements.iter().map(|e| e.pw_fwd * e.abs_s).sum();
         let unit_rev = elements.iter().map(|e| e.pw_rev * e.abs_s).sum();
+        let min_contact_length =
+            contact::min_contact_length(path.length(), path.p_bt, input.face_width, input.base_helix_angle);
         Ok(Self {
             input: *input,
             options: *options,
@@ -112,7 +116,14 @@ impl SlidingMesh {
             elements,
             unit_fwd,
             unit_rev,
+            min_contact_length,
         })
+    }
+
+    /// Minimum total length of the lines of contact over one mesh cycle, m
+    /// ([`contact::min_contact_length`]).
+    pub fn min_contact_length(&self) -> f64 {
+        self.min_contact_length
     }
 
     /// The path of contact.
@@ -153,12 +164,23 @@ impl SlidingMesh {
         )
     }
 
-    /// Schlenk's μ_mz (ISO/TR 14179-2) at this operating point: F_bt/b = |T1|/(r_b1 b),
-    /// v_ΣC = ω1ρ1C + ω2ρ2C, ρ_redC = R_t(C)/cos β_b.
+    /// Schlenk's μ_mz (ISO/TR 14179-2) at this operating point, v_ΣC = ω1ρ1C + ω2ρ2C, with the
+    /// load per length and radius of `law.line_load`: F_bt/b = |T1|/(r_b1 b) over
+    /// ρ_redC = R_t(C)/cos β_b ([`ContactLineLoad::FaceWidth`]), or
+    /// F_bn/l_min = |T1|/(r_b1 cos β_b l_min) over R_t(C) ([`ContactLineLoad::ContactLine`]).
     pub fn mu_mz(&self, torque1: f64, omega1: f64, omega2: f64, oil: OilState, law: &Schlenk) -> f64 {
-        let load = torque1.abs() / (self.input.base_radius1 * self.input.face_width);
+        let f_bt = torque1.abs() / self.input.base_radius1;
         let v_sum = omega1.abs() * self.path.rho1(0.0) + omega2.abs() * self.path.rho2(0.0);
-        let rho = self.path.reduced_radius_t(0.0) / self.cos_bb;
+        let rho_t = self.path.reduced_radius_t(0.0);
+        let (load, rho) = match law.line_load {
+            ContactLineLoad::FaceWidth => (f_bt / self.input.face_width, rho_t / self.cos_bb),
+            // A mesh whose contact lines vanish at some phase (ε_γ = 1 exactly) has no l_min
+            // to divide by: the face width stands in.
+            ContactLineLoad::ContactLine if self.min_contact_length > 0.0 => {
+                (f_bt / (self.cos_bb * self.min_contact_length), rho_t)
+            }
+            ContactLineLoad::ContactLine => (f_bt / (self.cos_bb * self.input.face_width), rho_t),
+        };
         law.mu_mz(load, v_sum, rho, oil.dynamic_viscosity, self.roughness)
     }
 
@@ -918,5 +940,32 @@ mod tests {
             SlidingMesh::new(&high, &o33),
             Err(SlidingError::ContactRatio { .. })
         ));
+    }
+
+    #[test]
+    fn contact_line_and_face_width_loads_differ_by_the_line_ratio() {
+        use super::super::friction::ContactLineLoad;
+        for beta in [0.0, 15f64.to_radians(), 33.5f64.to_radians()] {
+            let inp = seed_input(beta);
+            let mesh = SlidingMesh::new(&inp, &SlidingOptions::default()).unwrap();
+            let law = |f| Schlenk {
+                line_load: f,
+                ..Schlenk::default()
+            };
+            let (t, w) = (150.0, 210.0);
+            let iso = mesh.mu_mz(t, w, w, OIL, &law(ContactLineLoad::FaceWidth));
+            let line = mesh.mu_mz(t, w, w, OIL, &law(ContactLineLoad::ContactLine));
+            let cb = inp.base_helix_angle.cos();
+            let ratio = (cb * cb * mesh.min_contact_length() / inp.face_width).powf(0.2);
+            assert!(
+                (iso / line / ratio - 1.0).abs() < 1e-12,
+                "{beta}: {iso} {line} {ratio}"
+            );
+            if beta == 0.0 {
+                assert!((iso / line - 1.0).abs() < 1e-15);
+            } else {
+                assert!((iso / line - 1.0).abs() > 1e-3);
+            }
+        }
     }
 }

@@ -1,5 +1,7 @@
-//! Reference cases (`validation/<case>/case.toml`) evaluated with every applicable model choice
-//! (docs/validation.md).
+//! Reference cases and their comparison: each case of `validation/<case>/case.toml` evaluated
+//! with every applicable model choice and compared with its reference (docs/validation.md). This
+//! layer reads case files and loads models; it calls no solver (it evaluates the loss scene at
+//! fixed operating points). Checking a model file's input is `model`'s job, not this one's.
 //!
 //! A case names a model file, a quantity (any loss source, optionally one item, or the
 //! efficiency over chosen sources), the kind of reference (peer, standard, measurement, trend,
@@ -46,9 +48,9 @@ pub struct Row {
     pub relative_error: f64,
 }
 
-/// A case that could not be evaluated.
+/// A reference case that could not be evaluated.
 #[derive(Debug, thiserror::Error)]
-pub enum ValidationError {
+pub enum ReferenceError {
     /// Unreadable or malformed case or reference file.
     #[error("{}: {msg}", path.display())]
     Case {
@@ -70,8 +72,8 @@ pub enum ValidationError {
 }
 
 /// Every case directory under `dir` (those holding a `case.toml`), sorted.
-pub fn case_dirs(dir: &Path) -> Result<Vec<PathBuf>, ValidationError> {
-    let rd = std::fs::read_dir(dir).map_err(|e| ValidationError::Case {
+pub fn case_dirs(dir: &Path) -> Result<Vec<PathBuf>, ReferenceError> {
+    let rd = std::fs::read_dir(dir).map_err(|e| ReferenceError::Case {
         path: dir.to_path_buf(),
         msg: e.to_string(),
     })?;
@@ -84,7 +86,7 @@ pub fn case_dirs(dir: &Path) -> Result<Vec<PathBuf>, ValidationError> {
 }
 
 /// Evaluate every case under `dir` with every model choice of its family.
-pub fn run_all(dir: &Path) -> Result<Vec<Row>, ValidationError> {
+pub fn run_all(dir: &Path) -> Result<Vec<Row>, ReferenceError> {
     let mut rows = Vec::new();
     for d in case_dirs(dir)? {
         rows.extend(run_case(&Case::load(&d)?)?);
@@ -93,74 +95,85 @@ pub fn run_all(dir: &Path) -> Result<Vec<Row>, ValidationError> {
 }
 
 /// Evaluate one case.
-pub fn run_case(c: &Case) -> Result<Vec<Row>, ValidationError> {
+pub fn run_case(c: &Case) -> Result<Vec<Row>, ReferenceError> {
     let mut rows = Vec::new();
     for (label, keys) in &c.choices {
-        let gb = c.gearbox(keys).map_err(|msg| ValidationError::Model {
-            path: c.model_path.clone(),
-            choice: label.to_string(),
+        for oil in c.oils() {
+            rows.extend(run_choice(c, label, keys, oil.as_deref())?);
+        }
+    }
+    Ok(rows)
+}
+
+/// One model choice of a case with one oil (`None`: the model's): its points, and with the
+/// model's own oil its range and trend checks.
+fn run_choice(
+    c: &Case,
+    label: &str,
+    keys: &[(&str, toml::Value)],
+    oil: Option<&str>,
+) -> Result<Vec<Row>, ReferenceError> {
+    let mut rows = Vec::new();
+    let gb = c.gearbox(keys, oil).map_err(|msg| ReferenceError::Model {
+        path: c.model_path.clone(),
+        choice: label.to_string(),
+        msg,
+    })?;
+    let scene = LossScene::compile(&gb).map_err(|e| ReferenceError::Model {
+        path: c.model_path.clone(),
+        choice: label.to_string(),
+        msg: e.to_string(),
+    })?;
+    let eval = |gear: &str, rpm: f64, torque: f64, temp: f64| -> Result<f64, ReferenceError> {
+        value(&gb, &scene, c, gear, rpm, torque, temp).map_err(|msg| ReferenceError::Case {
+            path: c.dir.join("case.toml"),
             msg,
-        })?;
-        let scene = LossScene::compile(&gb).map_err(|e| ValidationError::Model {
-            path: c.model_path.clone(),
-            choice: label.to_string(),
-            msg: e.to_string(),
-        })?;
-        let eval = |gear: &str, rpm: f64, torque: f64, temp: f64| -> Result<f64, ValidationError> {
-            value(&gb, &scene, c, gear, rpm, torque, temp).map_err(|msg| ValidationError::Case {
-                path: c.dir.join("case.toml"),
-                msg,
-            })
+        })
+    };
+    let row = |point: &str, speed_rpm: f64, predicted: f64, reference: f64, kind: Kind| Row {
+        case: c.name.clone(),
+        point: point.to_string(),
+        model: label.to_string(),
+        quantity: c.quantity.as_str(),
+        speed_rpm,
+        predicted,
+        reference,
+        kind,
+        source: c.source.clone(),
+        relative_error: (predicted - reference) / reference,
+    };
+    for p in c.points.iter().filter(|p| p.oil.as_deref() == oil) {
+        let predicted = eval(&p.gear, p.speed_rpm, p.torque_nm, p.oil_temp_c)?;
+        let name = match &p.oil {
+            Some(o) => format!("{} {o}", p.point),
+            None => p.point.clone(),
         };
-        for p in &c.points {
-            let predicted = eval(&p.gear, p.speed_rpm, p.torque_nm, p.oil_temp_c)?;
-            rows.push(Row {
-                case: c.name.clone(),
-                point: p.point.clone(),
-                model: label.to_string(),
-                quantity: c.quantity.as_str(),
-                speed_rpm: p.speed_rpm,
-                predicted,
-                reference: p.reference_w,
-                kind: c.kind,
-                source: c.source.clone(),
-                relative_error: (predicted - p.reference_w) / p.reference_w,
-            });
-        }
-        for r in &c.ranges {
-            let predicted = eval(&r.gear, r.speed_rpm, r.torque_nm, r.oil_temp_c)?;
-            let reference = predicted.clamp(r.low, r.high);
-            rows.push(Row {
-                case: c.name.clone(),
-                point: r.point.clone(),
-                model: label.to_string(),
-                quantity: c.quantity.as_str(),
-                speed_rpm: r.speed_rpm,
-                predicted,
-                reference,
-                kind: c.kind,
-                source: c.source.clone(),
-                relative_error: (predicted - reference) / reference,
-            });
-        }
-        for t in &c.trends {
-            let pa = eval(&t.gear, t.speed_a_rpm, t.torque_nm, t.oil_temp_c)?;
-            let pb = eval(&t.gear, t.speed_b_rpm, t.torque_nm, t.oil_temp_c)?;
-            let predicted = t.metric.value(pa, pb, t.speed_a_rpm, t.speed_b_rpm);
-            let reference = predicted.clamp(t.low, t.high);
-            rows.push(Row {
-                case: c.name.clone(),
-                point: t.point.clone(),
-                model: label.to_string(),
-                quantity: c.quantity.as_str(),
-                speed_rpm: t.speed_b_rpm,
-                predicted,
-                reference,
-                kind: Kind::Trend,
-                source: c.source.clone(),
-                relative_error: (predicted - reference) / reference,
-            });
-        }
+        rows.push(row(&name, p.speed_rpm, predicted, p.reference_w, c.kind));
+    }
+    if oil.is_some() {
+        return Ok(rows);
+    }
+    for r in &c.ranges {
+        let predicted = eval(&r.gear, r.speed_rpm, r.torque_nm, r.oil_temp_c)?;
+        rows.push(row(
+            &r.point,
+            r.speed_rpm,
+            predicted,
+            predicted.clamp(r.low, r.high),
+            c.kind,
+        ));
+    }
+    for t in c.trends.iter().filter(|t| !t.exclude.iter().any(|e| e == label)) {
+        let pa = eval(&t.gear, t.speed_a_rpm, t.torque_nm, t.oil_temp_c)?;
+        let pb = eval(&t.gear, t.speed_b_rpm, t.torque_nm, t.oil_temp_c)?;
+        let predicted = t.metric.value(pa, pb, t.speed_a_rpm, t.speed_b_rpm);
+        rows.push(row(
+            &t.point,
+            t.speed_b_rpm,
+            predicted,
+            predicted.clamp(t.low, t.high),
+            Kind::Trend,
+        ));
     }
     Ok(rows)
 }
@@ -216,11 +229,17 @@ fn value(
     }
 }
 
-/// Load a model file with `[losses]` keys written over its own; a key `bearings.<k>` is written
+/// Load a model file with `[losses]` keys written over its own (and its `[oil]` replaced by the
+/// catalogue oil `oil` when given); a key `bearings.<k>` is written
 /// into every `[[bearings]]` entry instead.
-pub fn load_with(path: &Path, keys: &[(&str, toml::Value)]) -> Result<Gearbox, String> {
+pub fn load_with(path: &Path, keys: &[(&str, toml::Value)], oil: Option<&str>) -> Result<Gearbox, String> {
     let text = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
     let mut doc: toml::Table = text.parse().map_err(|e: toml::de::Error| e.to_string())?;
+    if let Some(o) = oil {
+        let mut t = toml::Table::new();
+        t.insert("catalogue".into(), toml::Value::String(o.into()));
+        doc.insert("oil".into(), toml::Value::Table(t));
+    }
     for (k, v) in keys {
         if let Some(bk) = k.strip_prefix("bearings.") {
             let Some(list) = doc.get_mut("bearings").and_then(|b| b.as_array_mut()) else {

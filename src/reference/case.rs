@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::ValidationError;
+use super::ReferenceError;
 use crate::model::Gearbox;
 use crate::scene::Source;
 
@@ -21,6 +21,10 @@ pub enum Kind {
     /// A handbook's range of values (e.g. typical efficiencies of a kind of gearbox): neither a
     /// measurement of this gearbox nor a model's output; the value must fall in the range.
     Handbook,
+    /// A self-consistency check: the project's own formula evaluated by hand, or the model's own
+    /// input table. It shows the model runs its formula or table as written, not that either
+    /// is right; kept apart from peers, standards and measurements in every summary.
+    SelfConsistency,
 }
 
 impl Kind {
@@ -32,6 +36,7 @@ impl Kind {
             Kind::Measurement => "measurement",
             Kind::Trend => "trend",
             Kind::Handbook => "handbook",
+            Kind::SelfConsistency => "self_consistency",
         }
     }
 
@@ -86,6 +91,13 @@ pub struct TrendCheck {
     pub low: f64,
     /// Upper end of the range.
     pub high: f64,
+    /// Model choices this check is not run with, because for them it cannot fail (the metric
+    /// is a constant of the law inside the range); `exclude_reason` says why.
+    #[serde(default)]
+    pub exclude: Vec<String>,
+    /// Why the excluded choices are excluded.
+    #[serde(default)]
+    pub exclude_reason: Option<String>,
 }
 
 /// One range check at one operating point (a handbook's range of a quantity).
@@ -123,6 +135,9 @@ pub struct Point {
     pub oil_temp_c: f64,
     /// Reference value, W.
     pub reference_w: f64,
+    /// Catalogue oil of this point (the model's `[oil]` replaced by it), if given.
+    #[serde(default)]
+    pub oil: Option<String>,
 }
 
 #[derive(Debug, serde::Deserialize)]
@@ -179,9 +194,9 @@ pub struct Case {
 
 impl Case {
     /// Read `dir/case.toml` and its reference CSV.
-    pub fn load(dir: &Path) -> Result<Case, ValidationError> {
+    pub fn load(dir: &Path) -> Result<Case, ReferenceError> {
         let path = dir.join("case.toml");
-        let bad = |msg: String| ValidationError::Case {
+        let bad = |msg: String| ReferenceError::Case {
             path: path.clone(),
             msg,
         };
@@ -194,17 +209,17 @@ impl Case {
                 .comment(Some(b'#'))
                 .trim(csv::Trim::All)
                 .from_path(&rp)
-                .map_err(|e| ValidationError::Case {
+                .map_err(|e| ReferenceError::Case {
                     path: rp.clone(),
                     msg: e.to_string(),
                 })?;
             for rec in rd.deserialize::<Point>() {
-                let p = rec.map_err(|e| ValidationError::Case {
+                let p = rec.map_err(|e| ReferenceError::Case {
                     path: rp.clone(),
                     msg: e.to_string(),
                 })?;
                 if !(p.reference_w.is_finite() && p.reference_w > 0.0) {
-                    return Err(ValidationError::Case {
+                    return Err(ReferenceError::Case {
                         path: rp.clone(),
                         msg: format!("point {}: reference_w must be > 0", p.point),
                     });
@@ -214,6 +229,13 @@ impl Case {
         }
         if points.is_empty() && f.trend.is_empty() && f.range.is_empty() {
             return Err(bad("no reference points, trend or range checks".into()));
+        }
+        if let Some(t) = f
+            .trend
+            .iter()
+            .find(|t| !t.exclude.is_empty() && t.exclude_reason.is_none())
+        {
+            return Err(bad(format!("trend {}: exclude needs exclude_reason", t.point)));
         }
         if let Some(r) = f
             .range
@@ -252,14 +274,29 @@ impl Case {
         })
     }
 
-    /// The gearbox with the case's overrides and then `keys` written over `[losses]`.
-    pub fn gearbox(&self, keys: &[(&str, toml::Value)]) -> Result<Gearbox, String> {
+    /// The gearbox with the case's overrides and then `keys` written over `[losses]`, and its
+    /// `[oil]` replaced by the catalogue oil `oil` when given.
+    pub fn gearbox(&self, keys: &[(&str, toml::Value)], oil: Option<&str>) -> Result<Gearbox, String> {
         let mut all: Vec<(&str, toml::Value)> = self
             .overrides
             .iter()
             .map(|(k, v)| (k.as_str(), v.clone()))
             .collect();
         all.extend(keys.iter().cloned());
-        super::load_with(&self.model_path, &all)
+        super::load_with(&self.model_path, &all, oil)
+    }
+
+    /// The distinct oils of the points (`None`: the model's own), in first-seen order.
+    pub fn oils(&self) -> Vec<Option<String>> {
+        let mut v: Vec<Option<String>> = Vec::new();
+        for p in &self.points {
+            if !v.contains(&p.oil) {
+                v.push(p.oil.clone());
+            }
+        }
+        if v.is_empty() {
+            v.push(None);
+        }
+        v
     }
 }

@@ -111,6 +111,8 @@ fn sliding_choices() -> Vec<Choice> {
         ]
     };
     vec![
+        // The model file as it is: every sliding default, the oil's X_L.
+        ("default", vec![off("churning"), off("pocketing")]),
         ("iso_tc60", det("iso_tc60", "uniform", "uniform")),
         ("benedict_kelley", det("benedict_kelley", "uniform", "uniform")),
         ("schlenk", det("schlenk", "uniform", "uniform")),
