@@ -141,25 +141,78 @@ fn jobs_of(spec: &JobSpec) -> Result<Vec<Job>, String> {
             speed_rpm,
             torque_nm,
             vehicle_speed_kmh,
-        } => speed_rpm
-            .iter()
-            .flat_map(|&s| {
-                torque_nm.iter().map(move |&t| {
-                    Job::Steady(SteadyOptions {
-                        gear: gear.clone(),
-                        speed_rpm: s,
-                        torque_nm: t,
-                        vehicle_speed_kmh: *vehicle_speed_kmh,
-                        ambient_c: None,
+        } => {
+            // The grid's size and values are checked as `geartherm map` checks them, before its
+            // points are built.
+            let grid = job::MapOptions {
+                gear: gear.clone(),
+                speed_rpm: speed_rpm.clone(),
+                torque_nm: torque_nm.clone(),
+                vehicle_speed_kmh: *vehicle_speed_kmh,
+                ambient_c: None,
+            };
+            grid.check().map_err(|e| format!("job: {}", e.message))?;
+            speed_rpm
+                .iter()
+                .flat_map(|&s| {
+                    torque_nm.iter().map(move |&t| {
+                        Job::Steady(SteadyOptions {
+                            gear: gear.clone(),
+                            speed_rpm: s,
+                            torque_nm: t,
+                            vehicle_speed_kmh: *vehicle_speed_kmh,
+                            ambient_c: None,
+                        })
                     })
                 })
-            })
-            .collect(),
+                .collect()
+        }
     };
     if jobs.is_empty() {
         return Err("job: no cycles or points".into());
     }
     Ok(jobs)
+}
+
+/// A study's name names its default output directory (`studies/<name>`): a plain name
+/// ([`model::parse::is_plain_name`]) that is one path component, neither `.` nor `..`.
+fn check_name(name: &str) -> Result<(), String> {
+    if model::parse::is_plain_name(name) && !name.contains('/') && name != "." && name != ".." {
+        return Ok(());
+    }
+    Err(format!(
+        "study.name = {name:?}: must be a plain name usable as a directory name: 1–{} characters, \
+         no `/`, no control characters, none of , \" ' | \\ ; `, not `.` or `..`",
+        model::parse::MAX_NAME_LEN
+    ))
+}
+
+/// Run jobs whose cycles give one case-id key (the same cycle twice, or two files with one
+/// name) would share case ids, and a resumed study would take one for the other.
+fn check_distinct_cycles(jobs: &[Job]) -> Result<(), String> {
+    let mut seen = std::collections::BTreeMap::new();
+    for (k, j) in jobs.iter().enumerate() {
+        if let Job::Run(o) = j {
+            if let Some(first) = seen.insert(cycle_key(&o.cycle), k) {
+                return Err(format!(
+                    "job.cycles[{first}] and job.cycles[{k}] ({}) give the same case id `{}`: \
+                     each cycle once, with distinct file names",
+                    o.cycle,
+                    cycle_key(&o.cycle)
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The case-id key of a cycle: its file stem, made a plain directory-name part.
+fn cycle_key(cycle: &str) -> String {
+    key_of(
+        Path::new(cycle)
+            .file_stem()
+            .map_or(cycle, |s| s.to_str().unwrap_or("cycle")),
+    )
 }
 
 /// Every job's options checked before any case runs (their ranges, the cycles read, the gear
@@ -275,6 +328,7 @@ impl Study {
     /// exist in the model (or be accepted by its schema), the plan must be well formed.
     pub fn new(spec: StudySpec, model_text: String, model_file: PathBuf) -> Result<Study, StudyError> {
         let invalid = StudyError::Invalid;
+        check_name(&spec.study.name).map_err(invalid)?;
         let base_model =
             job::Model::from_text(&model_text, &model_file, &[]).map_err(|e| invalid(e.message))?;
         let mut problems = model::Problems::default();
@@ -318,7 +372,16 @@ impl Study {
             }
         }
         let jobs = jobs_of(&spec.job).map_err(invalid)?;
+        if samples.len().saturating_mul(jobs.len()) > plan::MAX_SAMPLES {
+            return Err(invalid(format!(
+                "{} samples × {} jobs: more than {} cases",
+                samples.len(),
+                jobs.len(),
+                plan::MAX_SAMPLES
+            )));
+        }
         check_jobs(&spec.job, &jobs, &base_model)?;
+        check_distinct_cycles(&jobs).map_err(invalid)?;
         check_outputs(&spec.outputs, &output_columns(&jobs, &base_model)?)?;
         let spec_json = serde_json::to_string(&spec).map_err(|e| invalid(e.to_string()))?;
         let fingerprint = format!("{:016x}", fnv1a(&[spec_json.as_bytes(), model_text.as_bytes()]));
@@ -357,11 +420,7 @@ impl Study {
     /// Case id: `<sample>-<job>` (usable as a directory name).
     pub fn case_id(&self, c: &Case) -> String {
         let job = match &self.jobs[c.job] {
-            Job::Run(o) => key_of(
-                Path::new(&o.cycle)
-                    .file_stem()
-                    .map_or(&*o.cycle, |s| s.to_str().unwrap_or("cycle")),
-            ),
+            Job::Run(o) => cycle_key(&o.cycle),
             Job::Steady(_) => format!("p{:04}", c.job),
         };
         format!("{:06}-{job}", c.sample)

@@ -41,6 +41,11 @@ __all__ = [
 
 __version__ = _native.version()
 
+# The errors are defined in the native module; named as this package's, they pickle (through a
+# process pool, to a Dask worker and back) and unpickle as the same class, with their key path.
+for _e in (GearthermError, ModelError, InputError, SolveError):
+    _e.__module__ = __name__
+
 
 def toml_value(v: Any) -> str:
     """A Python value as TOML value text (numbers, strings, booleans, lists, dicts)."""
@@ -124,6 +129,8 @@ class Model:
         """A new model with values overridden by key path, e.g.
         ``{"lubrication.oil_level_mm": 55, 'thermal.coolers["atf_cooler"].effectiveness': 0.8}``;
         checked exactly like the file (a :class:`ModelError` names the path and the override)."""
+        if not isinstance(values, Mapping):
+            raise TypeError(f"override(): values must be a mapping of key path to value, not {type(values).__name__}")
         return Model(self._m.with_overrides([f"{k} = {toml_value(v)}" for k, v in values.items()]))
 
     @property
@@ -240,10 +247,15 @@ def _spec(
     sampling: Optional[Mapping[str, Any]],
     name: str,
 ) -> Dict[str, Any]:
-    if isinstance(parameters, Mapping):
+    if isinstance(parameters, Mapping) and all(isinstance(s, Mapping) for s in parameters.values()):
         params = [dict(spec, path=path) for path, spec in parameters.items()]
-    else:
+    elif isinstance(parameters, (list, tuple)) and all(isinstance(p, Mapping) for p in parameters):
         params = [dict(p) for p in parameters]
+    else:
+        raise TypeError(
+            "study(): parameters must be a mapping {key path: {\"range\" | \"values\" | \"scale\": ...}} "
+            f"or a list of such mappings with a \"path\", not {type(parameters).__name__}"
+        )
     return {
         "study": {"name": name, "model": ""},
         "job": dict(job) if job is not None else {"kind": "run", "cycles": ["wltc"]},
@@ -272,6 +284,19 @@ def _rows_to_frame(rows: List[Dict[str, Any]]):
             rec[k] = math.nan if v is None else v
         records.append(rec)
     return pd.DataFrame.from_records(records)
+
+
+def _case_indices(cases, n: int) -> List[int]:
+    """`cases` as distinct positions in [0, n), each once (a case run twice would be two rows)."""
+    import operator
+
+    todo = [operator.index(i) for i in cases]
+    for i in todo:
+        if not 0 <= i < n:
+            raise InputError(f"cases: {i}: must lie in [0, {n}) (the study has {n} cases)")
+    if len(set(todo)) != len(todo):
+        raise InputError("cases: a case is given more than once; each case runs once")
+    return todo
 
 
 def study(
@@ -310,7 +335,7 @@ def study(
     spec_json = json.dumps(_spec(parameters, job, sampling, name))
     text, file = model.text, model._m.file
     _, ids = _native.study_cases(spec_json, text, file)
-    todo = list(range(len(ids))) if cases is None else [int(i) for i in cases]
+    todo = list(range(len(ids))) if cases is None else _case_indices(cases, len(ids))
     n = len(todo)
     if client is None:
         rows = json.loads(_native.run_cases(spec_json, text, file, todo, threads_per_task))
