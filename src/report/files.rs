@@ -357,6 +357,36 @@ fn resolve(target: &Path) -> Result<PathBuf, OutputError> {
     }
 }
 
+/// The path a user knows for `path`: a file in the temporary directory of a transaction on
+/// `dir/name` (`dir/.name.geartherm-tmp-<pid>-<n>/file`) is named by its place in the target
+/// (`dir/name/file`); the `./` [`OutputDir::begin`] puts before a bare name is left out again.
+/// Other paths are returned as they are. For error messages.
+pub fn user_path(path: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    let mut parts = path.components().peekable();
+    while let Some(c) = parts.next() {
+        let staged = |c: Option<&std::path::Component>| {
+            c.and_then(|c| staging_target(c.as_os_str().to_str()?)).is_some()
+        };
+        match c {
+            std::path::Component::CurDir if out.as_os_str().is_empty() && staged(parts.peek()) => {}
+            c => match staging_target(c.as_os_str().to_str().unwrap_or("")) {
+                Some(name) => out.push(name),
+                None => out.push(c),
+            },
+        }
+    }
+    out
+}
+
+/// The target name of a transaction's temporary directory name `.name.geartherm-tmp-<pid>-<n>`.
+fn staging_target(dir_name: &str) -> Option<&str> {
+    let (name, tail) = dir_name.strip_prefix('.')?.rsplit_once(".geartherm-tmp-")?;
+    let (pid, n) = tail.split_once('-')?;
+    let numbers = pid.parse::<u32>().is_ok() && n.parse::<u128>().is_ok();
+    (numbers && !name.is_empty()).then_some(name)
+}
+
 fn unique() -> u128 {
     std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
@@ -500,6 +530,35 @@ pub fn replace_all_atomic(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<Pat
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_file_of_a_transaction_is_named_by_its_place_in_the_target() {
+        let cases = [
+            ("./.rd.geartherm-tmp-12-345/summary.json", "rd/summary.json"),
+            (
+                "/tmp/.rd.geartherm-tmp-12-345/summary.json",
+                "/tmp/rd/summary.json",
+            ),
+            ("../x/.a.b.geartherm-tmp-1-2/map.csv", "../x/a.b/map.csv"),
+            // Not a transaction's directory: kept.
+            (
+                "./.rd.geartherm-tmp-x-2/summary.json",
+                "./.rd.geartherm-tmp-x-2/summary.json",
+            ),
+            ("./rd/summary.json", "./rd/summary.json"),
+            ("rd/summary.json", "rd/summary.json"),
+        ];
+        for (path, shown) in cases {
+            assert_eq!(user_path(Path::new(path)), PathBuf::from(shown), "{path}");
+        }
+        // What `begin` makes is what `user_path` undoes.
+        let d = tempfile::tempdir().unwrap();
+        let out = OutputDir::begin(&d.path().join("run")).unwrap();
+        assert_eq!(
+            user_path(&out.path().join("summary.json")),
+            d.path().join("run/summary.json")
+        );
+    }
 
     fn names(d: &Path) -> Vec<String> {
         let mut v: Vec<String> = fs::read_dir(d)

@@ -14,7 +14,7 @@ use crate::model::Gearbox;
 use crate::physics::losses::clutch_drag::ClutchPack;
 use crate::physics::oil::OilProperties;
 
-use super::losses::{DefaultHeat, LossItem, Skipped, Source};
+use super::items::{DefaultHeat, LossItem, Skipped, Source};
 
 #[derive(Debug, Clone)]
 struct PackEntry {

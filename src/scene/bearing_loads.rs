@@ -186,36 +186,10 @@ fn body_of(gb: &Gearbox, g: usize) -> Body {
 
 /// Applied forces and bearing reactions in state `si` per unit input torque.
 pub fn state_loads(gb: &Gearbox, si: usize) -> StateLoads {
-    let forces = mesh_forces(gb, si);
-    let mut applied: Vec<(Body, PointForce)> = Vec::new();
-    for (m, pair) in gb.meshes.iter().zip(&forces) {
-        for (k, g) in [(0, m.gear1), (1, m.gear2)] {
-            let body = body_of(gb, g);
-            let f = pair[k];
-            match (m.set, body) {
-                // A central gear of a set with N ≥ 2 equally spaced planets: the transverse
-                // forces and the tilting moments of the N meshes cancel; the axial forces add.
-                (Some(si_), Body::Member(_)) if gb.planetary_sets[si_].planets >= 2 => {
-                    let n = gb.planetary_sets[si_].planets as f64;
-                    applied.push((
-                        body,
-                        PointForce {
-                            at: [0.0, 0.0, f.at[2]],
-                            force: [0.0, 0.0, n * f.force[2]],
-                        },
-                    ));
-                }
-                _ => applied.push((body, f)),
-            }
-        }
-    }
-    // Bodies carrying bearings.
-    let body_of_bearing = |b: &crate::model::bearings::Bearing| match b.mount {
-        BearingMount::Member { member, .. } => Body::Member(member),
-        BearingMount::Planet { gear } => Body::Planet(gear),
-    };
+    let applied = applied_forces(gb, si);
     let mut reactions = vec![PointForce::default(); gb.bearings.len()];
     let mut pin_moments = Vec::new();
+    // Bodies carrying bearings.
     let mut bodies: Vec<Body> = gb.bearings.iter().map(body_of_bearing).collect();
     bodies.sort_by_key(|b| match *b {
         Body::Member(i) => (0, i),
@@ -231,44 +205,16 @@ pub fn state_loads(gb: &Gearbox, si: usize) -> StateLoads {
             .filter(|(b, _)| *b == body)
             .map(|(_, f)| *f)
             .collect();
-        let total = mine.iter().fold([0.0; 3], |s, f| add(s, f.force));
         match idx.as_slice() {
             [k] => {
-                let z = gb.bearings[*k].position;
-                reactions[*k] = PointForce {
-                    at: [0.0, 0.0, z],
-                    force: scale(total, -1.0),
-                };
-                // Moment of the applied forces about the bearing point; the shaft or pin takes it.
-                let m = mine.iter().fold([0.0; 3], |s, f| {
-                    add(s, cross([f.at[0], f.at[1], f.at[2] - z], f.force))
-                });
-                pin_moments.push((body, [-m[0], -m[1], 0.0]));
+                let (reaction, pin_moment) = single_bearing_reaction(gb.bearings[*k].position, &mine);
+                reactions[*k] = reaction;
+                pin_moments.push((body, pin_moment));
             }
             [a, b] => {
-                let (za, zb) = (gb.bearings[*a].position, gb.bearings[*b].position);
-                let l = zb - za;
-                let m = mine.iter().fold([0.0; 3], |s, f| {
-                    add(s, cross([f.at[0], f.at[1], f.at[2] - za], f.force))
-                });
-                // Moments about A: M + (0,0,L) × R_B = 0 → R_B = (−M_y/L, M_x/L).
-                let rb = [-m[1] / l, m[0] / l, 0.0];
-                let ra = [-total[0] - rb[0], -total[1] - rb[1], 0.0];
-                let (mut ra, mut rb) = (ra, rb);
-                // Axial load to the locating bearing (validation: exactly one of the two).
-                if gb.bearings[*b].locating && !gb.bearings[*a].locating {
-                    rb[2] = -total[2];
-                } else {
-                    ra[2] = -total[2];
-                }
-                reactions[*a] = PointForce {
-                    at: [0.0, 0.0, za],
-                    force: ra,
-                };
-                reactions[*b] = PointForce {
-                    at: [0.0, 0.0, zb],
-                    force: rb,
-                };
+                let (ra, rb) = bearing_pair_reactions(&gb.bearings[*a], &gb.bearings[*b], &mine);
+                reactions[*a] = ra;
+                reactions[*b] = rb;
             }
             // More than two bearings on one body is rejected by the validation.
             _ => {}
@@ -281,13 +227,91 @@ pub fn state_loads(gb: &Gearbox, si: usize) -> StateLoads {
     }
 }
 
+/// The body a bearing carries.
+fn body_of_bearing(b: &crate::model::bearings::Bearing) -> Body {
+    match b.mount {
+        BearingMount::Member { member, .. } => Body::Member(member),
+        BearingMount::Planet { gear } => Body::Planet(gear),
+    }
+}
+
+/// The mesh forces on every body in state `si` per unit input torque. A central gear of a set
+/// with N ≥ 2 equally spaced planets: the transverse forces and the tilting moments of the N
+/// meshes cancel; the axial forces add.
+fn applied_forces(gb: &Gearbox, si: usize) -> Vec<(Body, PointForce)> {
+    let forces = mesh_forces(gb, si);
+    let mut applied: Vec<(Body, PointForce)> = Vec::new();
+    for (m, pair) in gb.meshes.iter().zip(&forces) {
+        for (k, g) in [(0, m.gear1), (1, m.gear2)] {
+            let body = body_of(gb, g);
+            let f = pair[k];
+            match (m.set, body) {
+                (Some(set), Body::Member(_)) if gb.planetary_sets[set].planets >= 2 => {
+                    let n = gb.planetary_sets[set].planets as f64;
+                    let axial = PointForce {
+                        at: [0.0, 0.0, f.at[2]],
+                        force: [0.0, 0.0, n * f.force[2]],
+                    };
+                    applied.push((body, axial));
+                }
+                _ => applied.push((body, f)),
+            }
+        }
+    }
+    applied
+}
+
+/// A body on one bearing at axial position `z` with the forces `mine`: the bearing's reaction,
+/// and the moment the shaft or pin takes (that of the applied forces about the bearing point).
+fn single_bearing_reaction(z: f64, mine: &[PointForce]) -> (PointForce, [f64; 3]) {
+    let total = mine.iter().fold([0.0; 3], |s, f| add(s, f.force));
+    let reaction = PointForce {
+        at: [0.0, 0.0, z],
+        force: scale(total, -1.0),
+    };
+    let m = mine.iter().fold([0.0; 3], |s, f| {
+        add(s, cross([f.at[0], f.at[1], f.at[2] - z], f.force))
+    });
+    (reaction, [-m[0], -m[1], 0.0])
+}
+
+/// A body on the two bearings `a` and `b` with the forces `mine`: their reactions, the axial
+/// load on the locating one (validation: exactly one of the two).
+fn bearing_pair_reactions(
+    a: &crate::model::bearings::Bearing,
+    b: &crate::model::bearings::Bearing,
+    mine: &[PointForce],
+) -> (PointForce, PointForce) {
+    let total = mine.iter().fold([0.0; 3], |s, f| add(s, f.force));
+    let (za, zb) = (a.position, b.position);
+    let l = zb - za;
+    let m = mine.iter().fold([0.0; 3], |s, f| {
+        add(s, cross([f.at[0], f.at[1], f.at[2] - za], f.force))
+    });
+    // Moments about A: M + (0,0,L) × R_B = 0 → R_B = (−M_y/L, M_x/L).
+    let mut rb = [-m[1] / l, m[0] / l, 0.0];
+    let mut ra = [-total[0] - rb[0], -total[1] - rb[1], 0.0];
+    if b.locating && !a.locating {
+        rb[2] = -total[2];
+    } else {
+        ra[2] = -total[2];
+    }
+    (
+        PointForce {
+            at: [0.0, 0.0, za],
+            force: ra,
+        },
+        PointForce {
+            at: [0.0, 0.0, zb],
+            force: rb,
+        },
+    )
+}
+
 /// Largest residual of force and moment balance over every body with bearings (N and N·m per
 /// unit input torque): applied forces + bearing reactions (+ pin moment for single bearings).
 pub fn balance_residual(gb: &Gearbox, loads: &StateLoads) -> f64 {
-    let body_of_bearing = |k: usize| match gb.bearings[k].mount {
-        BearingMount::Member { member, .. } => Body::Member(member),
-        BearingMount::Planet { gear } => Body::Planet(gear),
-    };
+    let body_of_bearing = |k: usize| body_of_bearing(&gb.bearings[k]);
     let mut worst: f64 = 0.0;
     for k in 0..gb.bearings.len() {
         let body = body_of_bearing(k);

@@ -11,7 +11,7 @@ use crate::physics::losses::seals::LipSeal;
 use crate::physics::oil::OilProperties;
 
 use super::bearing_loads::{magnitudes, state_loads};
-use super::losses::{DefaultHeat, LossItem, Skipped, Source};
+use super::items::{DefaultHeat, LossItem, Skipped, Source};
 
 /// Round-off of the kinematic solve snapped to zero (as for the gear items).
 fn clean(v: f64) -> f64 {

@@ -4,11 +4,15 @@ pub mod automatic;
 pub mod bearing_loads;
 pub mod churn_sample;
 pub mod element_losses;
+pub mod gear_losses;
+pub mod items;
 pub mod losses;
 pub mod planet_churning;
 pub mod ranges;
 pub mod system;
 pub mod thermal;
+pub mod usage;
+pub mod warning;
 
 pub use losses::{
     sum_by_source, DefaultHeat, LossItem, LossScene, Needs, OperatingPoint, PerSource, SampleTerms,

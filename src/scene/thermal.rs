@@ -15,7 +15,7 @@ use crate::physics::thermal::{
     thermostat_opening, FluidProperties, HTable, AIR_50C, OIL_CONDUCTIVITY, OIL_SPECIFIC_HEAT,
 };
 
-use super::losses::{DefaultHeat, LossItem};
+use super::items::{DefaultHeat, LossItem};
 
 /// Endpoint of a compiled link: a state (capacity node) or a boundary.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -169,175 +169,196 @@ fn oil_fluid(oil: &OilProperties) -> FluidProperties {
     }
 }
 
+/// Speed of each gear relative to the surrounding fluid, per unit input speed, per gear state:
+/// the spin for planets (the oil/air in a carrier rotates roughly with it), the absolute speed
+/// otherwise.
+fn fluid_speeds(gb: &Gearbox) -> Vec<Vec<f64>> {
+    (0..gb.gear_states.len())
+        .map(|s| {
+            gb.gear_speeds(s)
+                .iter()
+                .zip(&gb.gears)
+                .map(|(w, g)| match g.mount {
+                    GearMount::Planet { .. } => w.relative,
+                    GearMount::OnMember => w.absolute,
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The network's links sorted by what their conductance depends on.
+#[derive(Default)]
+struct Links {
+    fixed: Vec<Conductance>,
+    sample: Vec<SampleLink>,
+    oil: Vec<OilLink>,
+    radiation: Vec<Radiation>,
+}
+
+impl Links {
+    /// The links of `net`; `speeds[state][gear]` is a gear's speed relative to its fluid per
+    /// unit input speed ([`fluid_speeds`]).
+    fn compile(net: &ThermalNetwork, speeds: &[Vec<f64>]) -> Links {
+        let per_state = |gear: usize| -> Vec<f64> { speeds.iter().map(|s| s[gear].abs()).collect() };
+        let mut links = Links::default();
+        for l in &net.links {
+            let (a, b) = (End::from(l.a), End::from(l.b));
+            let sample = |law| SampleLink { a, b, law };
+            match &l.law {
+                LinkLaw::Conductance(g) => links.fixed.push(Conductance { a, b, g: *g }),
+                LinkLaw::Convection { area, h } => links.fixed.push(Conductance { a, b, g: area * h }),
+                LinkLaw::Table { area, table } => links.sample.push(sample(SampleLaw::Table {
+                    area: *area,
+                    table: table.clone(),
+                })),
+                LinkLaw::Law { area, h0, h1 } => links.sample.push(sample(SampleLaw::Law {
+                    area: *area,
+                    h0: *h0,
+                    h1: *h1,
+                })),
+                LinkLaw::Rotating {
+                    area,
+                    gear,
+                    radius,
+                    fluid: Fluid::Air,
+                } => links.sample.push(sample(SampleLaw::RotatingAir {
+                    area: *area,
+                    radius: *radius,
+                    speed_per_input: per_state(*gear),
+                })),
+                LinkLaw::Rotating {
+                    area,
+                    gear,
+                    radius,
+                    fluid: Fluid::Oil,
+                } => links.oil.push(OilLink {
+                    a,
+                    b,
+                    area: *area,
+                    radius: *radius,
+                    speed_per_input: per_state(*gear),
+                }),
+                LinkLaw::Radiation(k) => links.radiation.push(Radiation { a, b, k: *k }),
+            }
+        }
+        links
+    }
+}
+
+/// The coolers of `net` whose hot side is a capacity node.
+fn cooler_terms(net: &ThermalNetwork) -> Vec<CoolerTerm> {
+    net.coolers
+        .iter()
+        .filter_map(|c| match c.hot {
+            NodeRef::Node(h) => Some(CoolerTerm {
+                hot: h,
+                cold: c.cold.into(),
+                g: c.conductance,
+                thermostat: c.thermostat,
+                two_way: c.two_way,
+            }),
+            NodeRef::Boundary(_) => None,
+        })
+        .collect()
+}
+
+/// Where the heat of loss item `it` goes: (node, fraction), one entry per node, none with a zero
+/// fraction. The last `[[thermal.heat]]` rule for the item wins, then the last rule for its
+/// source, then the item's default.
+fn heat_destination(net: &ThermalNetwork, it: &LossItem) -> Vec<(usize, f64)> {
+    let key = format!("{}:{}", it.source.as_str(), it.name);
+    let rule = net
+        .heat
+        .iter()
+        .rev()
+        .find(|r| r.target == HeatTarget::Item(key.clone()))
+        .or_else(|| {
+            net.heat
+                .iter()
+                .rev()
+                .find(|r| r.target == HeatTarget::Source(it.source.as_str().to_string()))
+        });
+    let mut to: Vec<(usize, f64)> = match rule {
+        Some(r) => r.to.clone(),
+        None => default_destination(net, it),
+    };
+    // Merge duplicates (both gears in one node).
+    to.sort_by_key(|x| x.0);
+    to.dedup_by(|x, y| {
+        if x.0 == y.0 {
+            y.1 += x.1;
+            true
+        } else {
+            false
+        }
+    });
+    to.retain(|x| x.1 != 0.0);
+    to
+}
+
+/// The default heat destination of `it` in `net` (before merging duplicates).
+fn default_destination(net: &ThermalNetwork, it: &LossItem) -> Vec<(usize, f64)> {
+    // The body node of a gear: the node that lists it, else the oil.
+    let body = |gear: usize| -> usize {
+        net.nodes
+            .iter()
+            .position(|x| x.gears.contains(&gear))
+            .unwrap_or(net.oil_node)
+    };
+    match &it.heat {
+        DefaultHeat::Oil => vec![(net.oil_node, 1.0)],
+        DefaultHeat::Gears => it.gears.iter().map(|&(g, f)| (body(g), f)).collect(),
+        DefaultHeat::Member(gears) => gears.iter().map(|&(g, f)| (body(g), f)).collect(),
+        DefaultHeat::Nodes(nodes) => nodes
+            .iter()
+            .flat_map(|(name, f)| named_destination(net, name, *f))
+            .collect(),
+    }
+}
+
+/// Fraction `f` of an item's heat into the node called `name`: a meshed wall's name stands for
+/// its patches (each with its share); an unknown name heats the oil.
+fn named_destination(net: &ThermalNetwork, name: &str, f: f64) -> Vec<(usize, f64)> {
+    match net.groups.iter().find(|g| g.0 == name) {
+        Some(g) => g.1.iter().map(|&(i, s)| (i, f * s)).collect(),
+        None => vec![(
+            net.nodes
+                .iter()
+                .position(|x| x.name == name)
+                .unwrap_or(net.oil_node),
+            f,
+        )],
+    }
+}
+
 impl ThermalScene {
     /// Compile the network of `gb` for the loss items `items`.
     pub fn compile(gb: &Gearbox, net: &ThermalNetwork, items: &[LossItem]) -> ThermalScene {
         let n = net.nodes.len();
-        let names = net.nodes.iter().map(|x| x.name.clone()).collect();
         let capacity: Vec<f64> = net.nodes.iter().map(|x| x.capacity).collect();
         let initial = net
             .nodes
             .iter()
             .map(|x| x.initial_temp.unwrap_or(net.initial_temp))
             .collect();
-        // Speed of each gear relative to the surrounding fluid, per unit input speed: the spin for
-        // planets (the oil/air in a carrier rotates roughly with it), the absolute speed otherwise.
-        let speeds_abs: Vec<Vec<f64>> = (0..gb.gear_states.len())
-            .map(|s| {
-                gb.gear_speeds(s)
-                    .iter()
-                    .zip(&gb.gears)
-                    .map(|(w, g)| match g.mount {
-                        GearMount::Planet { .. } => w.relative,
-                        GearMount::OnMember => w.absolute,
-                    })
-                    .collect()
-            })
-            .collect();
-        let per_state = |gear: usize| -> Vec<f64> { speeds_abs.iter().map(|s| s[gear].abs()).collect() };
-        let mut fixed = Vec::new();
-        let mut sample = Vec::new();
-        let mut oil_links = Vec::new();
-        let mut radiation = Vec::new();
-        for l in &net.links {
-            let (a, b) = (End::from(l.a), End::from(l.b));
-            match &l.law {
-                LinkLaw::Conductance(g) => fixed.push(Conductance { a, b, g: *g }),
-                LinkLaw::Convection { area, h } => fixed.push(Conductance { a, b, g: area * h }),
-                LinkLaw::Table { area, table } => sample.push(SampleLink {
-                    a,
-                    b,
-                    law: SampleLaw::Table {
-                        area: *area,
-                        table: table.clone(),
-                    },
-                }),
-                LinkLaw::Law { area, h0, h1 } => sample.push(SampleLink {
-                    a,
-                    b,
-                    law: SampleLaw::Law {
-                        area: *area,
-                        h0: *h0,
-                        h1: *h1,
-                    },
-                }),
-                LinkLaw::Rotating {
-                    area,
-                    gear,
-                    radius,
-                    fluid,
-                } => match fluid {
-                    Fluid::Air => sample.push(SampleLink {
-                        a,
-                        b,
-                        law: SampleLaw::RotatingAir {
-                            area: *area,
-                            radius: *radius,
-                            speed_per_input: per_state(*gear),
-                        },
-                    }),
-                    Fluid::Oil => oil_links.push(OilLink {
-                        a,
-                        b,
-                        area: *area,
-                        radius: *radius,
-                        speed_per_input: per_state(*gear),
-                    }),
-                },
-                LinkLaw::Radiation(k) => radiation.push(Radiation { a, b, k: *k }),
-            }
-        }
-        let coolers = net
-            .coolers
-            .iter()
-            .filter_map(|c| match c.hot {
-                NodeRef::Node(h) => Some(CoolerTerm {
-                    hot: h,
-                    cold: c.cold.into(),
-                    g: c.conductance,
-                    thermostat: c.thermostat,
-                    two_way: c.two_way,
-                }),
-                NodeRef::Boundary(_) => None,
-            })
-            .collect();
-
-        // Heat destinations: defaults, then source rules, then item rules.
-        let body = |gear: usize| -> usize {
-            net.nodes
-                .iter()
-                .position(|x| x.gears.contains(&gear))
-                .unwrap_or(net.oil_node)
-        };
-        let heat = items
-            .iter()
-            .map(|it| {
-                let key = format!("{}:{}", it.source.as_str(), it.name);
-                let rule = net
-                    .heat
-                    .iter()
-                    .rev()
-                    .find(|r| r.target == HeatTarget::Item(key.clone()))
-                    .or_else(|| {
-                        net.heat
-                            .iter()
-                            .rev()
-                            .find(|r| r.target == HeatTarget::Source(it.source.as_str().to_string()))
-                    });
-                let mut to: Vec<(usize, f64)> = match rule {
-                    Some(r) => r.to.clone(),
-                    None => match &it.heat {
-                        DefaultHeat::Oil => vec![(net.oil_node, 1.0)],
-                        DefaultHeat::Gears => it.gears.iter().map(|&(g, f)| (body(g), f)).collect(),
-                        DefaultHeat::Member(gears) => gears.iter().map(|&(g, f)| (body(g), f)).collect(),
-                        DefaultHeat::Nodes(nodes) => nodes
-                            .iter()
-                            .flat_map(|(name, f)| {
-                                // A meshed wall's name stands for its patches.
-                                match net.groups.iter().find(|g| &g.0 == name) {
-                                    Some(g) => g.1.iter().map(|&(i, s)| (i, f * s)).collect(),
-                                    None => vec![(
-                                        net.nodes
-                                            .iter()
-                                            .position(|x| &x.name == name)
-                                            .unwrap_or(net.oil_node),
-                                        *f,
-                                    )],
-                                }
-                            })
-                            .collect(),
-                    },
-                };
-                // Merge duplicates (both gears in one node).
-                to.sort_by_key(|x| x.0);
-                to.dedup_by(|x, y| {
-                    if x.0 == y.0 {
-                        y.1 += x.1;
-                        true
-                    } else {
-                        false
-                    }
-                });
-                to.retain(|x| x.1 != 0.0);
-                to
-            })
-            .collect();
+        let links = Links::compile(net, &fluid_speeds(gb));
         debug_assert!(net.oil_node < n);
         let mut scene = ThermalScene {
-            names,
+            names: net.nodes.iter().map(|x| x.name.clone()).collect(),
             boundary_names: net.boundaries.iter().map(|b| b.name.clone()).collect(),
             inv_capacity: capacity.iter().map(|c| 1.0 / c).collect(),
             capacity,
             initial,
             oil: net.oil_node,
             ambient: net.ambient(),
-            heat,
+            heat: items.iter().map(|it| heat_destination(net, it)).collect(),
             boundaries: net.boundaries.iter().map(|b| b.temp.clone()).collect(),
-            fixed,
-            sample,
-            oil_links,
-            radiation,
-            coolers,
+            fixed: links.fixed,
+            sample: links.sample,
+            oil_links: links.oil,
+            radiation: links.radiation,
+            coolers: cooler_terms(net),
             oil_model: gb.oil.clone(),
             fixed_partials: Vec::new(),
         };

@@ -5,7 +5,7 @@ use crate::cycle::{schedule_with_launch, CycleError, DriveCycle, GearTable, Sche
 use crate::model::Gearbox;
 use crate::scene::Inputs;
 
-use super::transient::{Segment, Trajectory};
+use super::trajectory::{Segment, Trajectory};
 
 /// The gear table of a gearbox: every gear state with its ratio, in model order (the table index
 /// is the gear-state index).

@@ -1,6 +1,7 @@
 //! Solvers: the transient driver (diffsol) and the steady-state equilibrium search.
 pub mod dense_lu;
 pub mod drive;
+pub(crate) mod driver;
 pub mod equations;
 pub mod equilibrium;
 pub mod rosenbrock;
@@ -8,5 +9,7 @@ pub mod rows;
 pub mod sparse_lu;
 pub mod steady;
 pub mod sweep;
+pub mod trajectory;
 pub mod transient;
+pub mod transient_options;
 pub mod work_precision;

@@ -45,9 +45,10 @@ use diffsol_la::{LinearOp, LinearSolver};
 use diffsol::{FaerSparseMat, NalgebraMat, NalgebraVec};
 
 use super::dense_lu::SmallDenseLu;
+use super::driver::Driver;
 use super::equations::{HostVector, JacobianMatrix, SceneEquations};
 use super::sparse_lu::NetworkSparseLu;
-use super::transient::{Driver, NumericalFailure, Trajectory};
+use super::trajectory::{NumericalFailure, Trajectory};
 
 /// A Rosenbrock tableau in the transformed form (coefficients as KPP/FATODE give them).
 pub struct Tableau {

@@ -209,17 +209,16 @@ pub const TIME_NOISE: f64 = 0.03;
 /// no slower. Failed rows are never on it.
 pub fn pareto(rows: &[BenchRow]) -> Vec<bool> {
     rows.iter()
-        .map(|a| {
-            a.failure.is_none()
-                && a.err_max_k.is_finite()
-                && !rows.iter().any(|b| {
-                    b.failure.is_none()
-                        && ((b.err_max_k <= a.err_max_k
-                            && b.wall_time_s < a.wall_time_s * (1.0 - TIME_NOISE))
-                            || (b.err_max_k <= 0.5 * a.err_max_k && b.wall_time_s <= a.wall_time_s))
-                })
-        })
+        .map(|a| a.failure.is_none() && a.err_max_k.is_finite() && !rows.iter().any(|b| dominates(b, a)))
         .collect()
+}
+
+/// True when the successful row `b` is at least as accurate as `a` and faster by more than the
+/// timing noise, or at least twice as accurate and no slower.
+fn dominates(b: &BenchRow, a: &BenchRow) -> bool {
+    let faster = b.err_max_k <= a.err_max_k && b.wall_time_s < a.wall_time_s * (1.0 - TIME_NOISE);
+    let more_accurate = b.err_max_k <= 0.5 * a.err_max_k && b.wall_time_s <= a.wall_time_s;
+    b.failure.is_none() && (faster || more_accurate)
 }
 
 /// `bench.csv` text.

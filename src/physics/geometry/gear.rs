@@ -265,53 +265,7 @@ impl GearGeometry {
                 m_t * (FRAC_PI_2 + 2.0 * spec.x * tan_an),
             )
         };
-        let mm = |v: f64| v * 1e3;
-        if !(d_f > 0.0) {
-            return Err(GeometryError::Impossible(format!(
-                "root diameter d_f = {:.6} mm is not positive (d = {:.6} mm, m_n = {:.6} mm, x = {})",
-                mm(d_f),
-                mm(d),
-                mm(mn),
-                spec.x
-            )));
-        }
-        if !(d_a > 0.0) {
-            return Err(GeometryError::Impossible(format!(
-                "tip diameter d_a = {:.6} mm is not positive",
-                mm(d_a)
-            )));
-        }
-        if spec.internal {
-            if !(d_f > d_a) {
-                return Err(GeometryError::Impossible(format!(
-                    "ring gear: root diameter {:.6} mm must exceed tip diameter {:.6} mm",
-                    mm(d_f),
-                    mm(d_a)
-                )));
-            }
-            if !(d_a > d_b) {
-                return Err(GeometryError::Impossible(format!(
-                    "ring gear: tip circle d_a = {:.6} mm lies inside the base circle d_b = {:.6} mm (no involute there)",
-                    mm(d_a),
-                    mm(d_b)
-                )));
-            }
-        } else {
-            if !(d_a > d_f) {
-                return Err(GeometryError::Impossible(format!(
-                    "tip diameter {:.6} mm must exceed root diameter {:.6} mm",
-                    mm(d_a),
-                    mm(d_f)
-                )));
-            }
-            if !(d_a > d_b) {
-                return Err(GeometryError::Impossible(format!(
-                    "tip circle d_a = {:.6} mm lies inside the base circle d_b = {:.6} mm",
-                    mm(d_a),
-                    mm(d_b)
-                )));
-            }
-        }
+        check_diameters(spec, d, d_a, d_f, d_b)?;
         let hf_p_eff = if spec.internal {
             (d_f - d) / (2.0 * mn) - spec.x
         } else {
@@ -337,20 +291,7 @@ impl GearGeometry {
         let psi_a = profile.half_thickness_angle(r_a);
         let s_at = 2.0 * r_a * psi_a;
         let e_at = 2.0 * PI * r_a / z - s_at;
-        if !(s_at > 0.0) {
-            return Err(GeometryError::Impossible(format!(
-                "tooth is pointed: thickness on the tip circle d_a = {:.6} mm would be {:.6} mm",
-                mm(d_a),
-                mm(s_at)
-            )));
-        }
-        if !(e_at > 0.0) {
-            return Err(GeometryError::Impossible(format!(
-                "no tooth space left on the tip circle d_a = {:.6} mm (space width {:.6} mm)",
-                mm(d_a),
-                mm(e_at)
-            )));
-        }
+        check_tip_land(d_a, s_at, e_at)?;
         let (x_min, undercut) = if spec.internal {
             (None, false)
         } else {
@@ -451,6 +392,81 @@ impl GearGeometry {
     pub(crate) fn inv_alpha_t(&self) -> f64 {
         inv(self.alpha_t)
     }
+}
+
+/// The diameters of a gear are possible: root and tip circles positive, the tip beyond the root
+/// (inside it for a ring) and beyond the base circle (so that there is an involute).
+fn check_diameters(spec: &GearSpec, d: f64, d_a: f64, d_f: f64, d_b: f64) -> Result<(), GeometryError> {
+    let mn = spec.mn;
+    let mm = |v: f64| v * 1e3;
+    if !(d_f > 0.0) {
+        return Err(GeometryError::Impossible(format!(
+            "root diameter d_f = {:.6} mm is not positive (d = {:.6} mm, m_n = {:.6} mm, x = {})",
+            mm(d_f),
+            mm(d),
+            mm(mn),
+            spec.x
+        )));
+    }
+    if !(d_a > 0.0) {
+        return Err(GeometryError::Impossible(format!(
+            "tip diameter d_a = {:.6} mm is not positive",
+            mm(d_a)
+        )));
+    }
+    if spec.internal {
+        if !(d_f > d_a) {
+            return Err(GeometryError::Impossible(format!(
+                "ring gear: root diameter {:.6} mm must exceed tip diameter {:.6} mm",
+                mm(d_f),
+                mm(d_a)
+            )));
+        }
+        if !(d_a > d_b) {
+            return Err(GeometryError::Impossible(format!(
+                "ring gear: tip circle d_a = {:.6} mm lies inside the base circle d_b = {:.6} mm (no involute there)",
+                mm(d_a),
+                mm(d_b)
+            )));
+        }
+    } else {
+        if !(d_a > d_f) {
+            return Err(GeometryError::Impossible(format!(
+                "tip diameter {:.6} mm must exceed root diameter {:.6} mm",
+                mm(d_a),
+                mm(d_f)
+            )));
+        }
+        if !(d_a > d_b) {
+            return Err(GeometryError::Impossible(format!(
+                "tip circle d_a = {:.6} mm lies inside the base circle d_b = {:.6} mm",
+                mm(d_a),
+                mm(d_b)
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The tooth is not pointed and leaves a space on the tip circle: thickness `s_at` and space
+/// width `e_at` on the tip circle of diameter `d_a` positive.
+fn check_tip_land(d_a: f64, s_at: f64, e_at: f64) -> Result<(), GeometryError> {
+    let mm = |v: f64| v * 1e3;
+    if !(s_at > 0.0) {
+        return Err(GeometryError::Impossible(format!(
+            "tooth is pointed: thickness on the tip circle d_a = {:.6} mm would be {:.6} mm",
+            mm(d_a),
+            mm(s_at)
+        )));
+    }
+    if !(e_at > 0.0) {
+        return Err(GeometryError::Impossible(format!(
+            "no tooth space left on the tip circle d_a = {:.6} mm (space width {:.6} mm)",
+            mm(d_a),
+            mm(e_at)
+        )));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

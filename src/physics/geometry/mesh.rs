@@ -163,80 +163,15 @@ impl MeshGeometry {
         kind: MeshKind,
         centre_distance: Option<f64>,
     ) -> Result<MeshGeometry, GeometryError> {
+        check_pair(g1, g2, kind)?;
         let (s1, s2) = (&g1.spec, &g2.spec);
-        same("normal module mn [m]", s1.mn, s2.mn, 1e-9 * s1.mn.max(s2.mn))?;
-        same(
-            "normal pressure angle alpha_n [rad]",
-            s1.alpha_n,
-            s2.alpha_n,
-            1e-9,
-        )?;
-        same("helix angle beta [rad]", s1.beta, s2.beta, 1e-9)?;
-        if g1.is_internal() {
-            return Err(GeometryError::Impossible(
-                "gear 1 of a mesh must be an external gear (the pinion)".into(),
-            ));
-        }
-        match kind {
-            MeshKind::External if g2.is_internal() => {
-                return Err(GeometryError::Impossible(
-                    "external mesh given a ring gear as gear 2 (use MeshKind::Internal)".into(),
-                ))
-            }
-            MeshKind::Internal if !g2.is_internal() => {
-                return Err(GeometryError::Impossible(
-                    "internal mesh needs a ring (internal gear) as gear 2".into(),
-                ))
-            }
-            MeshKind::Internal if s2.z <= s1.z => {
-                return Err(GeometryError::Impossible(format!(
-                    "internal mesh: ring z2 = {} must have more teeth than pinion z1 = {}",
-                    s2.z, s1.z
-                )))
-            }
-            _ => {}
-        }
         let internal = kind == MeshKind::Internal;
         let (z1, z2) = (f64::from(s1.z), f64::from(s2.z));
         let mn = s1.mn;
         let m_t = g1.m_t;
         let alpha_t = g1.alpha_t;
-        let (zs, xs) = if internal {
-            (z2 - z1, s2.x - s1.x)
-        } else {
-            (z1 + z2, s1.x + s2.x)
-        };
-        let a = m_t * zs / 2.0;
-        // [std] operating pressure angle from the shifts
-        let inv_wt = g1.inv_alpha_t() + 2.0 * s1.alpha_n.tan() * xs / zs;
-        if !(inv_wt > 0.0) {
-            return Err(GeometryError::Impossible(format!(
-                "profile shift sum {xs} too negative: inv α_wt = {inv_wt:e} ≤ 0"
-            )));
-        }
-        let alpha_wt_shift = inv_inverse(inv_wt);
-        let a_w_from_shifts = a * alpha_t.cos() / alpha_wt_shift.cos();
-        let (a_w, alpha_wt) = match centre_distance {
-            None => (a_w_from_shifts, alpha_wt_shift),
-            Some(aw) => {
-                if !(aw.is_finite() && aw > 0.0) {
-                    return Err(GeometryError::InvalidParameter {
-                        name: "centre_distance",
-                        value: aw,
-                        requirement: "must be a finite number > 0",
-                    });
-                }
-                let c = a * alpha_t.cos() / aw;
-                if !(c < 1.0) {
-                    return Err(GeometryError::Impossible(format!(
-                        "centre distance {:.6} mm is not larger than (r_b2 ± r_b1) = {:.6} mm",
-                        aw * 1e3,
-                        a * alpha_t.cos() * 1e3
-                    )));
-                }
-                (aw, c.acos())
-            }
-        };
+        let (a, a_w_from_shifts, a_w, alpha_wt) =
+            operating_centre_distance(g1, g2, internal, centre_distance)?;
         let (r_b1, r_b2) = (g1.r_b(), g2.r_b());
         let (r_a1, r_a2) = (g1.r_a(), g2.r_a());
         let (cw, tw) = (alpha_wt.cos(), alpha_wt.tan());
@@ -280,19 +215,7 @@ impl MeshGeometry {
         };
         let interference1 = s_a < s1_at(g1.r_form()) - tol;
         let interference2 = s_e > s2_at(g2.r_form()) + tol;
-        let tip_interference = internal && {
-            let c1 = (r_a2 * r_a2 - r_a1 * r_a1 - a_w * a_w) / (2.0 * a_w * r_a1);
-            let c2 = (a_w * a_w + r_a2 * r_a2 - r_a1 * r_a1) / (2.0 * a_w * r_a2);
-            if c1.abs() > 1.0 || c2.abs() > 1.0 {
-                false // tip circles do not intersect
-            } else {
-                let aa1 = (r_b1 / r_a1).acos();
-                let aa2 = (r_b2 / r_a2).acos();
-                let th1 = c1.acos() + inv(aa1) - inv(alpha_wt);
-                let th2 = c2.acos();
-                th1 * z1 / z2 + inv(alpha_wt) - inv(aa2) < th2
-            }
-        };
+        let tip_interference = internal && tip_interference(g1, g2, a_w, alpha_wt);
         let b = s1.b.min(s2.b);
         let eps_alpha = g_alpha / p_bt;
         let eps_beta = b * s1.beta.sin() / (PI * mn);
@@ -415,6 +338,116 @@ impl MeshGeometry {
     /// Rotation of gear 1 while the contact moves over the whole path: `g_α / r_b1` \[rad\].
     pub fn contact_angle1(&self) -> f64 {
         self.g_alpha / self.r_b1
+    }
+}
+
+/// Gear 1 and gear 2 can mesh as `kind`: same module, pressure angle and helix angle; gear 1
+/// external; a ring as gear 2 exactly for an internal mesh, with more teeth than the pinion.
+fn check_pair(g1: &GearGeometry, g2: &GearGeometry, kind: MeshKind) -> Result<(), GeometryError> {
+    let (s1, s2) = (&g1.spec, &g2.spec);
+    same("normal module mn [m]", s1.mn, s2.mn, 1e-9 * s1.mn.max(s2.mn))?;
+    same(
+        "normal pressure angle alpha_n [rad]",
+        s1.alpha_n,
+        s2.alpha_n,
+        1e-9,
+    )?;
+    same("helix angle beta [rad]", s1.beta, s2.beta, 1e-9)?;
+    if g1.is_internal() {
+        return Err(GeometryError::Impossible(
+            "gear 1 of a mesh must be an external gear (the pinion)".into(),
+        ));
+    }
+    match kind {
+        MeshKind::External if g2.is_internal() => {
+            return Err(GeometryError::Impossible(
+                "external mesh given a ring gear as gear 2 (use MeshKind::Internal)".into(),
+            ))
+        }
+        MeshKind::Internal if !g2.is_internal() => {
+            return Err(GeometryError::Impossible(
+                "internal mesh needs a ring (internal gear) as gear 2".into(),
+            ))
+        }
+        MeshKind::Internal if s2.z <= s1.z => {
+            return Err(GeometryError::Impossible(format!(
+                "internal mesh: ring z2 = {} must have more teeth than pinion z1 = {}",
+                s2.z, s1.z
+            )))
+        }
+        _ => {}
+    }
+    Ok(())
+}
+
+/// Reference centre distance `a`, the zero-backlash operating centre distance from the profile
+/// shifts, and the operating centre distance `a_w` with its transverse pressure angle α_wt
+/// (from the shifts, or from `centre_distance` when given); see [`MeshGeometry::new`].
+fn operating_centre_distance(
+    g1: &GearGeometry,
+    g2: &GearGeometry,
+    internal: bool,
+    centre_distance: Option<f64>,
+) -> Result<(f64, f64, f64, f64), GeometryError> {
+    let (s1, s2) = (&g1.spec, &g2.spec);
+    let (z1, z2) = (f64::from(s1.z), f64::from(s2.z));
+    let (m_t, alpha_t) = (g1.m_t, g1.alpha_t);
+    let (zs, xs) = if internal {
+        (z2 - z1, s2.x - s1.x)
+    } else {
+        (z1 + z2, s1.x + s2.x)
+    };
+    let a = m_t * zs / 2.0;
+    // [std] operating pressure angle from the shifts
+    let inv_wt = g1.inv_alpha_t() + 2.0 * s1.alpha_n.tan() * xs / zs;
+    if !(inv_wt > 0.0) {
+        return Err(GeometryError::Impossible(format!(
+            "profile shift sum {xs} too negative: inv α_wt = {inv_wt:e} ≤ 0"
+        )));
+    }
+    let alpha_wt_shift = inv_inverse(inv_wt);
+    let a_w_from_shifts = a * alpha_t.cos() / alpha_wt_shift.cos();
+    let (a_w, alpha_wt) = match centre_distance {
+        None => (a_w_from_shifts, alpha_wt_shift),
+        Some(aw) => {
+            if !(aw.is_finite() && aw > 0.0) {
+                return Err(GeometryError::InvalidParameter {
+                    name: "centre_distance",
+                    value: aw,
+                    requirement: "must be a finite number > 0",
+                });
+            }
+            let c = a * alpha_t.cos() / aw;
+            if !(c < 1.0) {
+                return Err(GeometryError::Impossible(format!(
+                    "centre distance {:.6} mm is not larger than (r_b2 ± r_b1) = {:.6} mm",
+                    aw * 1e3,
+                    a * alpha_t.cos() * 1e3
+                )));
+            }
+            (aw, c.acos())
+        }
+    };
+    Ok((a, a_w_from_shifts, a_w, alpha_wt))
+}
+
+/// Tip (trochoid) interference of an internal mesh's pinion tip with the ring tip outside the
+/// path of contact (KHK criterion, see [`MeshGeometry::new`]) at centre distance `a_w` and
+/// operating pressure angle `alpha_wt`.
+fn tip_interference(g1: &GearGeometry, g2: &GearGeometry, a_w: f64, alpha_wt: f64) -> bool {
+    let (r_b1, r_b2) = (g1.r_b(), g2.r_b());
+    let (r_a1, r_a2) = (g1.r_a(), g2.r_a());
+    let (z1, z2) = (f64::from(g1.spec.z), f64::from(g2.spec.z));
+    let c1 = (r_a2 * r_a2 - r_a1 * r_a1 - a_w * a_w) / (2.0 * a_w * r_a1);
+    let c2 = (a_w * a_w + r_a2 * r_a2 - r_a1 * r_a1) / (2.0 * a_w * r_a2);
+    if c1.abs() > 1.0 || c2.abs() > 1.0 {
+        false // tip circles do not intersect
+    } else {
+        let aa1 = (r_b1 / r_a1).acos();
+        let aa2 = (r_b2 / r_a2).acos();
+        let th1 = c1.acos() + inv(aa1) - inv(alpha_wt);
+        let th2 = c2.acos();
+        th1 * z1 / z2 + inv(alpha_wt) - inv(aa2) < th2
     }
 }
 

@@ -93,6 +93,25 @@ fn parse_num(field: &str) -> Option<f64> {
     f.parse::<f64>().ok().filter(|v| v.is_finite())
 }
 
+/// What is wrong with an efficiency outside [0, 1].
+const NOT_AN_EFFICIENCY: &str = "is not an efficiency (a fraction in [0, 1])";
+
+/// A number for a message: as written for the usual magnitudes, in exponent form outside them
+/// (1e308, not 309 digits).
+fn number(v: f64) -> String {
+    if v == 0.0 || (1e-6..1e9).contains(&v.abs()) {
+        v.to_string()
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// True for an efficiency geartherm can have written: a fraction in [0, 1], or no value (NaN:
+/// undefined where there is no output power).
+fn is_efficiency(v: f64) -> bool {
+    v.is_nan() || (0.0..=1.0).contains(&v)
+}
+
 fn csv_err(path: &Path, e: csv::Error) -> PlotError {
     PlotError::Csv {
         path: path.to_path_buf(),
@@ -204,7 +223,17 @@ pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
             ts.source_w[k].push(v);
         }
         ts.total_loss_w.push(num(c_total)?);
-        ts.efficiency.push(num(c_eff)?);
+        let eff = num(c_eff)?;
+        if !is_efficiency(eff) {
+            return Err(PlotError::Csv {
+                path: path.to_path_buf(),
+                msg: format!(
+                    "line {line}, column `efficiency`: {} {NOT_AN_EFFICIENCY}",
+                    number(eff)
+                ),
+            });
+        }
+        ts.efficiency.push(eff);
     }
     if ts.is_empty() {
         return Err(PlotError::Data {
@@ -320,6 +349,17 @@ impl Summary {
     pub fn is_boundary(&self, node: &str) -> bool {
         self.nodes.iter().any(|n| n.name == node && n.boundary)
     }
+
+    /// The values the report writes as they must be: `cycle_efficiency` a fraction in [0, 1]
+    /// (an efficiency is never drawn or written over 100 %). Err: the key and what is wrong.
+    pub fn check(&self) -> Result<(), String> {
+        match self.cycle_efficiency {
+            Some(e) if !is_efficiency(e) => {
+                Err(format!("cycle_efficiency: {} {NOT_AN_EFFICIENCY}", number(e)))
+            }
+            _ => Ok(()),
+        }
+    }
 }
 
 /// A JSON scalar as display text (strings without quotes).
@@ -360,7 +400,9 @@ pub struct RunData {
 /// Read `timeseries.csv` and `summary.json` of the run output directory `dir`.
 pub fn read_run(dir: &Path) -> Result<RunData, PlotError> {
     let ts = read_timeseries(&dir.join("timeseries.csv"))?;
-    let summary: Summary = read_json(&dir.join("summary.json"))?;
+    let path = dir.join("summary.json");
+    let summary: Summary = read_json(&path)?;
+    summary.check().map_err(|what| PlotError::Data { path, what })?;
     Ok(RunData {
         dir: dir.to_path_buf(),
         ts,
@@ -469,6 +511,16 @@ pub fn read_map(dir: &Path) -> Result<MapGrid, PlotError> {
                     rows.len() + 2,
                     r.speed_rpm,
                     r.torque_nm
+                ),
+            });
+        }
+        if let Some(e) = r.efficiency.filter(|e| !is_efficiency(*e)) {
+            return Err(PlotError::Csv {
+                path,
+                msg: format!(
+                    "row {}, column `efficiency`: {} {NOT_AN_EFFICIENCY}",
+                    rows.len() + 2,
+                    number(e)
                 ),
             });
         }

@@ -8,6 +8,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
 
 use super::data::RunData;
+use super::panel::{self, Axes, Grid};
 use super::style::{self, LegendEntry, Source, SourceColour, Swatch};
 use super::{Canvas, DrawResult};
 use crate::scene::{PerSource, N_SOURCES};
@@ -84,8 +85,38 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     let root = style::titled(root, &title)?;
     let (w, _) = root.dim_in_pixel();
     let (left, right) = root.split_horizontally((w as f64 * 0.66) as u32);
+    let items = bar_items(run);
+    draw_items(&left, &items)?;
 
-    // Items, largest first, NaN dropped, beyond MAX_BARS summed into "other".
+    // Right: per-source totals and the legend.
+    let (_, rh) = right.dim_in_pixel();
+    let (totals_area, legend_area) = right.split_vertically((rh as f64 * 0.6) as u32);
+    draw_sources(&totals_area, run)?;
+    let mut entries: Vec<LegendEntry> = Source::ALL
+        .iter()
+        .map(|s| LegendEntry::new(s.as_str(), Swatch::Fill(s.colour())))
+        .collect();
+    if items.iter().any(|r| r.0.is_none()) {
+        entries.push(LegendEntry::new(
+            "other / unknown source",
+            Swatch::Fill(style::NEUTRAL),
+        ));
+    }
+    style::draw_legend_column(&legend_area, Some("Bar colour = loss source"), &entries, 20)?;
+    if let Some(b) = sm.energy_balance_relative.filter(|b| b.is_finite()) {
+        let (_, lh) = legend_area.dim_in_pixel();
+        legend_area.draw(&Text::new(
+            format!("energy balance residual: {:.2e} (relative)", b),
+            (10, lh as i32 - 30),
+            style::text_at(style::NOTE_PX, HPos::Left, VPos::Center),
+        ))?;
+    }
+    Ok(())
+}
+
+/// The bars of the per-component chart: (source, name, J), largest first, NaN dropped, beyond
+/// [`MAX_BARS`] summed into "other".
+fn bar_items(run: &RunData) -> Vec<(Option<Source>, String, f64)> {
     let mut items: Vec<(Option<Source>, String, f64)> = item_energies(run)
         .into_iter()
         .filter(|(_, _, j)| j.is_finite())
@@ -96,6 +127,26 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
         let sum: f64 = rest.iter().map(|r| r.2).sum();
         items.push((None, format!("other ({} items)", rest.len()), sum));
     }
+    items
+}
+
+/// The label of category row `v` of a bar chart whose rows, from the top, are named `names`.
+fn row_name(names: &[String], v: &SegmentValue<i32>) -> String {
+    match v {
+        SegmentValue::CenterOf(i) | SegmentValue::Exact(i) => {
+            let k = names.len() as i32 - 1 - *i;
+            if k >= 0 && (k as usize) < names.len() {
+                names[k as usize].clone()
+            } else {
+                String::new()
+            }
+        }
+        SegmentValue::Last => String::new(),
+    }
+}
+
+/// Left panel: one bar per item (kJ), coloured by source, its value at its end.
+fn draw_items(area: &Canvas, items: &[(Option<Source>, String, f64)]) -> DrawResult {
     let n = items.len();
     let kj: Vec<f64> = items.iter().map(|r| r.2 / 1e3).collect();
     let x_max = kj.iter().copied().fold(0.0f64, f64::max);
@@ -103,17 +154,17 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     let x_hi = if x_max > 0.0 { x_max * 1.22 } else { 1.0 };
 
     // Label font shrinks with the number of bars so that names stay readable and separate.
-    let (_, lh) = left.dim_in_pixel();
+    let (_, lh) = area.dim_in_pixel();
     let bar_px = (lh as f64 - 140.0) / n.max(1) as f64;
     let label_px = (bar_px * 0.7).clamp(12.0, style::TICK_PX as f64) as u32;
     let names: Vec<String> = items
         .iter()
-        .map(|r| style::fit_label(&left, &r.1, label_px, 260))
+        .map(|r| style::fit_label(area, &r.1, label_px, 260))
         .collect();
     let name_w = names
         .iter()
         .map(|s| {
-            left.estimate_text_size(s, &style::text(label_px))
+            area.estimate_text_size(s, &style::text(label_px))
                 .map(|(w, _)| w)
                 .unwrap_or(100)
         })
@@ -121,7 +172,7 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
         .unwrap_or(60)
         + 20;
 
-    let mut chart = ChartBuilder::on(&left)
+    let mut chart = ChartBuilder::on(area)
         .margin_left(20)
         .margin_right(20)
         .margin_top(20)
@@ -130,31 +181,14 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
         .x_label_area_size(80)
         .y_label_area_size(name_w.max(80))
         .build_cartesian_2d(x_min.min(0.0)..x_hi, (0..(n.max(2) as i32 - 1)).into_segmented())?;
-    let label_of = |v: &SegmentValue<i32>| match v {
-        SegmentValue::CenterOf(i) | SegmentValue::Exact(i) => {
-            let k = n as i32 - 1 - *i;
-            if k >= 0 && (k as usize) < n {
-                names[k as usize].clone()
-            } else {
-                String::new()
-            }
-        }
-        SegmentValue::Last => String::new(),
-    };
-    chart
-        .configure_mesh()
-        .disable_y_mesh()
+    Axes::house()
+        .grid(Grid::Vertical)
         .x_desc("Energy lost (kJ)")
-        .axis_desc_style(style::font(style::AXIS_DESC_PX))
-        .x_label_style(style::font(style::TICK_PX))
-        .y_label_style(style::font(label_px))
-        .light_line_style(style::GRID)
-        .bold_line_style(style::GRID_BOLD)
-        .x_labels(8)
-        .y_labels(n.max(1))
-        .x_label_formatter(&|v| style::fmt_num(*v))
-        .y_label_formatter(&label_of)
-        .draw()?;
+        .y_tick_style(style::font(label_px).into())
+        .labels(8, n.max(1))
+        .x_format(&panel::compact)
+        .y_format(&|v| row_name(&names, v))
+        .draw(&mut chart)?;
     let margin = ((bar_px * 0.15) as u32).clamp(1, 8);
     for (k, ((src, _, _), v)) in items.iter().zip(&kj).enumerate() {
         let row = (n - 1 - k) as i32;
@@ -179,14 +213,16 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
         ))?;
     }
     if n == 0 {
-        style::draw_note_centre(&left, "no loss items")?;
+        style::draw_note_centre(area, "no loss items")?;
     }
+    Ok(())
+}
 
-    // Right: per-source totals and the legend.
-    let (_, rh) = right.dim_in_pixel();
-    let (totals_area, legend_area) = right.split_vertically((rh as f64 * 0.6) as u32);
+/// Right panel: one bar per source and the total (kJ), the three largest shares in %.
+fn draw_sources(area: &Canvas, run: &RunData) -> DrawResult {
     let src_kj: Vec<f64> = source_energies(run).iter().map(|j| j / 1e3).collect();
-    let total_kj: f64 = sm
+    let total_kj: f64 = run
+        .summary
         .energy_lost_j
         .as_ref()
         .and_then(|e| e.total())
@@ -198,9 +234,10 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
         .map(|s| (s.as_str().to_string(), s.colour(), src_kj[s.index()]))
         .chain([("total".to_string(), RGBColor(70, 70, 70), total_kj)])
         .collect();
+    let names: Vec<String> = rows.iter().map(|r| r.0.clone()).collect();
     let t_max = rows.iter().map(|r| r.2).fold(0.0f64, f64::max);
     let t_hi = if t_max > 0.0 { t_max * 1.45 } else { 1.0 };
-    let mut tchart = ChartBuilder::on(&totals_area)
+    let mut chart = ChartBuilder::on(area)
         .margin_left(10)
         .margin_right(30)
         .margin_top(20)
@@ -208,30 +245,13 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
         .x_label_area_size(80)
         .y_label_area_size(140)
         .build_cartesian_2d(0.0..t_hi, (0..(rows.len() as i32 - 1)).into_segmented())?;
-    let row_label = |v: &SegmentValue<i32>| match v {
-        SegmentValue::CenterOf(i) | SegmentValue::Exact(i) => {
-            let k = rows.len() as i32 - 1 - *i;
-            if k >= 0 && (k as usize) < rows.len() {
-                rows[k as usize].0.clone()
-            } else {
-                String::new()
-            }
-        }
-        SegmentValue::Last => String::new(),
-    };
-    tchart
-        .configure_mesh()
-        .disable_y_mesh()
+    Axes::house()
+        .grid(Grid::Vertical)
         .x_desc("Energy lost (kJ)")
-        .axis_desc_style(style::font(style::AXIS_DESC_PX))
-        .label_style(style::font(style::TICK_PX))
-        .light_line_style(style::GRID)
-        .bold_line_style(style::GRID_BOLD)
-        .x_labels(4)
-        .y_labels(rows.len())
-        .x_label_formatter(&|v| style::fmt_num(*v))
-        .y_label_formatter(&row_label)
-        .draw()?;
+        .labels(4, rows.len())
+        .x_format(&panel::compact)
+        .y_format(&|v| row_name(&names, v))
+        .draw(&mut chart)?;
     for (k, (_, colour, v)) in rows.iter().enumerate() {
         let row = (rows.len() - 1 - k) as i32;
         let mut bar = Rectangle::new(
@@ -242,38 +262,19 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
             colour.filled(),
         );
         bar.set_margin(10, 10, 0, 0);
-        tchart.draw_series(std::iter::once(bar))?;
+        chart.draw_series(std::iter::once(bar))?;
         let share = if total_kj > 0.0 && k < 3 {
             format!(" ({:.0} %)", 100.0 * v / total_kj)
         } else {
             String::new()
         };
-        tchart.draw_series(std::iter::once(
+        chart.draw_series(std::iter::once(
             EmptyElement::at((v.max(0.0), SegmentValue::CenterOf(row)))
                 + Text::new(
                     format!("{}{share}", style::fmt_sig(*v, 3)),
                     (6, 0),
                     style::text_at(style::NOTE_PX, HPos::Left, VPos::Center),
                 ),
-        ))?;
-    }
-    let mut entries: Vec<LegendEntry> = Source::ALL
-        .iter()
-        .map(|s| LegendEntry::new(s.as_str(), Swatch::Fill(s.colour())))
-        .collect();
-    if items.iter().any(|r| r.0.is_none()) {
-        entries.push(LegendEntry::new(
-            "other / unknown source",
-            Swatch::Fill(style::NEUTRAL),
-        ));
-    }
-    style::draw_legend_column(&legend_area, Some("Bar colour = loss source"), &entries, 20)?;
-    if let Some(b) = sm.energy_balance_relative.filter(|b| b.is_finite()) {
-        let (_, lh) = legend_area.dim_in_pixel();
-        legend_area.draw(&Text::new(
-            format!("energy balance residual: {:.2e} (relative)", b),
-            (10, lh as i32 - 30),
-            style::text_at(style::NOTE_PX, HPos::Left, VPos::Center),
         ))?;
     }
     Ok(())

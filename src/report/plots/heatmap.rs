@@ -8,6 +8,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
 
 use super::data::{MapGrid, MapRow};
+use super::panel::{self, Axes, Chart, Grid};
 use super::style::{self, ColourMap, LegendEntry, Swatch};
 use super::{Canvas, DrawResult};
 
@@ -155,6 +156,93 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
     sorted[k.min(sorted.len() - 1)]
 }
 
+/// The values of one quantity over a map grid and its colour scale.
+struct Field {
+    nx: usize,
+    ny: usize,
+    /// Value of cell (i, j) at `j * nx + i`; NaN where missing or not converged.
+    z: Vec<f64>,
+    /// Cells whose equilibrium did not converge.
+    not_converged: Vec<bool>,
+    /// True when any cell has a value.
+    any_value: bool,
+    /// Colour scale range.
+    vmin: f64,
+    /// Colour scale range.
+    vmax: f64,
+    /// The scale is clipped at the 5th percentile.
+    clipped: bool,
+    cmap: ColourMap,
+}
+
+impl Field {
+    fn of(grid: &MapGrid, q: Quantity) -> Field {
+        let (nx, ny) = (grid.speeds_rpm.len(), grid.torques_nm.len());
+        let mut z = vec![f64::NAN; nx * ny];
+        let mut not_converged = vec![false; nx * ny];
+        for j in 0..ny {
+            for i in 0..nx {
+                match grid.cell(i, j) {
+                    Some(r) if r.converged => z[j * nx + i] = q.value(r),
+                    Some(_) => not_converged[j * nx + i] = true,
+                    None => {}
+                }
+            }
+        }
+        let mut finite: Vec<f64> = z.iter().copied().filter(|v| v.is_finite()).collect();
+        finite.sort_by(f64::total_cmp);
+        let (mut vmin, vmax) = match (finite.first(), finite.last()) {
+            (Some(&a), Some(&b)) => (a, b),
+            _ => (0.0, 1.0),
+        };
+        // Efficiency near zero torque is far below the rest; clip the colour scale at the 5th
+        // percentile so the useful range keeps its contrast (said on the colour bar).
+        let mut clipped = false;
+        if q == Quantity::Efficiency && finite.len() >= 20 {
+            let p5 = percentile(&finite, 0.05);
+            if p5 - vmin > 0.5 * (vmax - p5) {
+                vmin = p5;
+                clipped = true;
+            }
+        }
+        let (vmin, vmax) = if vmax > vmin {
+            (vmin, vmax)
+        } else {
+            style::pad_range(vmin, vmax, 0.0)
+        };
+        Field {
+            nx,
+            ny,
+            z,
+            not_converged,
+            any_value: !finite.is_empty(),
+            vmin,
+            vmax,
+            clipped,
+            cmap: q.colour_map(),
+        }
+    }
+
+    /// Colour of value `v`.
+    fn colour(&self, v: f64) -> RGBColor {
+        self.cmap.at((v - self.vmin) / (self.vmax - self.vmin))
+    }
+
+    /// Contour levels: "nice" steps strictly inside the scale, at most 30.
+    fn levels(&self) -> Vec<f64> {
+        let step = style::nice_step(self.vmax - self.vmin, 8);
+        let mut levels = Vec::new();
+        let mut lv = (self.vmin / step).ceil() * step;
+        while lv < self.vmax && levels.len() < 30 {
+            if lv > self.vmin {
+                levels.push(lv);
+            }
+            lv += step;
+        }
+        levels
+    }
+}
+
 /// Draw the heatmap of `q` over the map's speed × torque grid.
 pub fn draw(root: &Canvas, grid: &MapGrid, q: Quantity) -> DrawResult {
     let model = grid.meta.model.as_deref().unwrap_or("model");
@@ -163,45 +251,8 @@ pub fn draw(root: &Canvas, grid: &MapGrid, q: Quantity) -> DrawResult {
     let root = style::titled(root, &title)?;
     let (w, _) = root.dim_in_pixel();
     let (main, bar_area) = root.split_horizontally(w - 290);
-
-    let (nx, ny) = (grid.speeds_rpm.len(), grid.torques_nm.len());
-    let mut z = vec![f64::NAN; nx * ny];
-    let mut not_converged = vec![false; nx * ny];
-    for j in 0..ny {
-        for i in 0..nx {
-            if let Some(r) = grid.cell(i, j) {
-                if r.converged {
-                    z[j * nx + i] = q.value(r);
-                } else {
-                    not_converged[j * nx + i] = true;
-                }
-            }
-        }
-    }
-    let mut finite: Vec<f64> = z.iter().copied().filter(|v| v.is_finite()).collect();
-    finite.sort_by(f64::total_cmp);
-    let (mut vmin, vmax) = match (finite.first(), finite.last()) {
-        (Some(&a), Some(&b)) => (a, b),
-        _ => (0.0, 1.0),
-    };
-    // Efficiency near zero torque is far below the rest; clip the colour scale at the 5th
-    // percentile so the useful range keeps its contrast (said on the colour bar).
-    let mut clipped = false;
-    if q == Quantity::Efficiency && finite.len() >= 20 {
-        let p5 = percentile(&finite, 0.05);
-        if p5 - vmin > 0.5 * (vmax - p5) {
-            vmin = p5;
-            clipped = true;
-        }
-    }
-    let (vmin, vmax) = if vmax > vmin {
-        (vmin, vmax)
-    } else {
-        style::pad_range(vmin, vmax, 0.0)
-    };
-    let cmap = q.colour_map();
-    let norm = |v: f64| (v - vmin) / (vmax - vmin);
-
+    let field = Field::of(grid, q);
+    let (nx, ny) = (field.nx, field.ny);
     let xe = cell_edges(&grid.speeds_rpm);
     let ye = cell_edges(&grid.torques_nm);
     let mut chart = ChartBuilder::on(&main)
@@ -212,27 +263,38 @@ pub fn draw(root: &Canvas, grid: &MapGrid, q: Quantity) -> DrawResult {
         .x_label_area_size(80)
         .y_label_area_size(120)
         .build_cartesian_2d(xe[0]..xe[nx], ye[0]..ye[ny])?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
+    Axes::house()
+        .grid(Grid::Off)
         .x_desc("Input speed (rpm)")
         .y_desc("Input torque (N·m)")
-        .axis_desc_style(style::font(style::AXIS_DESC_PX))
-        .label_style(style::font(style::TICK_PX))
-        .x_labels(10)
-        .y_labels(10)
-        .x_label_formatter(&|v| style::fmt_num(*v))
-        .y_label_formatter(&|v| style::fmt_num(*v))
-        .draw()?;
+        .labels(10, 10)
+        .x_format(&panel::compact)
+        .y_format(&panel::compact)
+        .draw(&mut chart)?;
+    draw_cells(&mut chart, &field, &xe, &ye)?;
+    let levels = field.levels();
+    let small_grid = nx <= 12 && ny <= 12;
+    draw_contours(&mut chart, grid, &field, &levels, !small_grid)?;
+    if small_grid {
+        draw_cell_values(&mut chart, grid, &field)?;
+    }
+    if !field.any_value {
+        style::draw_note_centre(&main, "no converged points with a value")?;
+    }
+    draw_colour_bar(&bar_area, &field, q, &levels)
+}
 
+/// The cells in their colours, non-converged ones grey and hatched.
+fn draw_cells(chart: &mut Chart, field: &Field, xe: &[f64], ye: &[f64]) -> DrawResult {
+    let (nx, ny) = (field.nx, field.ny);
     chart.draw_series(
         (0..ny)
             .flat_map(|j| (0..nx).map(move |i| (i, j)))
             .filter_map(|(i, j)| {
-                let v = z[j * nx + i];
+                let v = field.z[j * nx + i];
                 let colour = if v.is_finite() {
-                    cmap.at(norm(v))
-                } else if not_converged[j * nx + i] {
+                    field.colour(v)
+                } else if field.not_converged[j * nx + i] {
                     style::MISSING
                 } else {
                     return None;
@@ -245,35 +307,34 @@ pub fn draw(root: &Canvas, grid: &MapGrid, q: Quantity) -> DrawResult {
     )?;
     // Hatching of non-converged cells, in pixels.
     let plot = chart.plotting_area();
+    let (ox, oy) = plot.get_base_pixel();
     for j in 0..ny {
-        for i in 0..nx {
-            if not_converged[j * nx + i] {
-                let a = chart.backend_coord(&(xe[i], ye[j + 1]));
-                let b = chart.backend_coord(&(xe[i + 1], ye[j]));
-                let (ox, oy) = plot.get_base_pixel();
-                style::hatch_px(
-                    &plot.strip_coord_spec(),
-                    (a.0 - ox, a.1 - oy),
-                    (b.0 - ox, b.1 - oy),
-                )?;
-            }
+        for i in (0..nx).filter(|&i| field.not_converged[j * nx + i]) {
+            let a = chart.backend_coord(&(xe[i], ye[j + 1]));
+            let b = chart.backend_coord(&(xe[i + 1], ye[j]));
+            style::hatch_px(
+                &plot.strip_coord_spec(),
+                (a.0 - ox, a.1 - oy),
+                (b.0 - ox, b.1 - oy),
+            )?;
         }
     }
+    Ok(())
+}
 
-    // Contours at nice levels, drawn white under black so they read on any colour.
-    let step = style::nice_step(vmax - vmin, 8);
-    let mut levels = Vec::new();
-    let mut lv = (vmin / step).ceil() * step;
-    while lv < vmax && levels.len() < 30 {
-        if lv > vmin {
-            levels.push(lv);
-        }
-        lv += step;
-    }
-    let small_grid = nx <= 12 && ny <= 12;
+/// Contours at `levels`, drawn white under black so they read on any colour; `labelled`: each
+/// with its value at the segment nearest the middle of its list (typically mid-line), avoiding
+/// earlier labels.
+fn draw_contours(
+    chart: &mut Chart,
+    grid: &MapGrid,
+    field: &Field,
+    levels: &[f64],
+    labelled: bool,
+) -> DrawResult {
     let mut label_boxes: Vec<(i32, i32, i32, i32)> = Vec::new();
-    for &level in &levels {
-        let segs = contour_segments(&grid.speeds_rpm, &grid.torques_nm, &z, level);
+    for &level in levels {
+        let segs = contour_segments(&grid.speeds_rpm, &grid.torques_nm, &field.z, level);
         if segs.is_empty() {
             continue;
         }
@@ -285,71 +346,84 @@ pub fn draw(root: &Canvas, grid: &MapGrid, q: Quantity) -> DrawResult {
             segs.iter()
                 .map(|s| PathElement::new(s.to_vec(), BLACK.stroke_width(2))),
         )?;
-        if !small_grid {
-            // Label at the segment nearest the middle of the list (typically mid-line), avoiding
-            // earlier labels.
-            let label = style::fmt_num(level);
-            let (tw, th) = (label.chars().count() as i32 * 12 + 12, 28);
-            let mid = segs.len() / 2;
-            let candidates = (0..segs.len()).map(|k| {
-                if k % 2 == 0 {
-                    mid + k / 2
-                } else {
-                    mid.wrapping_sub(k / 2 + 1)
-                }
-            });
-            for k in candidates.filter(|&k| k < segs.len()) {
-                let s = segs[k];
-                let p = ((s[0].0 + s[1].0) / 2.0, (s[0].1 + s[1].1) / 2.0);
-                let (px, py) = chart.backend_coord(&p);
-                let b = (px - tw / 2, py - th / 2, px + tw / 2, py + th / 2);
-                if label_boxes
-                    .iter()
-                    .any(|o| b.0 < o.2 && o.0 < b.2 && b.1 < o.3 && o.1 < b.3)
-                {
-                    continue;
-                }
-                label_boxes.push(b);
-                chart.draw_series(std::iter::once(
-                    EmptyElement::at(p)
-                        + Rectangle::new([(-tw / 2, -th / 2), (tw / 2, th / 2)], WHITE.mix(0.85).filled())
-                        + Text::new(
-                            label.clone(),
-                            (0, 0),
-                            style::text_at(style::NOTE_PX, HPos::Center, VPos::Center),
-                        ),
-                ))?;
-                break;
-            }
+        if labelled {
+            draw_contour_label(chart, &segs, level, &mut label_boxes)?;
         }
     }
-    if small_grid {
-        // Print every value; text colour chosen against the cell colour.
-        for j in 0..ny {
-            for i in 0..nx {
-                let v = z[j * nx + i];
-                if !v.is_finite() {
-                    continue;
-                }
-                let RGBColor(r, g, b) = cmap.at(norm(v));
-                let luminance = 0.299 * r as f64 + 0.587 * g as f64 + 0.114 * b as f64;
-                let colour = if luminance > 140.0 { BLACK } else { WHITE };
-                let text = style::text_at(style::NOTE_PX, HPos::Center, VPos::Center).color(&colour);
-                chart.draw_series(std::iter::once(Text::new(
-                    style::fmt_sig(v, 3),
-                    (grid.speeds_rpm[i], grid.torques_nm[j]),
-                    text,
-                )))?;
-            }
-        }
-    }
-    if finite.is_empty() {
-        style::draw_note_centre(&main, "no converged points with a value")?;
-    }
+    Ok(())
+}
 
-    // Colour bar with its own axis.
-    let (_, bh) = bar_area.dim_in_pixel();
-    let (bar_main, bar_legend) = bar_area.split_vertically(bh - 150);
+/// The label of a contour at `level` on the first of its segments `segs`, from the middle of the
+/// list outwards, whose label box overlaps none of `boxes` (which it joins).
+fn draw_contour_label(
+    chart: &mut Chart,
+    segs: &[[(f64, f64); 2]],
+    level: f64,
+    boxes: &mut Vec<(i32, i32, i32, i32)>,
+) -> DrawResult {
+    let label = style::fmt_num(level);
+    let (tw, th) = (label.chars().count() as i32 * 12 + 12, 28);
+    let mid = segs.len() / 2;
+    let candidates = (0..segs.len()).map(|k| {
+        if k % 2 == 0 {
+            mid + k / 2
+        } else {
+            mid.wrapping_sub(k / 2 + 1)
+        }
+    });
+    for k in candidates.filter(|&k| k < segs.len()) {
+        let s = segs[k];
+        let p = ((s[0].0 + s[1].0) / 2.0, (s[0].1 + s[1].1) / 2.0);
+        let (px, py) = chart.backend_coord(&p);
+        let b = (px - tw / 2, py - th / 2, px + tw / 2, py + th / 2);
+        if boxes
+            .iter()
+            .any(|o| b.0 < o.2 && o.0 < b.2 && b.1 < o.3 && o.1 < b.3)
+        {
+            continue;
+        }
+        boxes.push(b);
+        chart.draw_series(std::iter::once(
+            EmptyElement::at(p)
+                + Rectangle::new([(-tw / 2, -th / 2), (tw / 2, th / 2)], WHITE.mix(0.85).filled())
+                + Text::new(
+                    label.clone(),
+                    (0, 0),
+                    style::text_at(style::NOTE_PX, HPos::Center, VPos::Center),
+                ),
+        ))?;
+        break;
+    }
+    Ok(())
+}
+
+/// Every cell's value, in black or white against the cell colour (small grids).
+fn draw_cell_values(chart: &mut Chart, grid: &MapGrid, field: &Field) -> DrawResult {
+    for j in 0..field.ny {
+        for i in 0..field.nx {
+            let v = field.z[j * field.nx + i];
+            if !v.is_finite() {
+                continue;
+            }
+            let RGBColor(r, g, b) = field.colour(v);
+            let luminance = 0.299 * r as f64 + 0.587 * g as f64 + 0.114 * b as f64;
+            let colour = if luminance > 140.0 { BLACK } else { WHITE };
+            let text = style::text_at(style::NOTE_PX, HPos::Center, VPos::Center).color(&colour);
+            chart.draw_series(std::iter::once(Text::new(
+                style::fmt_sig(v, 3),
+                (grid.speeds_rpm[i], grid.torques_nm[j]),
+                text,
+            )))?;
+        }
+    }
+    Ok(())
+}
+
+/// The colour bar with its own axis and the contour levels, and the legend below it.
+fn draw_colour_bar(area: &Canvas, field: &Field, q: Quantity, levels: &[f64]) -> DrawResult {
+    let (vmin, vmax) = (field.vmin, field.vmax);
+    let (_, bh) = area.dim_in_pixel();
+    let (bar_main, bar_legend) = area.split_vertically(bh - 150);
     let mut bar = ChartBuilder::on(&bar_main)
         .margin_top(40)
         .margin_bottom(10)
@@ -358,26 +432,25 @@ pub fn draw(root: &Canvas, grid: &MapGrid, q: Quantity) -> DrawResult {
         .x_label_area_size(0)
         .right_y_label_area_size(170)
         .build_cartesian_2d(0.0..1.0, vmin..vmax)?;
-    bar.configure_mesh()
-        .disable_mesh()
-        .disable_x_axis()
-        .y_desc(if clipped {
-            format!("{} (clipped below)", q.label())
-        } else {
-            q.label().to_string()
-        })
-        .axis_desc_style(style::font(style::AXIS_DESC_PX))
-        .label_style(style::font(style::TICK_PX))
+    let desc = if field.clipped {
+        format!("{} (clipped below)", q.label())
+    } else {
+        q.label().to_string()
+    };
+    Axes::house()
+        .grid(Grid::Off)
+        .without_x_axis()
+        .y_desc(desc)
         .y_labels(10)
-        .y_label_formatter(&|v| style::fmt_num(*v))
-        .draw()?;
+        .y_format(&panel::compact)
+        .draw(&mut bar)?;
     let n_steps = 256;
     bar.draw_series((0..n_steps).map(|k| {
         let a = vmin + (vmax - vmin) * k as f64 / n_steps as f64;
         let b = vmin + (vmax - vmin) * (k + 1) as f64 / n_steps as f64;
         Rectangle::new(
             [(0.0, a), (1.0, b)],
-            cmap.at((k as f64 + 0.5) / n_steps as f64).filled(),
+            field.cmap.at((k as f64 + 0.5) / n_steps as f64).filled(),
         )
     }))?;
     bar.draw_series(
@@ -386,10 +459,11 @@ pub fn draw(root: &Canvas, grid: &MapGrid, q: Quantity) -> DrawResult {
             .map(|&l| PathElement::new(vec![(0.0, l), (1.0, l)], BLACK.stroke_width(2))),
     )?;
     let mut entries = Vec::new();
-    if not_converged.iter().any(|&b| b) {
+    if field.not_converged.iter().any(|&b| b) {
         entries.push(LegendEntry::new("not converged", Swatch::Hatched));
     }
-    if (0..nx * ny).any(|k| !z[k].is_finite() && !not_converged[k]) {
+    let n = field.nx * field.ny;
+    if (0..n).any(|k| !field.z[k].is_finite() && !field.not_converged[k]) {
         entries.push(LegendEntry::new("no value", Swatch::Fill(WHITE)));
     }
     entries.push(LegendEntry::new("contour", Swatch::Line(BLACK, 2)));

@@ -4,7 +4,7 @@ use std::fmt::Write;
 
 use super::data::{value_text, RunData};
 use super::energy::source_energies;
-use super::style::{fmt_sig, Source};
+use super::style::{fmt_fixed, fmt_share, fmt_sig, Source};
 
 /// Escape text for a Markdown table cell.
 fn cell(s: &str) -> String {
@@ -38,7 +38,7 @@ pub fn markdown(run: &RunData) -> String {
         "| Wall time | {} |",
         opt(sm.wall_time_s, |t| format!("{} s", fmt_sig(t, 3)))
     );
-    let _ = writeln!(s, "| Steps | {} |", opt(sm.steps, |n| format!("{n:.0}")));
+    let _ = writeln!(s, "| Steps | {} |", opt(sm.steps, |n| fmt_fixed(n, 0)));
     let t0 = ts.time_order().first().map(|&i| ts.time_s[i]);
     let t1 = ts.time_order().last().map(|&i| ts.time_s[i]);
     if let (Some(a), Some(b)) = (t0, t1) {
@@ -76,11 +76,7 @@ pub fn markdown(run: &RunData) -> String {
     );
     for x in Source::ALL {
         let e = src[x.index()];
-        let share = if total > 0.0 {
-            format!("{:.1} %", 100.0 * e / total)
-        } else {
-            "–".into()
-        };
+        let share = fmt_share(e, total);
         let _ = writeln!(s, "| {} | {} | {} |", x.as_str(), fmt_sig(e / 1e3, 4), share);
     }
     let _ = writeln!(s, "| **total** | **{}** | |", fmt_sig(total / 1e3, 4));
@@ -117,7 +113,7 @@ pub fn markdown(run: &RunData) -> String {
             let order = ts.time_order();
             series.and_then(|v| order.iter().rev().map(|&i| v[i]).find(|x| x.is_finite()))
         });
-        let f = |v: Option<f64>| opt(v, |x| format!("{x:.1}"));
+        let f = |v: Option<f64>| opt(v, |x| fmt_fixed(x, 1));
         let boundary = if sm.is_boundary(n) { "yes" } else { "" };
         let _ = writeln!(
             s,

@@ -4,6 +4,7 @@
 use plotters::prelude::*;
 
 use super::data::{decimate, finite_segments, RunData};
+use super::panel::{self, Axes, TimeAxis};
 use super::style::{self, LegendEntry, Source, SourceColour, Swatch};
 use super::{Canvas, DrawResult};
 
@@ -28,14 +29,12 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
         .into_iter()
         .filter(|&i| Source::ALL.iter().all(|s| ts.source_w[s.index()][i].is_finite()))
         .collect();
-    let t_hi = order.last().map(|&i| ts.time_s[i]).unwrap_or(1.0);
-    let t_lo = order.first().map(|&i| ts.time_s[i]).unwrap_or(0.0);
-    let (t_scale, t_desc) = style::time_axis(t_hi);
-    let (x0, x1) = if t_hi > t_lo {
-        (t_lo * t_scale, t_hi * t_scale)
-    } else {
-        style::pad_range(t_lo * t_scale, t_hi * t_scale, 0.0)
-    };
+    let TimeAxis {
+        scale: t_scale,
+        desc: t_desc,
+        x0,
+        x1,
+    } = TimeAxis::over(&ts.time_s, &order);
 
     // Cumulative stacks (W): stack[k][r] = sum of sources 0..=k at row order[r].
     let mut stack = vec![vec![0.0; order.len()]; Source::ALL.len()];
@@ -62,19 +61,13 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
         .x_label_area_size(80)
         .y_label_area_size(120)
         .build_cartesian_2d(x0..x1, 0.0..y1)?;
-    chart
-        .configure_mesh()
+    Axes::house()
         .x_desc(t_desc)
         .y_desc("Loss power (W)")
-        .axis_desc_style(style::font(style::AXIS_DESC_PX))
-        .label_style(style::font(style::TICK_PX))
-        .light_line_style(style::GRID)
-        .bold_line_style(style::GRID_BOLD)
-        .x_labels(12)
-        .y_labels(8)
-        .x_label_formatter(&|v| style::fmt_num(*v))
-        .y_label_formatter(&|v| style::fmt_num(*v))
-        .draw()?;
+        .labels(12, 8)
+        .x_format(&panel::compact)
+        .y_format(&panel::compact)
+        .draw(&mut chart)?;
 
     let buckets = (w - LEGEND_W) as usize;
     let times: Vec<f64> = order.iter().map(|&i| ts.time_s[i] * t_scale).collect();

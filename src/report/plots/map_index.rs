@@ -4,6 +4,7 @@
 use std::fmt::Write as _;
 
 use super::data::{value_text, MapGrid};
+use super::style::fmt_fixed;
 
 fn range(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
     values.filter(|v| v.is_finite()).fold(None, |acc, v| match acc {
@@ -14,7 +15,11 @@ fn range(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
 
 fn range_text(r: Option<(f64, f64)>, scale: f64, unit: &str, digits: usize) -> String {
     r.map_or("–".into(), |(lo, hi)| {
-        format!("{:.digits$} … {:.digits$} {unit}", lo * scale, hi * scale)
+        format!(
+            "{} … {} {unit}",
+            fmt_fixed(lo * scale, digits),
+            fmt_fixed(hi * scale, digits)
+        )
     })
 }
 

@@ -17,6 +17,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use tempfile::NamedTempFile;
 
+use crate::report::files::user_path;
+
 pub mod data;
 pub mod efficiency;
 pub mod energy;
@@ -24,6 +26,7 @@ pub mod heatmap;
 pub mod index;
 pub mod losses;
 pub mod map_index;
+pub mod panel;
 pub mod study;
 pub mod style;
 pub mod temperatures;
@@ -33,11 +36,13 @@ pub mod work_precision;
 #[cfg(test)]
 mod tests;
 
-/// Errors of the plot reports. Every variant names the file concerned.
+/// Errors of the plot reports. Every variant names the file concerned, as the user knows it
+/// (a file in a transaction's temporary directory by its place in the target:
+/// [`user_path`]).
 #[derive(Debug, thiserror::Error)]
 pub enum PlotError {
     /// A file could not be read or written.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {source}", user_path(path).display())]
     Io {
         /// The file.
         path: PathBuf,
@@ -46,7 +51,7 @@ pub enum PlotError {
         source: std::io::Error,
     },
     /// A CSV file is malformed (field count, a value that is not a finite number).
-    #[error("{}: malformed CSV: {msg}", path.display())]
+    #[error("{}: malformed CSV: {msg}", user_path(path).display())]
     Csv {
         /// The file.
         path: PathBuf,
@@ -54,7 +59,7 @@ pub enum PlotError {
         msg: String,
     },
     /// A JSON file does not parse.
-    #[error("{}: malformed JSON: {source}", path.display())]
+    #[error("{}: malformed JSON: {source}", user_path(path).display())]
     Json {
         /// The file.
         path: PathBuf,
@@ -63,7 +68,7 @@ pub enum PlotError {
         source: serde_json::Error,
     },
     /// A file parses but lacks what the figure needs (a required column, any data rows).
-    #[error("{}: {what}", path.display())]
+    #[error("{}: {what}", user_path(path).display())]
     Data {
         /// The file.
         path: PathBuf,
@@ -71,7 +76,7 @@ pub enum PlotError {
         what: String,
     },
     /// Rendering a figure failed.
-    #[error("{}: drawing failed: {msg}", path.display())]
+    #[error("{}: drawing failed: {msg}", user_path(path).display())]
     Draw {
         /// The figure's file.
         path: PathBuf,

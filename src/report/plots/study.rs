@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
+use super::panel::{self, Axes, Grid};
 use super::{commit, stage_png, style, Canvas, DrawResult, PlotError};
 use crate::report::study::{CaseRow, ParamValue, Table};
 
@@ -81,19 +82,17 @@ fn panel(area: &Canvas, t: &Table, p: &str, out: &str, cats: &[String]) -> DrawR
             }
         }
     };
-    chart
-        .configure_mesh()
-        .light_line_style(WHITE)
-        .bold_line_style(style::GRID)
+    Axes::with_fonts(style::font(16).into(), style::font(18).into())
+        .grid(Grid::Lines {
+            light: Some(WHITE),
+            bold: Some(style::GRID),
+        })
         .x_desc(p)
         .y_desc(out)
-        .x_labels(if cats.is_empty() { 5 } else { cats.len() * 2 + 1 })
-        .y_labels(5)
-        .x_label_formatter(&xfmt)
-        .y_label_formatter(&|y| style::fmt_num(*y))
-        .label_style(style::font(16))
-        .axis_desc_style(style::font(18))
-        .draw()?;
+        .labels(if cats.is_empty() { 5 } else { cats.len() * 2 + 1 }, 5)
+        .x_format(&xfmt)
+        .y_format(&panel::compact)
+        .draw(&mut chart)?;
     let c = style::series_colour(0).mix(0.45);
     chart.draw_series(pts.iter().map(|&(x, y)| Circle::new((x, y), 3, c.filled())))?;
     // The main effect: the mean of the output per category, or per fifth of the range.
@@ -187,16 +186,16 @@ fn draw_pareto(root: &Canvas, t: &Table, a: &str, b: &str, title: &str) -> DrawR
         .x_label_area_size(70)
         .y_label_area_size(110)
         .build_cartesian_2d(x0..x1, y0..y1)?;
-    chart
-        .configure_mesh()
-        .light_line_style(style::GRID)
+    Axes::house()
+        .grid(Grid::Lines {
+            light: Some(style::GRID),
+            bold: None,
+        })
         .x_desc(format!("{a} (minimised)"))
         .y_desc(format!("{b} (minimised)"))
-        .x_label_formatter(&|x| style::fmt_num(*x))
-        .y_label_formatter(&|y| style::fmt_num(*y))
-        .label_style(style::font(style::TICK_PX))
-        .axis_desc_style(style::font(style::AXIS_DESC_PX))
-        .draw()?;
+        .x_format(&panel::compact)
+        .y_format(&panel::compact)
+        .draw(&mut chart)?;
     let grey = style::NEUTRAL.mix(0.45);
     chart
         .draw_series(pts.iter().map(|&(x, y)| Circle::new((x, y), 4, grey.filled())))?

@@ -261,6 +261,33 @@ pub fn fmt_sig(v: f64, sig: usize) -> String {
     format!("{v:.decimals$}")
 }
 
+/// `v` with `decimals` decimals while that stays short (|v| < 10⁹), else with four significant
+/// digits in exponent form ([`fmt_sig`]); "–" when not finite. For table cells.
+pub fn fmt_fixed(v: f64, decimals: usize) -> String {
+    if v.is_finite() && v.abs() < 1e9 {
+        format!("{v:.decimals$}")
+    } else {
+        fmt_sig(v, 4)
+    }
+}
+
+/// `part` as a percentage of `whole` with one decimal; "–" when `whole` is not positive or
+/// the share is not a finite number.
+pub fn fmt_share(part: f64, whole: f64) -> String {
+    let pct = 100.0 * part / whole;
+    // 100·part overflows for parts near f64::MAX; the ratio first does not.
+    let pct = if pct.is_finite() {
+        pct
+    } else {
+        100.0 * (part / whole)
+    };
+    if whole > 0.0 && pct.is_finite() {
+        format!("{} %", fmt_fixed(pct, 1))
+    } else {
+        "–".into()
+    }
+}
+
 /// A "nice" step (1, 2, 2.5, 5 × 10^k) giving about `n` intervals over `span`.
 pub fn nice_step(span: f64, n: usize) -> f64 {
     if !(span.is_finite() && span > 0.0) {

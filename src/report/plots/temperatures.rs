@@ -6,7 +6,8 @@ use plotters::prelude::*;
 use plotters::series::DashedLineSeries;
 use plotters::style::text_anchor::{HPos, VPos};
 
-use super::data::{decimate, finite_segments, RunData};
+use super::data::{decimate, finite_segments, RunData, TimeSeries};
+use super::panel::{self, Axes, TimeAxis};
 use super::style::{self, LegendEntry, Swatch};
 use super::{Canvas, DrawResult};
 
@@ -39,7 +40,6 @@ pub fn gear_levels(gears: &[String]) -> Vec<String> {
 
 /// Draw `temperatures.png` of the run: node temperatures, vehicle speed and gear vs time.
 pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
-    let ts = &run.ts;
     let sm = &run.summary;
     let title = format!(
         "Temperatures — {} / {}",
@@ -52,21 +52,32 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     let split_y = (h as f64 * 0.64) as u32;
     let (upper, lower) = main.split_vertically(split_y);
     let (leg_up, leg_low) = legend.split_vertically(split_y);
-
-    let order = ts.time_order();
-    let t_lo = order.first().map(|&i| ts.time_s[i]).unwrap_or(0.0);
-    let t_hi = order.last().map(|&i| ts.time_s[i]).unwrap_or(1.0);
-    let (t_scale, t_desc) = style::time_axis(t_hi);
-    let (x0, x1) = if t_hi > t_lo {
-        (t_lo * t_scale, t_hi * t_scale)
-    } else {
-        style::pad_range(t_lo * t_scale, t_hi * t_scale, 0.0)
-    };
+    let order = run.ts.time_order();
+    let time = TimeAxis::over(&run.ts.time_s, &order);
     let buckets = (w - LEGEND_W) as usize;
+    draw_temperatures(&upper, &leg_up, run, (&order, time, buckets))?;
+    draw_drive(&lower, &leg_low, run, (&order, time, buckets))?;
+    if gear_levels(&run.ts.gear).is_empty() {
+        lower.draw(&Text::new(
+            "no gear data",
+            (w as i32 / 2, 30),
+            style::text_at(style::NOTE_PX, HPos::Center, VPos::Top),
+        ))?;
+    }
+    Ok(())
+}
 
-    // Upper panel: temperatures. The gearbox nodes set the left axis; boundaries (ambient,
-    // coolant at a fixed 90 °C, ...) have their own right axis, so a distant boundary does not
-    // squash the node curves into a thin band.
+/// The rows in time order, the time axis and the number of horizontal pixel buckets the curves
+/// are decimated to.
+type Timeline<'a> = (&'a [usize], TimeAxis, usize);
+
+/// Upper panel: temperatures. The gearbox nodes set the left axis; boundaries (ambient, coolant
+/// at a fixed 90 °C, ...) have their own right axis, so a distant boundary does not squash the
+/// node curves into a thin band.
+fn draw_temperatures(area: &Canvas, legend: &Canvas, run: &RunData, line: Timeline) -> DrawResult {
+    let (ts, sm) = (&run.ts, &run.summary);
+    let (order, time, buckets) = line;
+    let (x0, x1) = (time.x0, time.x1);
     let oil = sm.oil_node.as_deref();
     let any_node = ts.temps_c.iter().any(|(n, _)| !sm.is_boundary(n));
     let any_boundary = ts.temps_c.iter().any(|(n, _)| sm.is_boundary(n));
@@ -81,7 +92,7 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     };
     let (y0, y1) = range_of(!any_node);
     let (b0, b1) = range_of(true);
-    let mut chart = ChartBuilder::on(&upper)
+    let mut chart = ChartBuilder::on(area)
         .margin_left(20)
         .margin_right(10)
         .margin_top(10)
@@ -90,18 +101,12 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
         .right_y_label_area_size(Y2_LABEL_W)
         .build_cartesian_2d(x0..x1, y0..y1)?
         .set_secondary_coord(x0..x1, b0..b1);
-    chart
-        .configure_mesh()
+    Axes::house()
         .y_desc("Temperature (°C)")
-        .axis_desc_style(style::font(style::AXIS_DESC_PX))
-        .label_style(style::font(style::TICK_PX))
-        .light_line_style(style::GRID)
-        .bold_line_style(style::GRID_BOLD)
-        .x_labels(12)
-        .y_labels(8)
-        .x_label_formatter(&|_| String::new())
-        .y_label_formatter(&|v| style::fmt_num(*v))
-        .draw()?;
+        .labels(12, 8)
+        .x_format(&panel::blank)
+        .y_format(&panel::compact)
+        .draw(&mut chart)?;
     if any_node && any_boundary {
         chart
             .configure_secondary_axes()
@@ -117,7 +122,7 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
         let colour = style::series_colour(k);
         let boundary = sm.is_boundary(name);
         let width = if Some(name.as_str()) == oil { 5 } else { 3 };
-        for seg in finite_segments(&order, &ts.time_s, values, t_scale) {
+        for seg in finite_segments(order, &ts.time_s, values, time.scale) {
             let seg = decimate(&seg, buckets);
             if seg.len() == 1 {
                 chart.draw_series(std::iter::once(Circle::new(seg[0], 5, colour.filled())))?;
@@ -139,17 +144,23 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
         entries.push(LegendEntry::new(label, swatch));
     }
     if ts.temps_c.is_empty() {
-        style::draw_note_centre(&upper, "no temperature columns in timeseries.csv")?;
+        style::draw_note_centre(area, "no temperature columns in timeseries.csv")?;
     }
-    style::draw_legend_column(&leg_up, Some("Thermal nodes"), &entries, 14)?;
+    style::draw_legend_column(legend, Some("Thermal nodes"), &entries, 14)?;
+    Ok(())
+}
 
-    // Lower panel: vehicle speed and gear.
+/// Lower panel: vehicle speed (left axis) and gear (step line, right axis).
+fn draw_drive(area: &Canvas, legend: &Canvas, run: &RunData, line: Timeline) -> DrawResult {
+    let ts = &run.ts;
+    let (order, time, buckets) = line;
+    let (x0, x1) = (time.x0, time.x1);
     let (s0, s1) = style::padded_range(ts.vehicle_speed_kmh.iter().copied().chain([0.0]), 0.06);
     let all_non_negative = ts.vehicle_speed_kmh.iter().all(|v| v.is_nan() || *v >= 0.0);
     let s0 = if all_non_negative { 0.0 } else { s0 };
     let levels = gear_levels(&ts.gear);
     let n_levels = levels.len().max(1) as f64;
-    let mut lower_chart = ChartBuilder::on(&lower)
+    let mut chart = ChartBuilder::on(area)
         .margin_left(20)
         .margin_right(10)
         .margin_top(14)
@@ -159,19 +170,13 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
         .right_y_label_area_size(Y2_LABEL_W)
         .build_cartesian_2d(x0..x1, s0..s1)?
         .set_secondary_coord(x0..x1, -0.6..(n_levels - 0.4));
-    lower_chart
-        .configure_mesh()
-        .x_desc(t_desc)
+    Axes::house()
+        .x_desc(time.desc)
         .y_desc("Vehicle speed (km/h)")
-        .axis_desc_style(style::font(style::AXIS_DESC_PX))
-        .label_style(style::font(style::TICK_PX))
-        .light_line_style(style::GRID)
-        .bold_line_style(style::GRID_BOLD)
-        .x_labels(12)
-        .y_labels(5)
-        .x_label_formatter(&|v| style::fmt_num(*v))
-        .y_label_formatter(&|v| style::fmt_num(*v))
-        .draw()?;
+        .labels(12, 5)
+        .x_format(&panel::compact)
+        .y_format(&panel::compact)
+        .draw(&mut chart)?;
     let gear_label = |v: &f64| {
         let r = v.round();
         if (v - r).abs() < 1e-6 && r >= 0.0 && (r as usize) < levels.len() {
@@ -180,7 +185,7 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
             String::new()
         }
     };
-    lower_chart
+    chart
         .configure_secondary_axes()
         .y_desc("Gear")
         .axis_desc_style(style::font(style::AXIS_DESC_PX))
@@ -191,17 +196,33 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
 
     let speed_colour = RGBColor(40, 40, 40);
     let gear_colour = RGBColor(204, 121, 167);
-    for seg in finite_segments(&order, &ts.time_s, &ts.vehicle_speed_kmh, t_scale) {
+    for seg in finite_segments(order, &ts.time_s, &ts.vehicle_speed_kmh, time.scale) {
         if seg.len() == 1 {
-            lower_chart.draw_series(std::iter::once(Circle::new(seg[0], 5, speed_colour.filled())))?;
+            chart.draw_series(std::iter::once(Circle::new(seg[0], 5, speed_colour.filled())))?;
         }
         let seg = decimate(&seg, buckets);
-        lower_chart.draw_series(LineSeries::new(seg, speed_colour.stroke_width(2)))?;
+        chart.draw_series(LineSeries::new(seg, speed_colour.stroke_width(2)))?;
     }
-    // Gear as a step line: hold each gear until the next sample; breaks where the gear is missing.
+    for s in gear_steps(ts, order, &levels, time.scale) {
+        if s.len() == 1 {
+            chart.draw_secondary_series(std::iter::once(Circle::new(s[0], 6, gear_colour.filled())))?;
+        }
+        chart.draw_secondary_series(LineSeries::new(s, gear_colour.stroke_width(3)))?;
+    }
+    let entries = [
+        LegendEntry::new("vehicle speed", Swatch::Line(speed_colour, 2)),
+        LegendEntry::new("gear (right axis)", Swatch::Line(gear_colour, 3)),
+    ];
+    style::draw_legend_column(legend, Some("Drive"), &entries, 18)?;
+    Ok(())
+}
+
+/// The gear as step lines (time in display units, gear level): each gear held until the next
+/// sample; a new line where the gear is missing.
+fn gear_steps(ts: &TimeSeries, order: &[usize], levels: &[String], t_scale: f64) -> Vec<Vec<(f64, f64)>> {
     let mut step: Vec<(f64, f64)> = Vec::new();
     let mut steps = Vec::new();
-    for &i in &order {
+    for &i in order {
         let lvl = levels.iter().position(|l| l == ts.gear[i].trim());
         let t = ts.time_s[i] * t_scale;
         match lvl {
@@ -223,23 +244,5 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     if !step.is_empty() {
         steps.push(step);
     }
-    for s in steps {
-        if s.len() == 1 {
-            lower_chart.draw_secondary_series(std::iter::once(Circle::new(s[0], 6, gear_colour.filled())))?;
-        }
-        lower_chart.draw_secondary_series(LineSeries::new(s, gear_colour.stroke_width(3)))?;
-    }
-    let low_entries = [
-        LegendEntry::new("vehicle speed", Swatch::Line(speed_colour, 2)),
-        LegendEntry::new("gear (right axis)", Swatch::Line(gear_colour, 3)),
-    ];
-    style::draw_legend_column(&leg_low, Some("Drive"), &low_entries, 18)?;
-    if levels.is_empty() {
-        lower.draw(&Text::new(
-            "no gear data",
-            (w as i32 / 2, 30),
-            style::text_at(style::NOTE_PX, HPos::Center, VPos::Top),
-        ))?;
-    }
-    Ok(())
+    steps
 }

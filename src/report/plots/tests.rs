@@ -590,3 +590,19 @@ fn write_samples() {
     write_bench(&d);
     render_bench(&d).unwrap();
 }
+
+#[test]
+fn table_numbers_fit_their_cells() {
+    use style::{fmt_fixed, fmt_share};
+    assert_eq!(fmt_fixed(81.14, 1), "81.1");
+    assert_eq!(fmt_fixed(1809.0, 0), "1809");
+    assert_eq!(fmt_fixed(1e300, 1), "1.000e300");
+    assert_eq!(fmt_fixed(f64::INFINITY, 1), "–");
+    assert_eq!(fmt_share(54.79, 324.4), format!("{:.1} %", 100.0 * 54.79 / 324.4));
+    // 100·part overflows; the share does not.
+    assert_eq!(fmt_share(1e308, 1e308), "100.0 %");
+    assert_eq!(fmt_share(1e300, 1e-3), "1.000e305 %");
+    assert_eq!(fmt_share(1e308, 1e-3), "–");
+    assert_eq!(fmt_share(1.0, 0.0), "–");
+    assert_eq!(fmt_share(f64::NAN, 1.0), "–");
+}

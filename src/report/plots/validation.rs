@@ -4,6 +4,7 @@
 use plotters::prelude::*;
 use plotters::series::DashedLineSeries;
 
+use super::panel::{Axes, Grid};
 use super::style::{self, LegendEntry, Marker, Swatch};
 use super::{Canvas, DrawResult};
 use crate::reference::Row;
@@ -69,17 +70,18 @@ pub fn draw_parity(root: &Canvas, rows: &[&Row], title: &str) -> DrawResult {
         .x_label_area_size(70)
         .y_label_area_size(100)
         .build_cartesian_2d((lo..hi).log_scale(), (lo..hi).log_scale())?;
-    ch.configure_mesh()
-        .x_labels(8)
-        .y_labels(8)
-        .x_label_formatter(&|v| format!("{v:.0}"))
-        .y_label_formatter(&|v| format!("{v:.0}"))
-        .light_line_style(WHITE)
+    let watts = |v: &f64| format!("{v:.0}");
+    Axes::with_fonts(style::text(22), style::text(24))
+        .grid(Grid::Lines {
+            light: Some(WHITE),
+            bold: None,
+        })
+        .labels(8, 8)
+        .x_format(&watts)
+        .y_format(&watts)
         .x_desc("reference, W")
         .y_desc("geartherm, W")
-        .label_style(style::text(22))
-        .axis_desc_style(style::text(24))
-        .draw()?;
+        .draw(&mut ch)?;
     let line = |f: f64| vec![(lo, lo * f), (hi, hi * f)];
     ch.draw_series(LineSeries::new(line(1.0), BLACK.stroke_width(2)))?;
     for (f, c) in [(1.1, RGBColor(120, 120, 120)), (0.9, RGBColor(120, 120, 120))] {
@@ -166,12 +168,10 @@ fn error_vs_speed(root: &Canvas, rows: &[&Row], title: &str, ranges: bool) -> Dr
         .x_label_area_size(70)
         .y_label_area_size(100)
         .build_cartesian_2d(x0..x1, y0..y1)?;
-    ch.configure_mesh()
+    Axes::with_fonts(style::text(22), style::text(24))
         .x_desc("input speed, rpm")
         .y_desc(y_desc)
-        .label_style(style::text(22))
-        .axis_desc_style(style::text(24))
-        .draw()?;
+        .draw(&mut ch)?;
     ch.draw_series(LineSeries::new(vec![(x0, 0.0), (x1, 0.0)], BLACK.stroke_width(2)))?;
     for v in [10.0, -10.0] {
         ch.draw_series(LineSeries::new(

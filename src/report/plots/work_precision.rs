@@ -2,10 +2,12 @@
 //! markers per solver (points joined in order of rtol), rtol written next to points where it
 //! does not collide with another label, the default setting ringed and annotated.
 
+use plotters::coord::combinators::{LogCoord, WithKeyPoints};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
 
 use super::data::{BenchMeta, BenchRow};
+use super::panel::Axes;
 use super::style::{self, LegendEntry, Marker, Swatch};
 use super::{Canvas, DrawResult};
 
@@ -69,6 +71,33 @@ fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo / f, hi * f)
 }
 
+/// True for a row with a positive finite error and wall time (drawn on the log–log axes).
+fn drawable(r: &BenchRow) -> bool {
+    matches!((r.err_max_k, r.wall_time_s), (Some(e), Some(t)) if e.is_finite() && e > 0.0 && t.is_finite() && t > 0.0)
+}
+
+/// A log axis with its own tick values.
+type LogAxis = WithKeyPoints<LogCoord<f64>>;
+
+/// The log–log chart of the figure.
+type LogChart<'b> = ChartContext<'b, BitMapBackend<'b>, Cartesian2d<LogAxis, LogAxis>>;
+
+/// A log axis over [lo, hi] with the key and light points of [`log_ticks`].
+fn log_axis(lo: f64, hi: f64) -> LogAxis {
+    let (keys, light) = log_ticks(lo, hi);
+    (lo..hi)
+        .log_scale()
+        .with_key_points(keys)
+        .with_light_points(light)
+}
+
+/// Pixel boxes (x0, y0, x1, y1) of what is drawn, and the rtol labels waiting for a free place.
+#[derive(Default)]
+struct Placement {
+    boxes: Vec<(i32, i32, i32, i32)>,
+    pending: Vec<((i32, i32), String)>,
+}
+
 /// Draw `work_precision.png`: wall time vs maximum temperature error per solver.
 pub fn draw(root: &Canvas, rows: &[BenchRow], meta: &BenchMeta) -> DrawResult {
     let title = format!(
@@ -79,12 +108,9 @@ pub fn draw(root: &Canvas, rows: &[BenchRow], meta: &BenchMeta) -> DrawResult {
     let root = style::titled(root, &title)?;
     let (w, _) = root.dim_in_pixel();
     let (main, legend) = root.split_horizontally(w - 320);
-
-    let ok = |r: &BenchRow| matches!((r.err_max_k, r.wall_time_s), (Some(e), Some(t)) if e.is_finite() && e > 0.0 && t.is_finite() && t > 0.0);
-    let hidden = rows.iter().filter(|r| !ok(r)).count();
-    let (ex0, ex1) = log_range(rows.iter().filter(|r| ok(r)).filter_map(|r| r.err_max_k));
-    let (ty0, ty1) = log_range(rows.iter().filter(|r| ok(r)).filter_map(|r| r.wall_time_s));
-
+    let hidden = rows.iter().filter(|r| !drawable(r)).count();
+    let (ex0, ex1) = log_range(rows.iter().filter(|r| drawable(r)).filter_map(|r| r.err_max_k));
+    let (ty0, ty1) = log_range(rows.iter().filter(|r| drawable(r)).filter_map(|r| r.wall_time_s));
     let mut chart = ChartBuilder::on(&main)
         .margin_left(20)
         .margin_right(30)
@@ -92,128 +118,22 @@ pub fn draw(root: &Canvas, rows: &[BenchRow], meta: &BenchMeta) -> DrawResult {
         .margin_bottom(10)
         .x_label_area_size(80)
         .y_label_area_size(120)
-        .build_cartesian_2d(
-            {
-                let (keys, light) = log_ticks(ex0, ex1);
-                (ex0..ex1)
-                    .log_scale()
-                    .with_key_points(keys)
-                    .with_light_points(light)
-            },
-            {
-                let (keys, light) = log_ticks(ty0, ty1);
-                (ty0..ty1)
-                    .log_scale()
-                    .with_key_points(keys)
-                    .with_light_points(light)
-            },
-        )?;
-    chart
-        .configure_mesh()
+        .build_cartesian_2d(log_axis(ex0, ex1), log_axis(ty0, ty1))?;
+    let label = |v: &f64| log_label(*v);
+    Axes::house()
         .x_desc("Maximum temperature error vs reference (K)")
         .y_desc("Wall time (s)")
-        .axis_desc_style(style::font(style::AXIS_DESC_PX))
-        .label_style(style::font(style::TICK_PX))
-        .light_line_style(style::GRID)
-        .bold_line_style(style::GRID_BOLD)
-        .x_labels(40)
-        .y_labels(40)
-        .x_label_formatter(&|v| log_label(*v))
-        .y_label_formatter(&|v| log_label(*v))
-        .draw()?;
-
-    // Solvers in order of first appearance.
-    let mut solvers: Vec<&str> = Vec::new();
-    for r in rows {
-        if !solvers.contains(&r.solver.as_str()) {
-            solvers.push(&r.solver);
-        }
-    }
-    let plot = chart.plotting_area().strip_coord_spec();
-    let (ox, oy) = chart.plotting_area().get_base_pixel();
-    let mut entries = Vec::new();
-    let mut boxes: Vec<(i32, i32, i32, i32)> = Vec::new();
-    let mut pending_labels = Vec::new();
-    for (k, solver) in solvers.iter().enumerate() {
-        let colour = style::series_colour(k);
-        let marker = Marker::nth(k);
-        let mut pts: Vec<&BenchRow> = rows.iter().filter(|r| r.solver == *solver && ok(r)).collect();
-        pts.sort_by(|a, b| b.rtol.unwrap_or(f64::NAN).total_cmp(&a.rtol.unwrap_or(f64::NAN)));
-        let xy: Vec<(f64, f64)> = pts
-            .iter()
-            .filter_map(|r| Some((r.err_max_k?, r.wall_time_s?)))
-            .collect();
-        chart.draw_series(LineSeries::new(xy.clone(), colour.stroke_width(3)))?;
-        for (j, (r, p)) in pts.iter().zip(&xy).enumerate() {
-            let (px, py) = chart.backend_coord(p);
-            style::draw_marker_px(&plot, (px - ox, py - oy), marker, 9, colour.filled())?;
-            boxes.push((px - 12, py - 12, px + 12, py + 12));
-            // Sparse labels: every other point, plus the last one.
-            let wanted = j % 2 == 0 || j + 1 == xy.len();
-            if let Some(rt) = r.rtol.filter(|_| wanted) {
-                pending_labels.push(((px, py), format!("rtol {}", log_label(rt))));
-            }
-        }
-        entries.push(LegendEntry::new(*solver, Swatch::MarkerLine(colour, marker)));
-    }
-    // Default setting: ring and annotation.
+        .labels(40, 40)
+        .x_format(&label)
+        .y_format(&label)
+        .draw(&mut chart)?;
+    let mut placed = Placement::default();
+    let mut entries = draw_solvers(&mut chart, rows, &mut placed)?;
     let default_colour = RGBColor(0, 0, 0);
-    for r in rows.iter().filter(|r| r.default && ok(r)) {
-        if let (Some(e), Some(t)) = (r.err_max_k, r.wall_time_s) {
-            let (px, py) = chart.backend_coord(&(e, t));
-            plot.draw(&Circle::new(
-                (px - ox, py - oy),
-                20,
-                default_colour.stroke_width(4),
-            ))?;
-            let label = format!(
-                "default: {}, rtol {}",
-                r.solver,
-                r.rtol.map(log_label).unwrap_or_default()
-            );
-            let (pw, _) = plot.dim_in_pixel();
-            let right = px - ox < pw as i32 - 420;
-            let (tx, anchor) = if right {
-                (px - ox + 28, HPos::Left)
-            } else {
-                (px - ox - 28, HPos::Right)
-            };
-            plot.draw(&Text::new(
-                label,
-                (tx, py - oy - 26),
-                style::text_at(style::LEGEND_PX, anchor, VPos::Center).color(&default_colour),
-            ))?;
-            let x0 = if right { px + 28 } else { px - 448 };
-            boxes.push((x0, py - 42, x0 + 420, py - 10));
-        }
+    for r in rows.iter().filter(|r| r.default && drawable(r)) {
+        draw_default(&chart, r, default_colour, &mut placed)?;
     }
-    // rtol labels where they fit (greedy, in row order).
-    let f = style::text(style::NOTE_PX);
-    for ((px, py), label) in pending_labels {
-        let tw = plot
-            .estimate_text_size(&label, &f)
-            .map(|(w, _)| w as i32)
-            .unwrap_or(80);
-        let th = style::NOTE_PX as i32 + 4;
-        for (dx, dy) in [(14, 6), (14, -th - 6), (-tw - 14, 6), (-tw - 14, -th - 6)] {
-            let b = (px + dx, py + dy, px + dx + tw, py + dy + th);
-            let (pw, ph) = plot.dim_in_pixel();
-            let inside = b.0 - ox > 0 && b.2 - ox < pw as i32 && b.1 - oy > 0 && b.3 - oy < ph as i32;
-            if inside
-                && !boxes
-                    .iter()
-                    .any(|o| b.0 < o.2 && o.0 < b.2 && b.1 < o.3 && o.1 < b.3)
-            {
-                plot.draw(&Text::new(
-                    label.clone(),
-                    (b.0 - ox, b.1 - oy),
-                    style::text(style::NOTE_PX).color(&style::NEUTRAL),
-                ))?;
-                boxes.push(b);
-                break;
-            }
-        }
-    }
+    draw_rtol_labels(&chart, placed)?;
     if rows.iter().any(|r| r.default) {
         entries.push(LegendEntry::new("default setting", Swatch::Ring(default_colour)));
     }
@@ -230,6 +150,116 @@ pub fn draw(root: &Canvas, rows: &[BenchRow], meta: &BenchMeta) -> DrawResult {
             (10, lh as i32 - 44),
             style::text(style::NOTE_PX),
         ))?;
+    }
+    Ok(())
+}
+
+/// One line with markers per solver (in order of first appearance; points joined in order of
+/// rtol); every other point's rtol (and the last one's) waits in `placed` for a free place.
+/// Returns the legend entries.
+fn draw_solvers(
+    chart: &mut LogChart,
+    rows: &[BenchRow],
+    placed: &mut Placement,
+) -> Result<Vec<LegendEntry>, Box<dyn std::error::Error>> {
+    let mut solvers: Vec<&str> = Vec::new();
+    for r in rows {
+        if !solvers.contains(&r.solver.as_str()) {
+            solvers.push(&r.solver);
+        }
+    }
+    let plot = chart.plotting_area().strip_coord_spec();
+    let (ox, oy) = chart.plotting_area().get_base_pixel();
+    let mut entries = Vec::new();
+    for (k, solver) in solvers.iter().enumerate() {
+        let colour = style::series_colour(k);
+        let marker = Marker::nth(k);
+        let mut pts: Vec<&BenchRow> = rows
+            .iter()
+            .filter(|r| r.solver == *solver && drawable(r))
+            .collect();
+        pts.sort_by(|a, b| b.rtol.unwrap_or(f64::NAN).total_cmp(&a.rtol.unwrap_or(f64::NAN)));
+        let xy: Vec<(f64, f64)> = pts
+            .iter()
+            .filter_map(|r| Some((r.err_max_k?, r.wall_time_s?)))
+            .collect();
+        chart.draw_series(LineSeries::new(xy.clone(), colour.stroke_width(3)))?;
+        for (j, (r, p)) in pts.iter().zip(&xy).enumerate() {
+            let (px, py) = chart.backend_coord(p);
+            style::draw_marker_px(&plot, (px - ox, py - oy), marker, 9, colour.filled())?;
+            placed.boxes.push((px - 12, py - 12, px + 12, py + 12));
+            // Sparse labels: every other point, plus the last one.
+            let wanted = j % 2 == 0 || j + 1 == xy.len();
+            if let Some(rt) = r.rtol.filter(|_| wanted) {
+                placed.pending.push(((px, py), format!("rtol {}", log_label(rt))));
+            }
+        }
+        entries.push(LegendEntry::new(*solver, Swatch::MarkerLine(colour, marker)));
+    }
+    Ok(entries)
+}
+
+/// The default setting `r`: ringed and annotated (right of the point, or left near the edge).
+fn draw_default(chart: &LogChart, r: &BenchRow, colour: RGBColor, placed: &mut Placement) -> DrawResult {
+    let (Some(e), Some(t)) = (r.err_max_k, r.wall_time_s) else {
+        return Ok(());
+    };
+    let plot = chart.plotting_area().strip_coord_spec();
+    let (ox, oy) = chart.plotting_area().get_base_pixel();
+    let (px, py) = chart.backend_coord(&(e, t));
+    plot.draw(&Circle::new((px - ox, py - oy), 20, colour.stroke_width(4)))?;
+    let label = format!(
+        "default: {}, rtol {}",
+        r.solver,
+        r.rtol.map(log_label).unwrap_or_default()
+    );
+    let (pw, _) = plot.dim_in_pixel();
+    let right = px - ox < pw as i32 - 420;
+    let (tx, anchor) = if right {
+        (px - ox + 28, HPos::Left)
+    } else {
+        (px - ox - 28, HPos::Right)
+    };
+    plot.draw(&Text::new(
+        label,
+        (tx, py - oy - 26),
+        style::text_at(style::LEGEND_PX, anchor, VPos::Center).color(&colour),
+    ))?;
+    let x0 = if right { px + 28 } else { px - 448 };
+    placed.boxes.push((x0, py - 42, x0 + 420, py - 10));
+    Ok(())
+}
+
+/// The waiting rtol labels where they fit (greedy, in row order): beside their point, inside the
+/// plot, over nothing drawn.
+fn draw_rtol_labels(chart: &LogChart, placed: Placement) -> DrawResult {
+    let plot = chart.plotting_area().strip_coord_spec();
+    let (ox, oy) = chart.plotting_area().get_base_pixel();
+    let Placement { mut boxes, pending } = placed;
+    let f = style::text(style::NOTE_PX);
+    for ((px, py), label) in pending {
+        let tw = plot
+            .estimate_text_size(&label, &f)
+            .map(|(w, _)| w as i32)
+            .unwrap_or(80);
+        let th = style::NOTE_PX as i32 + 4;
+        for (dx, dy) in [(14, 6), (14, -th - 6), (-tw - 14, 6), (-tw - 14, -th - 6)] {
+            let b = (px + dx, py + dy, px + dx + tw, py + dy + th);
+            let (pw, ph) = plot.dim_in_pixel();
+            let inside = b.0 - ox > 0 && b.2 - ox < pw as i32 && b.1 - oy > 0 && b.3 - oy < ph as i32;
+            let free = !boxes
+                .iter()
+                .any(|o| b.0 < o.2 && o.0 < b.2 && b.1 < o.3 && o.1 < b.3);
+            if inside && free {
+                plot.draw(&Text::new(
+                    label.clone(),
+                    (b.0 - ox, b.1 - oy),
+                    style::text(style::NOTE_PX).color(&style::NEUTRAL),
+                ))?;
+                boxes.push(b);
+                break;
+            }
+        }
     }
     Ok(())
 }
