@@ -191,12 +191,13 @@ BAD_VALUES = ["", "=", "[", "{", '"', "'''", "1 2", "1\n[model]\nname = \"x\"", 
 
 def set_value(rng, orig):
     r = rng.random()
-    if r < 0.4:
+    if r < 0.2:
         return rng.choice(HOSTILE)
-    if r < 0.6 and isinstance(orig, (int, float)) and not isinstance(orig, bool):
-        x = orig * rng.choice([0, -1, 1e-9, 0.5, 2, 1e3, 1e9])
+    if r < 0.65 and isinstance(orig, (int, float)) and not isinstance(orig, bool):
+        moderate = rng.random() < 0.6
+        x = orig * (rng.choice([0.5, 0.9, 1.1, 2]) if moderate else rng.choice([0, -1, 1e-9, 1e3, 1e9]))
         return repr(float(x)) if isinstance(orig, float) else str(int(x))
-    if r < 0.7:
+    if r < 0.75:
         return repr(orig).replace("'", '"').replace("True", "true").replace("False", "false")
     return rng.choice(BAD_VALUES)
 
@@ -206,12 +207,12 @@ def set_args(rng, text):
     if paths is None:
         paths = _PATHS.setdefault(text, leaf_paths(text))
     out = []
-    for _ in range(rng.choice([1, 1, 2, 3])):
+    for _ in range(rng.choice([1, 1, 1, 2, 3])):
         path, orig = rng.choice(paths)
         r = rng.random()
-        if r < 0.15:
+        if r < 0.1:
             path = rng.choice(BAD_PATHS)
-        elif r < 0.25:
+        elif r < 0.15:
             path = path + rng.choice([".x", "[0]", '["x"]', "[1000000]", ""])
         form = rng.random()
         val = set_value(rng, orig)

@@ -105,6 +105,17 @@ def csv_craft(rng, text):
     return "\n".join(lines).encode()
 
 
+def diagonal(rng, path):
+    """n rows of n distinct speeds and torques: an n × n grid for n points."""
+    with open(path) as f:
+        lines = f.read().split("\n")
+    tail = lines[1].split(",")[2:]
+    n = rng.choice([300, 5000, 70000])
+    rows = [",".join([str(1000.0 + k), str(10.0 + k)] + tail) for k in range(n)]
+    with open(path, "w") as f:
+        f.write("\n".join([lines[0]] + rows) + "\n")
+
+
 def make_case(i, rng):
     kind = rng.choice(["run", "run", "map", "bench"])
     target = rng.choice(["json", "csv", "csv", "both", "special"])
@@ -122,7 +133,9 @@ def craft(case, rng, d):
             text = json_craft(rng, json.load(f))
         with open(mp, "w") as f:
             f.write(text)
-    if t in ("csv", "both"):
+    if t in ("csv", "both") and case["kind"] == "map" and rng.random() < 0.05:
+        diagonal(rng, tp)
+    elif t in ("csv", "both"):
         with open(tp) as f:
             data = csv_craft(rng, f.read())
         with open(tp, "wb") as f:

@@ -2,8 +2,8 @@
 //! differently (`--speed-rpm` on the command line, `speed_rpm` in a study file and in Python);
 //! the message names both, so that it reads the same from each.
 
-use super::envelope::OIL_RANGE_C;
 use super::JobError;
+use crate::solve::equilibrium::OIL_RANGE_C;
 
 /// A closed range of a numeric option.
 #[derive(Debug, Clone, Copy, PartialEq)]

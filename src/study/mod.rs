@@ -141,37 +141,39 @@ fn jobs_of(spec: &JobSpec) -> Result<Vec<Job>, String> {
             speed_rpm,
             torque_nm,
             vehicle_speed_kmh,
-        } => {
-            // The grid's size and values are checked as `geartherm map` checks them, before its
-            // points are built.
-            let grid = job::MapOptions {
-                gear: gear.clone(),
-                speed_rpm: speed_rpm.clone(),
-                torque_nm: torque_nm.clone(),
-                vehicle_speed_kmh: *vehicle_speed_kmh,
-                ambient_c: None,
-            };
-            grid.check().map_err(|e| format!("job: {}", e.message))?;
-            speed_rpm
-                .iter()
-                .flat_map(|&s| {
-                    torque_nm.iter().map(move |&t| {
-                        Job::Steady(SteadyOptions {
-                            gear: gear.clone(),
-                            speed_rpm: s,
-                            torque_nm: t,
-                            vehicle_speed_kmh: *vehicle_speed_kmh,
-                            ambient_c: None,
-                        })
-                    })
-                })
-                .collect()
-        }
+        } => map_jobs(job::MapOptions {
+            gear: gear.clone(),
+            speed_rpm: speed_rpm.clone(),
+            torque_nm: torque_nm.clone(),
+            vehicle_speed_kmh: *vehicle_speed_kmh,
+            ambient_c: None,
+        })?,
     };
     if jobs.is_empty() {
         return Err("job: no cycles or points".into());
     }
     Ok(jobs)
+}
+
+/// A map job's points, one steady job each; the grid's size and values are checked as
+/// `geartherm map` checks them, before its points are built.
+fn map_jobs(grid: job::MapOptions) -> Result<Vec<Job>, String> {
+    grid.check().map_err(|e| format!("job: {}", e.message))?;
+    let point = |s: f64, t: f64| {
+        Job::Steady(SteadyOptions {
+            gear: grid.gear.clone(),
+            speed_rpm: s,
+            torque_nm: t,
+            vehicle_speed_kmh: grid.vehicle_speed_kmh,
+            ambient_c: None,
+        })
+    };
+    Ok(grid
+        .speed_rpm
+        .iter()
+        .flat_map(|&s| grid.torque_nm.iter().map(move |&t| (s, t)))
+        .map(|(s, t)| point(s, t))
+        .collect())
 }
 
 /// A study's name names its default output directory (`studies/<name>`): a plain name
