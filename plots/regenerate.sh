@@ -5,3 +5,8 @@ cargo build --release
 ./target/release/geartherm run models/at6_lepelletier.toml --cycle wltc --out plots/at6_wltc --report --quiet
 ./target/release/geartherm map models/fzg_c.toml --gear 1 --speed-rpm 300:3000:28 --torque-nm 0:300:31 --out plots/fzg_c_map --quiet
 ./target/release/geartherm validate validation --out plots/validation --doc docs/validation.md > /dev/null
+./target/release/geartherm run models/ev_reducer.toml --cycle wltc --out plots/ev_reducer_wltc --report --quiet
+./target/release/geartherm run models/ev_reducer.toml --cycle artemis_motorway130 --out plots/ev_reducer_motorway --report --quiet
+./target/release/geartherm map models/ev_reducer.toml --gear D --speed-rpm 0:16000:33 --torque-nm 0:90:31 --out plots/ev_reducer_map --quiet
+./target/release/geartherm rating models/ev_reducer.toml --gear D --speed-rpm 500:16000:32 --oil-limit-c 110 --torque-max-nm 310 --out plots/ev_reducer_rating --quiet > /dev/null
+./target/release/geartherm rating models/fzg_c.toml --gear 1 --speed-rpm 250:6000:24 --oil-limit-c 100 --out plots/fzg_c_rating --quiet > /dev/null

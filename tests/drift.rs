@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use geartherm::job::{self, LossesOptions, RunOptions, SteadyOptions};
+use geartherm::job::{self, LossesOptions, RatingOptions, RunOptions, SteadyOptions};
 use geartherm::study::spec::{JobSpec, Meta, OutputSpec, ParamSpec, Sampling, StudySpec};
 use geartherm::study::{ParamValue, Study, StudyError};
 use toml::{Table, Value};
@@ -77,12 +77,16 @@ fn cli(row: &Row, out: &Path) -> Outcome {
             Value::Float(x) => {
                 cmd.arg(format!("{}={x}", flag(k)));
             }
+            Value::Array(a) => {
+                let items: Vec<String> = a.iter().map(|v| v.to_string()).collect();
+                cmd.arg(format!("{}={}", flag(k), items.join(",")));
+            }
             other => {
                 cmd.arg(format!("{}={other}", flag(k)));
             }
         }
     }
-    if row.job == "run" {
+    if row.job == "run" || row.job == "rating" {
         cmd.arg("--quiet").arg("--out").arg(out);
     }
     let o = cmd.output().unwrap();
@@ -119,6 +123,7 @@ fn library(row: &Row, m: &job::Model) -> Outcome {
         "losses" => outcome(job::losses::losses(m, &options::<LossesOptions>(row))),
         "steady" => outcome(job::steady::steady(m, &options::<SteadyOptions>(row))),
         "run" => outcome(job::run::run(m, &options::<RunOptions>(row), &mut |_, _| {})),
+        "rating" => outcome(job::rating::rating(m, &options::<RatingOptions>(row), &|| {})),
         other => panic!("{other}"),
     }
 }

@@ -8,7 +8,9 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
-use geartherm::job::{self, ErrorKind, JobError, LossesOptions, MapOptions, RunOptions, SteadyOptions};
+use geartherm::job::{
+    self, ErrorKind, JobError, LossesOptions, MapOptions, RatingOptions, RunOptions, SteadyOptions,
+};
 use geartherm::model::Override;
 use geartherm::study::spec::StudySpec;
 use geartherm::study::{CaseRow, Study, StudyError};
@@ -235,6 +237,16 @@ impl Model {
         let m = self.m.clone();
         let r = py.detach(|| job::map::map(&m, &o, &|| {})).map_err(job_error)?;
         Ok(r.csv)
+    }
+
+    /// A thermal rating (a mapping of `job::RatingOptions` in): the `rating.json` document.
+    fn rating(&self, py: Python<'_>, options: &Bound<'_, PyAny>) -> PyResult<String> {
+        let o: RatingOptions = self::options("rating", options)?;
+        let m = self.m.clone();
+        let r = py
+            .detach(|| job::rating::rating(&m, &o, &|| {}))
+            .map_err(job_error)?;
+        to_json(&r)
     }
 
     /// A drive-cycle run (a mapping of `job::RunOptions` in): (`summary.json` text, `timeseries.csv`

@@ -31,9 +31,11 @@ def _cli(job, options, out):
         flag = "--" + k.replace("_", "-")
         if v is True:
             args.append(flag)
+        elif isinstance(v, list):
+            args.append(f"{flag}={','.join(repr(x) for x in v)}")
         elif v is not False:
             args.append(f"{flag}={v!r}" if isinstance(v, float) else f"{flag}={v}")
-    if job == "run":
+    if job in ("run", "rating"):
         args += ["--quiet", "--out", str(out)]
     p = subprocess.run(args, cwd=ROOT, capture_output=True, text=True)
     kind = {0: "ok", 1: "refused", 2: "failed"}[p.returncode]
@@ -47,6 +49,8 @@ def _python(model, job, options):
             model.losses(o.pop("gear"), o.pop("speed_rpm"), o.pop("torque_nm"), o.pop("oil_temp_c"))
         elif job == "steady":
             model.steady(**o)
+        elif job == "rating":
+            model.rating(**o)
         else:
             model.run(**o)
     except geartherm.SolveError as e:

@@ -10,6 +10,7 @@ use clap::{Parser, Subcommand};
 mod bench;
 mod check;
 mod output;
+mod rating;
 mod report;
 mod run;
 mod steady;
@@ -48,6 +49,9 @@ pub enum Command {
     Steady(steady::SteadyArgs),
     /// Equilibria over a speed × torque grid (map.csv and heat maps).
     Map(steady::MapArgs),
+    /// Thermal rating: the highest input torque whose equilibrium oil temperature stays at or
+    /// below a limit, at one speed or over a sweep (rating.csv, rating.json, rating.png).
+    Rating(rating::RatingArgs),
     /// Design study: every sample of a parameter plan on cycles or operating points, in
     /// parallel; resumable; writes study.csv, study.parquet, main_effects.png, pareto.png.
     Study(study::StudyArgs),
@@ -93,6 +97,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         Command::Run(a) => run::run(&a),
         Command::Steady(a) => steady::steady(&a),
         Command::Map(a) => steady::map(&a),
+        Command::Rating(a) => rating::rating(&a),
         Command::Study(a) => study::study(&a),
         Command::Bench(a) => bench::bench(&a),
         Command::Validate(a) => validate::validate(&a),

@@ -79,7 +79,7 @@ pub struct MapArgs {
 }
 
 /// A grid axis as written on the command line: `A:B:N` or a comma-separated list.
-fn values(name: &str, flag: &str, s: &str) -> Result<Vec<f64>, JobError> {
+pub(super) fn values(name: &str, flag: &str, s: &str) -> Result<Vec<f64>, JobError> {
     if s.contains(':') {
         return axis(name, flag, s);
     }
@@ -122,7 +122,7 @@ pub fn steady(a: &SteadyArgs) -> Result<(), Failure> {
     }
 }
 
-fn steady_text(r: &SteadyResult) -> String {
+pub(super) fn steady_text(r: &SteadyResult) -> String {
     let mut t = format!(
         "{} gear {} at {} rpm, {} N·m: equilibrium after {} Newton + {} PTC iterations ({}), residual {:.1e} W\n",
         r.model, r.gear, r.speed_rpm, r.torque_nm, r.iterations, r.ptc_iterations, r.method, r.residual_w
@@ -172,6 +172,7 @@ pub fn map(a: &MapArgs) -> Result<(), Failure> {
         b.finish_and_clear();
     }
     let r = result?;
+    warnings(&r.meta.warnings);
     for (name, bytes) in r.files()? {
         out.write(name, &bytes)?;
     }

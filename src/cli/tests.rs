@@ -5,7 +5,9 @@ use std::path::Path;
 
 use clap::Parser;
 use geartherm::job::command::{command_line, split, validate_line, ToArgs};
-use geartherm::job::{BenchOptions, LossesOptions, MapOptions, RunOptions, SteadyOptions, ValidateOptions};
+use geartherm::job::{
+    BenchOptions, LossesOptions, MapOptions, RatingOptions, RunOptions, SteadyOptions, ValidateOptions,
+};
 use geartherm::model::Override;
 
 use super::{Cli, Command};
@@ -110,6 +112,30 @@ fn map_options_round_trip() {
     let Command::Map(a) = parse(&l) else { panic!("{l}") };
     check_source(&a.point.source);
     assert_eq!(a.options().unwrap(), o, "{l}");
+}
+
+#[test]
+fn rating_options_round_trip() {
+    for (speeds, torque_max_nm, ambient_c) in [
+        (vec![3000.0], None, None),
+        (vec![0.0, 1234.5, 1.0 / 3.0], Some(450.25), Some(-20.5)),
+    ] {
+        let o = RatingOptions {
+            gear: "D".into(),
+            speed_rpm: speeds,
+            oil_limit_c: 0.1 + 0.2,
+            vehicle_speed_kmh: 55.5,
+            ambient_c,
+            torque_min_nm: 12.125,
+            torque_max_nm,
+        };
+        let l = line(&o);
+        let Command::Rating(a) = parse(&l) else {
+            panic!("{l}")
+        };
+        check_source(&a.point.source);
+        assert_eq!(a.options().unwrap(), o, "{l}");
+    }
 }
 
 #[test]

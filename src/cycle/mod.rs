@@ -5,11 +5,11 @@
 //! - [`parse`]: CSV text → [`DriveCycle`] (vehicle cycle `time_s,speed_kmh[,gear]` or rig cycle
 //!   `time_s,input_speed_rpm,input_torque_nm,gear`), with line-numbered [`CycleError`]s;
 //! - [`bundled`]: the cycles in `models/cycles/` compiled in; [`bundled_names`], [`resolve`];
-//! - [`vehicle`]: the `[vehicle]` section ([`VehicleSpec`]) → checked [`Vehicle`];
+//! - [`vehicle`]: the checked [`Vehicle`] and its longitudinal dynamics;
 //! - [`gears`]: the gear table (state names and ratios) the others share;
 //! - [`shift`]: gear choice with hysteresis and minimum hold time;
-//! - [`launch`]: the `[launch]` section, a torque converter with lock-up: engine-side speed and
-//!   torque from the turbine (= gearbox input) demand;
+//! - [`launch`]: the checked [`LaunchDevice`], a torque converter with lock-up: engine-side speed
+//!   and torque from the turbine (= gearbox input) demand;
 //! - [`schedule()`]: cycle + vehicle + gear table → piecewise-constant [`Schedule`].
 
 pub mod bundled;
@@ -24,10 +24,8 @@ pub mod vehicle;
 pub use bundled::{bundled_names, resolve};
 pub use error::{CycleError, CycleErrorKind};
 pub use gears::GearTable;
-pub use launch::{EngineSide, LaunchDevice, LaunchSpec};
+pub use launch::{EngineSide, LaunchDevice};
 pub use parse::{CycleKind, CycleRow, DriveCycle};
 pub use schedule::{schedule, schedule_with_launch, Interval, Schedule};
 pub use shift::{BoundShift, Shifter};
-pub use vehicle::{
-    Demand, Overrun, RoadLoad, RoadLoadSpec, ShiftSpec, ShiftStrategy, Vehicle, VehicleProblem, VehicleSpec,
-};
+pub use vehicle::{Demand, Overrun, RoadLoad, ShiftStrategy, Vehicle};

@@ -85,172 +85,35 @@ impl DriveCycle {
     /// Parse CSV text. `source` names the text in error messages (a path, or `bundled:<name>`);
     /// the cycle's `name` is the file stem of `source`.
     pub fn parse(text: &str, source: &str) -> Result<DriveCycle, CycleError> {
-        let err = |kind, allowed: String| CycleError::new(kind, source, allowed);
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let mut records = records(text);
-
-        // Header.
-        let (header_line, header) = match records.next() {
-            None => {
-                return Err(err(
-                    CycleErrorKind::TooShort,
-                    format!("empty file: {ALLOWED_HEADERS}"),
-                ))
-            }
-            Some(r) => r,
+        let Some((header_line, header)) = records.next() else {
+            return Err(CycleError::new(
+                CycleErrorKind::TooShort,
+                source,
+                format!("empty file: {ALLOWED_HEADERS}"),
+            ));
         };
-        let names: Vec<String> = header.iter().map(|h| h.to_ascii_lowercase()).collect();
-        let mut col = [None::<usize>; 5];
-        for (i, n) in names.iter().enumerate() {
-            match KNOWN.iter().position(|k| k == n) {
-                None => {
-                    return Err(err(
-                        CycleErrorKind::Header,
-                        format!("unknown column; {ALLOWED_HEADERS}"),
-                    )
-                    .at_line(header_line)
-                    .at_column(if n.is_empty() { "(empty)" } else { n }));
-                }
-                Some(k) if col[k].is_some() => {
-                    return Err(err(CycleErrorKind::Header, "column appears twice".into())
-                        .at_line(header_line)
-                        .at_column(n));
-                }
-                Some(k) => col[k] = Some(i),
-            }
-        }
-        let [c_time, c_speed, c_in_speed, c_in_torque, c_gear] = col;
-        let kind = if c_in_speed.is_some() || c_in_torque.is_some() {
-            if c_speed.is_some() {
-                return Err(err(
-                    CycleErrorKind::Header,
-                    format!("speed_kmh cannot be mixed with rig columns; {ALLOWED_HEADERS}"),
-                )
-                .at_line(header_line));
-            }
-            CycleKind::Rig
-        } else {
-            CycleKind::Vehicle
-        };
-        let required: &[(&str, Option<usize>)] = match kind {
-            CycleKind::Vehicle => &[(TIME, c_time), (SPEED, c_speed)],
-            CycleKind::Rig => &[
-                (TIME, c_time),
-                (IN_SPEED, c_in_speed),
-                (IN_TORQUE, c_in_torque),
-                (GEAR, c_gear),
-            ],
-        };
-        for (name, c) in required {
-            if c.is_none() {
-                return Err(err(
-                    CycleErrorKind::Header,
-                    format!("missing column {name}; {ALLOWED_HEADERS}"),
-                )
-                .at_line(header_line));
-            }
-        }
-        let c_time = c_time.unwrap_or(0);
-
-        // Rows.
+        let cols = Columns::from_header(&header, header_line, source)?;
         let mut rows: Vec<CycleRow> = Vec::new();
         for (line, rec) in records {
-            if rec.len() != names.len() {
-                return Err(err(
-                    CycleErrorKind::Fields,
-                    format!("row has {} fields, the header has {}", rec.len(), names.len()),
-                )
-                .at_line(line));
-            }
-            let num = |c: usize| -> Result<f64, CycleError> {
-                let s = rec.get(c).copied().unwrap_or("");
-                match s.parse::<f64>() {
-                    Ok(v) if v.is_finite() => Ok(v),
-                    _ => Err(err(CycleErrorKind::Value, "must be a finite number".into())
-                        .at_line(line)
-                        .at_value(&names[c], s)),
-                }
-            };
-            if rows.len() >= MAX_ROWS {
-                return Err(err(
+            // (A row with the wrong number of fields is reported as such first.)
+            if rows.len() >= MAX_ROWS && rec.len() == cols.names.len() {
+                return Err(CycleError::new(
                     CycleErrorKind::Value,
+                    source,
                     format!("a cycle may have at most {MAX_ROWS} rows"),
                 )
                 .at_line(line));
             }
-            let time = num(c_time)?;
-            if !(0.0..=MAX_TIME_S).contains(&time) {
-                return Err(err(
-                    CycleErrorKind::Time,
-                    format!("time must lie in [0, {MAX_TIME_S:e}] s"),
-                )
-                .at_line(line)
-                .at_value(TIME, rec.get(c_time).copied().unwrap_or("")));
-            }
-            if let Some(prev) = rows.last() {
-                if time < prev.time + MIN_TIME_STEP_S {
-                    return Err(err(
-                        CycleErrorKind::Time,
-                        format!(
-                            "time must increase by at least {MIN_TIME_STEP_S} s per row (line {} has time_s = {})",
-                            prev.line, prev.time
-                        ),
-                    )
-                    .at_line(line)
-                    .at_value(TIME, rec.get(c_time).copied().unwrap_or("")));
-                }
-            }
-            let bounded = |c: usize, lo: f64, hi: f64, unit: &str| -> Result<f64, CycleError> {
-                let v = num(c)?;
-                if !(lo..=hi).contains(&v) {
-                    Err(
-                        err(CycleErrorKind::Value, format!("must lie in [{lo}, {hi}] {unit}"))
-                            .at_line(line)
-                            .at_value(&names[c], rec.get(c).copied().unwrap_or("")),
-                    )
-                } else {
-                    Ok(v)
-                }
-            };
-            let mut row = CycleRow {
-                line,
-                time,
-                vehicle_speed: 0.0,
-                input_speed: 0.0,
-                input_torque: 0.0,
-                gear: None,
-            };
-            match kind {
-                CycleKind::Vehicle => {
-                    row.vehicle_speed =
-                        bounded(c_speed.unwrap_or(0), 0.0, MAX_VEHICLE_SPEED_KMH, "km/h")? * KMH;
-                }
-                CycleKind::Rig => {
-                    row.input_speed =
-                        bounded(c_in_speed.unwrap_or(0), 0.0, MAX_INPUT_SPEED_RPM, "rpm")? * RPM;
-                    row.input_torque = bounded(
-                        c_in_torque.unwrap_or(0),
-                        -MAX_INPUT_TORQUE_NM,
-                        MAX_INPUT_TORQUE_NM,
-                        "N m",
-                    )?;
-                }
-            }
-            if let Some(c) = c_gear {
-                let g = rec.get(c).copied().unwrap_or("");
-                if g.is_empty() {
-                    return Err(err(CycleErrorKind::Value, "gear name must not be empty".into())
-                        .at_line(line)
-                        .at_value(GEAR, g));
-                }
-                row.gear = Some(g.to_string());
-            }
+            let row = cols.row(&rec, line, rows.last(), source)?;
             rows.push(row);
         }
         if rows.len() < 2 {
             let line = rows.last().map_or(header_line, |r| r.line);
-            return Err(err(
+            return Err(CycleError::new(
                 CycleErrorKind::TooShort,
+                source,
                 format!("a cycle needs at least 2 rows, found {}", rows.len()),
             )
             .at_line(line));
@@ -258,9 +121,9 @@ impl DriveCycle {
         Ok(DriveCycle {
             name: stem(source),
             source: source.to_string(),
-            kind,
+            kind: cols.kind,
             rows,
-            has_gear: c_gear.is_some(),
+            has_gear: cols.gear.is_some(),
         })
     }
 
@@ -312,6 +175,173 @@ impl DriveCycle {
     /// Highest vehicle speed, m/s.
     pub fn max_vehicle_speed(&self) -> f64 {
         self.rows.iter().map(|r| r.vehicle_speed).fold(0.0, f64::max)
+    }
+}
+
+/// The columns of a cycle file, from its header: the kind of cycle and where each value is.
+struct Columns {
+    /// Header names, lower case.
+    names: Vec<String>,
+    /// Vehicle or rig cycle.
+    kind: CycleKind,
+    /// Index of `time_s`.
+    time: usize,
+    /// Index of `speed_kmh` (vehicle cycles).
+    speed: Option<usize>,
+    /// Index of `input_speed_rpm` (rig cycles).
+    input_speed: Option<usize>,
+    /// Index of `input_torque_nm` (rig cycles).
+    input_torque: Option<usize>,
+    /// Index of `gear`, if the file has one.
+    gear: Option<usize>,
+}
+
+impl Columns {
+    /// Known, unique column names; the kind they make; the columns that kind needs.
+    fn from_header(header: &[&str], header_line: usize, source: &str) -> Result<Columns, CycleError> {
+        let err =
+            |allowed: String| CycleError::new(CycleErrorKind::Header, source, allowed).at_line(header_line);
+        let names: Vec<String> = header.iter().map(|h| h.to_ascii_lowercase()).collect();
+        let mut col = [None::<usize>; 5];
+        for (i, n) in names.iter().enumerate() {
+            match KNOWN.iter().position(|k| k == n) {
+                None => {
+                    return Err(err(format!("unknown column; {ALLOWED_HEADERS}"))
+                        .at_column(if n.is_empty() { "(empty)" } else { n }));
+                }
+                Some(k) if col[k].is_some() => {
+                    return Err(err("column appears twice".into()).at_column(n));
+                }
+                Some(k) => col[k] = Some(i),
+            }
+        }
+        let [c_time, c_speed, c_in_speed, c_in_torque, c_gear] = col;
+        let kind = if c_in_speed.is_some() || c_in_torque.is_some() {
+            if c_speed.is_some() {
+                return Err(err(format!(
+                    "speed_kmh cannot be mixed with rig columns; {ALLOWED_HEADERS}"
+                )));
+            }
+            CycleKind::Rig
+        } else {
+            CycleKind::Vehicle
+        };
+        let required: &[(&str, Option<usize>)] = match kind {
+            CycleKind::Vehicle => &[(TIME, c_time), (SPEED, c_speed)],
+            CycleKind::Rig => &[
+                (TIME, c_time),
+                (IN_SPEED, c_in_speed),
+                (IN_TORQUE, c_in_torque),
+                (GEAR, c_gear),
+            ],
+        };
+        if let Some((name, _)) = required.iter().find(|(_, c)| c.is_none()) {
+            return Err(err(format!("missing column {name}; {ALLOWED_HEADERS}")));
+        }
+        Ok(Columns {
+            names,
+            kind,
+            time: c_time.unwrap_or(0),
+            speed: c_speed,
+            input_speed: c_in_speed,
+            input_torque: c_in_torque,
+            gear: c_gear,
+        })
+    }
+
+    /// One record (file line `line`) as a row, after the row `prev`: field count, time, the
+    /// kind's values in range, gear name.
+    fn row(
+        &self,
+        rec: &[&str],
+        line: usize,
+        prev: Option<&CycleRow>,
+        source: &str,
+    ) -> Result<CycleRow, CycleError> {
+        let err = |kind, allowed: String| CycleError::new(kind, source, allowed).at_line(line);
+        let field = |c: usize| rec.get(c).copied().unwrap_or("");
+        if rec.len() != self.names.len() {
+            return Err(err(
+                CycleErrorKind::Fields,
+                format!(
+                    "row has {} fields, the header has {}",
+                    rec.len(),
+                    self.names.len()
+                ),
+            ));
+        }
+        let num = |c: usize| -> Result<f64, CycleError> {
+            match field(c).parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v),
+                _ => Err(err(CycleErrorKind::Value, "must be a finite number".into())
+                    .at_value(&self.names[c], field(c))),
+            }
+        };
+        let bounded = |c: usize, lo: f64, hi: f64, unit: &str| -> Result<f64, CycleError> {
+            let v = num(c)?;
+            if (lo..=hi).contains(&v) {
+                Ok(v)
+            } else {
+                Err(
+                    err(CycleErrorKind::Value, format!("must lie in [{lo}, {hi}] {unit}"))
+                        .at_value(&self.names[c], field(c)),
+                )
+            }
+        };
+        let time = num(self.time)?;
+        if !(0.0..=MAX_TIME_S).contains(&time) {
+            return Err(err(
+                CycleErrorKind::Time,
+                format!("time must lie in [0, {MAX_TIME_S:e}] s"),
+            )
+            .at_value(TIME, field(self.time)));
+        }
+        if let Some(prev) = prev {
+            if time < prev.time + MIN_TIME_STEP_S {
+                return Err(err(
+                    CycleErrorKind::Time,
+                    format!(
+                        "time must increase by at least {MIN_TIME_STEP_S} s per row (line {} has time_s = {})",
+                        prev.line, prev.time
+                    ),
+                )
+                .at_value(TIME, field(self.time)));
+            }
+        }
+        let mut row = CycleRow {
+            line,
+            time,
+            vehicle_speed: 0.0,
+            input_speed: 0.0,
+            input_torque: 0.0,
+            gear: None,
+        };
+        match self.kind {
+            CycleKind::Vehicle => {
+                row.vehicle_speed =
+                    bounded(self.speed.unwrap_or(0), 0.0, MAX_VEHICLE_SPEED_KMH, "km/h")? * KMH;
+            }
+            CycleKind::Rig => {
+                row.input_speed =
+                    bounded(self.input_speed.unwrap_or(0), 0.0, MAX_INPUT_SPEED_RPM, "rpm")? * RPM;
+                row.input_torque = bounded(
+                    self.input_torque.unwrap_or(0),
+                    -MAX_INPUT_TORQUE_NM,
+                    MAX_INPUT_TORQUE_NM,
+                    "N m",
+                )?;
+            }
+        }
+        if let Some(c) = self.gear {
+            let g = field(c);
+            if g.is_empty() {
+                return Err(
+                    err(CycleErrorKind::Value, "gear name must not be empty".into()).at_value(GEAR, g)
+                );
+            }
+            row.gear = Some(g.to_string());
+        }
+        Ok(row)
     }
 }
 

@@ -119,70 +119,14 @@ pub fn schedule_with_launch(
     launch: Option<&LaunchDevice>,
 ) -> Result<Schedule, CycleError> {
     let src = cycle.source.as_str();
-    if gears.states.is_empty() {
-        return Err(CycleError::new(
-            CycleErrorKind::Config,
-            src,
-            "the gearbox has no gear state",
-        ));
-    }
-    for (n, r) in &gears.states {
-        if !(r.is_finite() && *r != 0.0) {
-            return Err(CycleError::new(
-                CycleErrorKind::Config,
-                src,
-                format!("gear state {n} has ratio {r}; a finite non-zero ratio is needed"),
-            ));
-        }
-    }
-    // Gear-column lookups, with the file line in the error.
-    let gear_of = |k: usize| -> Result<Option<usize>, CycleError> {
-        let row = &cycle.rows[k];
-        match &row.gear {
-            None => Ok(None),
-            Some(g) => gears.index_of(g).map(Some).ok_or_else(|| {
-                CycleError::new(
-                    CycleErrorKind::UnknownGear,
-                    src,
-                    format!("not a gear state of the model ({})", gears.names().join(", ")),
-                )
-                .at_line(row.line)
-                .at_value("gear", g.clone())
-            }),
-        }
-    };
-
+    check_gear_table(gears, src)?;
     // Every row's gear must exist, the last one included (it only closes the last interval, but
     // a name the model does not know is a mistake in the file either way).
     for k in 0..cycle.rows.len() {
-        gear_of(k)?;
+        gear_of(cycle, k, gears)?;
     }
-    let n = cycle.rows.len().saturating_sub(1);
-    let mut out: Vec<Interval> = Vec::with_capacity(n);
-    match cycle.kind {
-        CycleKind::Rig => {
-            for k in 0..n {
-                let (r0, r1) = (&cycle.rows[k], &cycle.rows[k + 1]);
-                let gear = gear_of(k)?.unwrap_or(0);
-                let (w, t) = (r0.input_speed, r0.input_torque);
-                out.push(Interval {
-                    t0: r0.time,
-                    t1: r1.time,
-                    vehicle_speed: 0.0,
-                    gear,
-                    input_speed: w,
-                    input_torque: t,
-                    output_power: t * w,
-                    standstill: w <= 0.0,
-                    engine_speed: w,
-                    engine_torque: t,
-                    converter_loss: 0.0,
-                    lockup: false,
-                    shift: false,
-                    jump: false,
-                });
-            }
-        }
+    let mut out = match cycle.kind {
+        CycleKind::Rig => rig_intervals(cycle, gears)?,
         CycleKind::Vehicle => {
             let v = vehicle.ok_or_else(|| {
                 CycleError::new(
@@ -192,61 +136,9 @@ pub fn schedule_with_launch(
                      a rig cycle (time_s,input_speed_rpm,input_torque_nm,gear) does not",
                 )
             })?;
-            let bound = match (&v.shift, cycle.has_gear) {
-                (_, true) => None,
-                (Some(s), false) => Some(s.bind(gears, src)?),
-                (None, false) if gears.states.len() == 1 => None,
-                (None, false) => {
-                    return Err(CycleError::new(
-                        CycleErrorKind::Config,
-                        src,
-                        "the cycle has no gear column and the model has no [vehicle.shift] strategy \
-                         (needed when the gearbox has more than one gear state)",
-                    ));
-                }
-            };
-            let mut shifter = bound.as_ref().map(Shifter::new);
-            for k in 0..n {
-                let (r0, r1) = (&cycle.rows[k], &cycle.rows[k + 1]);
-                let (v0, v1) = (r0.vehicle_speed, r1.vehicle_speed);
-                let dt = r1.time - r0.time;
-                let standstill = v0 <= v.standstill_speed && v1 <= v.standstill_speed;
-                let d = v.demand(v0, v1, dt);
-                let w_out = v.output_speed(d.mean_speed);
-                let gear = match (&mut shifter, &bound) {
-                    (Some(s), Some(b)) => b.index[s.step(r0.time, w_out, standstill)],
-                    _ => gear_of(k)?.unwrap_or(0),
-                };
-                let ratio = gears.states[gear].1.abs();
-                let (w_in, torque, power) = if standstill {
-                    (0.0, 0.0, 0.0)
-                } else {
-                    let p = match v.overrun {
-                        Overrun::Zero => d.mean_power.max(0.0),
-                        Overrun::Transmit => d.mean_power,
-                    };
-                    let w_in = w_out * ratio;
-                    (w_in, p / w_in, p)
-                };
-                out.push(Interval {
-                    t0: r0.time,
-                    t1: r1.time,
-                    vehicle_speed: d.mean_speed,
-                    gear,
-                    input_speed: w_in,
-                    input_torque: torque,
-                    output_power: power,
-                    standstill,
-                    engine_speed: w_in,
-                    engine_torque: torque,
-                    converter_loss: 0.0,
-                    lockup: false,
-                    shift: false,
-                    jump: false,
-                });
-            }
+            vehicle_intervals(cycle, v, gears)?
         }
-    }
+    };
     if let Some(l) = launch {
         for i in &mut out {
             // Rig cycles have no vehicle speed; with a vehicle it follows from the input speed.
@@ -271,10 +163,141 @@ pub fn schedule_with_launch(
     Ok(Schedule { intervals: out })
 }
 
+/// At least one gear state, each with a finite non-zero ratio.
+fn check_gear_table(gears: &GearTable, src: &str) -> Result<(), CycleError> {
+    if gears.states.is_empty() {
+        return Err(CycleError::new(
+            CycleErrorKind::Config,
+            src,
+            "the gearbox has no gear state",
+        ));
+    }
+    for (n, r) in &gears.states {
+        if !(r.is_finite() && *r != 0.0) {
+            return Err(CycleError::new(
+                CycleErrorKind::Config,
+                src,
+                format!("gear state {n} has ratio {r}; a finite non-zero ratio is needed"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The gear-table index of row `k`'s gear column (None without one), with the file line in the
+/// error.
+fn gear_of(cycle: &DriveCycle, k: usize, gears: &GearTable) -> Result<Option<usize>, CycleError> {
+    let row = &cycle.rows[k];
+    match &row.gear {
+        None => Ok(None),
+        Some(g) => gears.index_of(g).map(Some).ok_or_else(|| {
+            CycleError::new(
+                CycleErrorKind::UnknownGear,
+                &cycle.source,
+                format!("not a gear state of the model ({})", gears.names().join(", ")),
+            )
+            .at_line(row.line)
+            .at_value("gear", g.clone())
+        }),
+    }
+}
+
+/// An interval whose engine side is its gearbox input (no launch device yet).
+fn direct(t0: f64, t1: f64, vehicle_speed: f64, gear: usize, w: f64, torque: f64, power: f64) -> Interval {
+    Interval {
+        t0,
+        t1,
+        vehicle_speed,
+        gear,
+        input_speed: w,
+        input_torque: torque,
+        output_power: power,
+        standstill: false,
+        engine_speed: w,
+        engine_torque: torque,
+        converter_loss: 0.0,
+        lockup: false,
+        shift: false,
+        jump: false,
+    }
+}
+
+/// Rig cycle: each row's input speed, torque and gear held until the next row.
+fn rig_intervals(cycle: &DriveCycle, gears: &GearTable) -> Result<Vec<Interval>, CycleError> {
+    let n = cycle.rows.len().saturating_sub(1);
+    let mut out = Vec::with_capacity(n);
+    for k in 0..n {
+        let (r0, r1) = (&cycle.rows[k], &cycle.rows[k + 1]);
+        let gear = gear_of(cycle, k, gears)?.unwrap_or(0);
+        let (w, t) = (r0.input_speed, r0.input_torque);
+        out.push(Interval {
+            standstill: w <= 0.0,
+            ..direct(r0.time, r1.time, 0.0, gear, w, t, t * w)
+        });
+    }
+    Ok(out)
+}
+
+/// Vehicle cycle: the mean demand of each interval through the gear of the cycle's gear column,
+/// the shift strategy, or the only gear state.
+fn vehicle_intervals(
+    cycle: &DriveCycle,
+    v: &Vehicle,
+    gears: &GearTable,
+) -> Result<Vec<Interval>, CycleError> {
+    let src = cycle.source.as_str();
+    let bound = match (&v.shift, cycle.has_gear) {
+        (_, true) => None,
+        (Some(s), false) => Some(s.bind(gears, src)?),
+        (None, false) if gears.states.len() == 1 => None,
+        (None, false) => {
+            return Err(CycleError::new(
+                CycleErrorKind::Config,
+                src,
+                "the cycle has no gear column and the model has no [vehicle.shift] strategy \
+                 (needed when the gearbox has more than one gear state)",
+            ));
+        }
+    };
+    let mut shifter = bound.as_ref().map(Shifter::new);
+    let n = cycle.rows.len().saturating_sub(1);
+    let mut out = Vec::with_capacity(n);
+    for k in 0..n {
+        let (r0, r1) = (&cycle.rows[k], &cycle.rows[k + 1]);
+        let (v0, v1) = (r0.vehicle_speed, r1.vehicle_speed);
+        let dt = r1.time - r0.time;
+        let standstill = v0 <= v.standstill_speed && v1 <= v.standstill_speed;
+        let d = v.demand(v0, v1, dt);
+        let w_out = v.output_speed(d.mean_speed);
+        let gear = match (&mut shifter, &bound) {
+            (Some(s), Some(b)) => b.index[s.step(r0.time, w_out, standstill)],
+            _ => gear_of(cycle, k, gears)?.unwrap_or(0),
+        };
+        let ratio = gears.states[gear].1.abs();
+        let (w_in, torque, power) = if standstill {
+            (0.0, 0.0, 0.0)
+        } else {
+            let p = match v.overrun {
+                Overrun::Zero => d.mean_power.max(0.0),
+                Overrun::Transmit => d.mean_power,
+            };
+            let w_in = w_out * ratio;
+            (w_in, p / w_in, p)
+        };
+        out.push(Interval {
+            standstill,
+            ..direct(r0.time, r1.time, d.mean_speed, gear, w_in, torque, power)
+        });
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cycle::vehicle::tests::{at6, at6_gears, spec, AT6_TOML};
+    use crate::cycle::parse::KMH;
+    use crate::cycle::vehicle::tests::{at6, at6_gears};
+    use crate::cycle::vehicle::RoadLoad;
     use approx::assert_relative_eq;
 
     fn wltc() -> DriveCycle {
@@ -429,13 +452,21 @@ mod tests {
     #[test]
     fn interval_values_by_hand() {
         // one interval 36 → 54 km/h in 2 s, in the only gear (ratio 2), transmit.
-        let s = spec(
-            "[vehicle]\nmass_kg = 1000.0\nrotating_mass_factor = 0.0\nwheel_radius_m = 0.5\n\
-             final_drive_ratio = 4.0\noverrun = \"transmit\"\n\
-             road_load = { f0_n = 100.0, f1_n_per_mps = 0.0, f2_n_per_mps2 = 0.0 }\n",
-        );
         let gears = GearTable::new(vec![("D".into(), 2.0)]);
-        let v = s.validate(&gears).unwrap();
+        let v = Vehicle {
+            mass: 1000.0,
+            effective_mass: 1000.0,
+            wheel_radius: 0.5,
+            final_drive_ratio: 4.0,
+            road_load: RoadLoad {
+                f0: 100.0,
+                f1: 0.0,
+                f2: 0.0,
+            },
+            overrun: Overrun::Transmit,
+            standstill_speed: 0.1 * KMH,
+            shift: None,
+        };
         let c = DriveCycle::parse("time_s,speed_kmh\n0,36\n2,54\n", "x").unwrap();
         let sch = schedule(&c, Some(&v), &gears).unwrap();
         let i = sch.intervals[0];
@@ -586,7 +617,7 @@ mod tests {
         let s = schedule(&c, Some(&v), &one).unwrap();
         assert!(s.intervals.iter().all(|i| i.gear == 0) && s.shift_count() == 0);
         // a strategy naming states the table lacks
-        let v = spec(AT6_TOML).validate(&at6_gears()).unwrap();
+        let v = at6();
         let e = schedule(&c, Some(&v), &one).unwrap_err();
         assert_eq!(e.kind, CycleErrorKind::Config);
         let bad = GearTable::new(vec![("1".into(), 0.0)]);

@@ -12,7 +12,7 @@
 //! - braking or coasting is not special: the gear follows the input speed (downshifts as the
 //!   vehicle slows).
 //!
-//! Validation ([`super::vehicle::VehicleSpec::validate`]) guarantees
+//! The model's check of `[vehicle.shift]` (`crate::model::sections::vehicle`) guarantees
 //! `upshift[i]·r(i+1)/r(i) > downshift[i]`: an upshift never lands below the downshift
 //! threshold and a downshift never lands above the upshift threshold, so the rules cannot hunt.
 

@@ -9,6 +9,7 @@ use crate::model::Override;
 use super::bench::BenchOptions;
 use super::losses::LossesOptions;
 use super::map::MapOptions;
+use super::rating::RatingOptions;
 use super::run::RunOptions;
 use super::steady::SteadyOptions;
 use super::validate::ValidateOptions;
@@ -155,6 +156,21 @@ impl ToArgs for MapOptions {
         flag(&mut a, "--torque-nm", list(&self.torque_nm));
         flag(&mut a, "--vehicle-speed-kmh", num(self.vehicle_speed_kmh));
         opt(&mut a, "--ambient-c", self.ambient_c);
+        a
+    }
+}
+
+impl ToArgs for RatingOptions {
+    const COMMAND: &'static str = "rating";
+    fn to_args(&self) -> Vec<String> {
+        let mut a = Vec::new();
+        flag(&mut a, "--gear", self.gear.clone());
+        flag(&mut a, "--speed-rpm", list(&self.speed_rpm));
+        flag(&mut a, "--oil-limit-c", num(self.oil_limit_c));
+        flag(&mut a, "--vehicle-speed-kmh", num(self.vehicle_speed_kmh));
+        opt(&mut a, "--ambient-c", self.ambient_c);
+        flag(&mut a, "--torque-min-nm", num(self.torque_min_nm));
+        opt(&mut a, "--torque-max-nm", self.torque_max_nm);
         a
     }
 }

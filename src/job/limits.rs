@@ -190,8 +190,36 @@ pub const REPEATS: Limit = Limit {
     unit: "",
 };
 
+/// Oil temperature limit of a thermal rating, °C: the steady solver's valid oil range
+/// (`solve::equilibrium::OIL_RANGE_C`; above it an equilibrium is not sought).
+pub const OIL_LIMIT_C: Limit = Limit {
+    name: "oil_limit_c",
+    flag: "--oil-limit-c",
+    lo: -60.0,
+    hi: 200.0,
+    unit: "°C",
+};
+
+/// Lowest input torque a thermal rating searches, N·m (drive only).
+pub const RATING_TORQUE_MIN_NM: Limit = Limit {
+    name: "torque_min_nm",
+    flag: "--torque-min-nm",
+    lo: 0.0,
+    hi: 1e6,
+    unit: "N m",
+};
+
+/// Highest input torque a thermal rating searches (its ceiling), N·m.
+pub const RATING_TORQUE_MAX_NM: Limit = Limit {
+    name: "torque_max_nm",
+    flag: "--torque-max-nm",
+    lo: 0.0,
+    hi: 1e6,
+    unit: "N m",
+};
+
 /// Every limit, for tables and tests.
-pub const ALL: [Limit; 14] = [
+pub const ALL: [Limit; 17] = [
     SPEED_RPM,
     TORQUE_NM,
     DRIVE_TORQUE_NM,
@@ -206,6 +234,9 @@ pub const ALL: [Limit; 14] = [
     MIN_RTOL,
     REPEATS,
     MAP_AXIS_POINTS,
+    OIL_LIMIT_C,
+    RATING_TORQUE_MIN_NM,
+    RATING_TORQUE_MAX_NM,
 ];
 
 /// Points per map axis.

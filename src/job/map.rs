@@ -119,6 +119,8 @@ pub struct MapMeta {
     pub wall_time_s: f64,
     /// Worker threads.
     pub threads: usize,
+    /// Loss models used outside their fitted range at the map's equilibria.
+    pub warnings: Vec<crate::scene::RangeWarning>,
 }
 
 /// A finished map: `map.csv` text and `map.json` contents.
@@ -209,8 +211,34 @@ pub fn solve(
             mean_iterations: iterations as f64 / n.max(1) as f64,
             wall_time_s: wall,
             threads: rayon::current_num_threads(),
+            warnings: warnings(scene, state, &points),
         },
     })
+}
+
+/// The range warnings over every point of a map, one per item and range.
+fn warnings(
+    scene: &crate::scene::Scene,
+    state: usize,
+    points: &[MapPoint],
+) -> Vec<crate::scene::RangeWarning> {
+    let mut log = crate::scene::RangeLog::new(&scene.losses);
+    for p in points {
+        if let Some(e) = &p.equilibrium {
+            log.check(
+                &scene.losses,
+                &crate::scene::OperatingPoint {
+                    state,
+                    input_speed: p.speed_rpm * std::f64::consts::PI / 30.0,
+                    input_torque: p.torque_nm,
+                    oil: scene
+                        .thermal
+                        .oil_properties(e.solution.temperatures[scene.thermal.oil]),
+                },
+            );
+        }
+    }
+    log.warnings(&scene.losses)
 }
 
 fn failures(scene: &crate::scene::Scene, points: &[MapPoint]) -> Vec<String> {

@@ -10,6 +10,7 @@
 //! | `run` | [`RunOptions`] | [`run::run`] | [`RunResult`] |
 //! | `steady` | [`SteadyOptions`] | [`steady::steady`] | [`SteadyResult`] |
 //! | `map` | [`MapOptions`] | [`map::map`] | [`MapResult`] |
+//! | `rating` | [`RatingOptions`] | [`rating::rating`] | [`RatingResult`] |
 //! | `bench` | [`BenchOptions`] | [`bench::bench`] | [`BenchResult`] |
 //! | `validate` | [`ValidateOptions`] | [`validate::validate`] | [`ValidateResult`] |
 //!
@@ -27,6 +28,7 @@ pub mod limits;
 pub mod losses;
 pub mod map;
 pub mod model;
+pub mod rating;
 pub mod run;
 pub mod steady;
 pub mod validate;
@@ -36,6 +38,7 @@ pub use error::{ErrorKind, JobError};
 pub use losses::LossesOptions;
 pub use map::{MapOptions, MapResult};
 pub use model::Model;
+pub use rating::{RatingOptions, RatingResult};
 pub use run::{RunOptions, RunResult};
 pub use steady::{SteadyOptions, SteadyResult};
 pub use validate::{ValidateOptions, ValidateResult};

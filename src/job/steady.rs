@@ -145,7 +145,14 @@ pub fn steady(m: &Model, o: &SteadyOptions) -> Result<SteadyResult, JobError> {
     Ok(result(m, o, &scene, state, &eq))
 }
 
-fn result(m: &Model, o: &SteadyOptions, scene: &Scene, state: usize, eq: &Equilibrium) -> SteadyResult {
+/// The report of the checked equilibrium `eq` at `o` (`steady`'s, and a rating point's).
+pub(crate) fn result(
+    m: &Model,
+    o: &SteadyOptions,
+    scene: &Scene,
+    state: usize,
+    eq: &Equilibrium,
+) -> SteadyResult {
     let temperatures_c = scene
         .thermal
         .names

@@ -2,20 +2,39 @@
 //!
 //! `load` is the only place that reads a model file; everything below works on the checked
 //! [`Gearbox`].
+//!
+//! Layout:
+//! - [`sections`]: one file per model-file section (`[model]`, `[oil]`, `[[members]]`,
+//!   `[[gears]]`, `[[meshes]]`, `[[planetary_sets]]`, `[[shift_elements]]`, `[[gear_states]]`,
+//!   `[train]`, `[lubrication]`, `[losses]`, `[thermal]` (a folder, one file per sub-table:
+//!   nodes, boundaries, links, coolers, heat, wall_mesh), `[vehicle]`, `[[clutch_packs]]`,
+//!   `[pump]`, `[launch]`, `[[bearings]]`, `[[seals]]`), each holding the section's serde
+//!   struct(s), its checks with their key paths, and the checked type it becomes;
+//! - [`file`]: the whole file, one field per section; [`parse`]: TOML text → [`file::ModelFile`],
+//!   every section's type errors with their full key paths; [`validate`]: the order in which the
+//!   sections are checked, → [`Gearbox`]; [`gearbox`]: the checked gearbox;
+//! - [`choice`]: model choices (`churning = "changenet"`), enums read by name once with their
+//!   section; [`problems`] (what a check reports), [`overrides`] (key-path overrides), [`source`]
+//!   (the loss sources), [`catalogue`] and [`bearing_catalogue`] (the oils and bearings compiled
+//!   in).
+//!
+//! The paths `model::thermal`, `model::wall_mesh`, `model::bearings`, `model::pump` name the
+//! section modules, and `model::gearbox` every checked part type.
 
-pub mod automatic;
-pub mod bearings;
+pub mod bearing_catalogue;
 pub mod catalogue;
+pub mod choice;
+pub mod file;
 pub mod gearbox;
-pub mod losses;
 pub mod overrides;
 pub mod parse;
 pub mod problems;
-pub mod schema;
+pub mod sections;
 pub mod source;
-pub mod thermal;
 pub mod validate;
-pub mod wall_mesh;
+
+pub use sections::thermal::wall_mesh;
+pub use sections::{bearings, pump, thermal};
 
 use std::path::{Path, PathBuf};
 

@@ -8,29 +8,9 @@
 use serde::de::DeserializeOwned;
 use toml::{Table, Value};
 
+use super::file::{ModelFile, SECTIONS};
 use super::problems::Problems;
-use super::schema::*;
-
-const SECTIONS: &[&str] = &[
-    "model",
-    "oil",
-    "members",
-    "gears",
-    "meshes",
-    "planetary_sets",
-    "shift_elements",
-    "gear_states",
-    "train",
-    "lubrication",
-    "losses",
-    "thermal",
-    "vehicle",
-    "clutch_packs",
-    "pump",
-    "launch",
-    "bearings",
-    "seals",
-];
+use super::sections::*;
 
 /// Line and column (1-based) of a byte offset.
 pub fn line_col(text: &str, offset: usize) -> (usize, usize) {
@@ -40,9 +20,11 @@ pub fn line_col(text: &str, offset: usize) -> (usize, usize) {
     (line, col)
 }
 
+/// A value as messages show it: strings quoted and escaped (a message stays on one line),
+/// tables and arrays summarised.
 fn describe(v: &Value) -> String {
     match v {
-        Value::String(s) => format!("\"{s}\""),
+        Value::String(s) => format!("{s:?}"),
         Value::Table(_) => "{table}".into(),
         Value::Array(a) => format!("[array of {}]", a.len()),
         other => other.to_string(),
@@ -177,17 +159,7 @@ fn check_names(value: &Value, path: &str, problems: &mut Problems) {
             for (k, v) in t {
                 let p = join(k);
                 if k == "name" && p != "model.name" && p != "oil.name" {
-                    if let Value::String(s) = v {
-                        if !is_plain_name(s) {
-                            problems.push(
-                                p,
-                                describe(v),
-                                format!(
-                                    "must be a plain name: 1–{MAX_NAME_LEN} characters, no control characters, none of , \" ' | \\ ; `, no leading or trailing space"
-                                ),
-                            );
-                        }
-                    }
+                    check_name(v, p, problems);
                 } else {
                     check_names(v, &p, problems);
                 }
@@ -199,6 +171,21 @@ fn check_names(value: &Value, path: &str, problems: &mut Problems) {
             }
         }
         _ => {}
+    }
+}
+
+/// A `name` value at `path` that is a string must be a plain name (other types are the typed
+/// reading's to report).
+fn check_name(v: &Value, path: String, problems: &mut Problems) {
+    let Value::String(s) = v else { return };
+    if !is_plain_name(s) {
+        problems.push(
+            path,
+            describe(v),
+            format!(
+                "must be a plain name: 1–{MAX_NAME_LEN} characters, no control characters, none of , \" ' | \\ ; `, no leading or trailing space"
+            ),
+        );
     }
 }
 
@@ -244,24 +231,26 @@ pub fn parse_table(mut table: Table, problems: &mut Problems) -> Option<ModelFil
     }
     check_names(&Value::Table(table.clone()), "", problems);
     let before = problems.len();
-    let model = section::<ModelMeta>(&mut table, "model", true, problems);
-    let oil = section::<OilSpec>(&mut table, "oil", true, problems);
-    let members = array::<MemberSpec>(&mut table, "members", false, problems);
-    let gears = array::<GearSpecFile>(&mut table, "gears", true, problems);
-    let meshes = array::<MeshSpec>(&mut table, "meshes", false, problems);
-    let planetary_sets = array::<PlanetarySetSpec>(&mut table, "planetary_sets", false, problems);
-    let shift_elements = array::<ShiftElementSpec>(&mut table, "shift_elements", false, problems);
-    let gear_states = array::<GearStateSpec>(&mut table, "gear_states", false, problems);
-    let train = section::<TrainSpec>(&mut table, "train", true, problems);
-    let lubrication = section::<LubricationSpec>(&mut table, "lubrication", true, problems);
-    let losses = section::<LossesSpec>(&mut table, "losses", false, problems);
-    let thermal = section::<super::thermal::ThermalSpec>(&mut table, "thermal", false, problems);
-    let vehicle = section::<Table>(&mut table, "vehicle", false, problems);
-    let clutch_packs = array::<super::automatic::ClutchPackSpec>(&mut table, "clutch_packs", false, problems);
-    let pump = section::<super::automatic::PumpSpec>(&mut table, "pump", false, problems);
-    let launch = section::<Table>(&mut table, "launch", false, problems);
-    let bearings = array::<super::bearings::BearingSpec>(&mut table, "bearings", false, problems);
-    let seals = array::<super::bearings::SealSpec>(&mut table, "seals", false, problems);
+    let model = section::<model::ModelMeta>(&mut table, "model", true, problems);
+    let oil = section::<oil::OilSpec>(&mut table, "oil", true, problems);
+    let members = array::<members::MemberSpec>(&mut table, "members", false, problems);
+    let gears = array::<gears::GearSpecFile>(&mut table, "gears", true, problems);
+    let meshes = array::<meshes::MeshSpec>(&mut table, "meshes", false, problems);
+    let planetary_sets =
+        array::<planetary_sets::PlanetarySetSpec>(&mut table, "planetary_sets", false, problems);
+    let shift_elements =
+        array::<shift_elements::ShiftElementSpec>(&mut table, "shift_elements", false, problems);
+    let gear_states = array::<gear_states::GearStateSpec>(&mut table, "gear_states", false, problems);
+    let train = section::<train::TrainSpec>(&mut table, "train", true, problems);
+    let lubrication = section::<lubrication::LubricationSpec>(&mut table, "lubrication", true, problems);
+    let losses = section::<losses::LossesSpec>(&mut table, "losses", false, problems);
+    let thermal = section::<thermal::ThermalSpec>(&mut table, "thermal", false, problems);
+    let vehicle = section::<vehicle::VehicleSpec>(&mut table, "vehicle", false, problems);
+    let clutch_packs = array::<clutch_packs::ClutchPackSpec>(&mut table, "clutch_packs", false, problems);
+    let pump = section::<pump::PumpSpec>(&mut table, "pump", false, problems);
+    let launch = section::<launch::LaunchSpec>(&mut table, "launch", false, problems);
+    let bearings = array::<bearings::BearingSpec>(&mut table, "bearings", false, problems);
+    let seals = array::<seals::SealSpec>(&mut table, "seals", false, problems);
     if problems.len() > before || !problems.is_empty() {
         return None;
     }

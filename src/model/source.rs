@@ -2,13 +2,14 @@
 //! because the model file names sources (heat rules `source = "…"`, items `"<source>:<name>"`);
 //! the scene, solvers and reports index per-source arrays by it.
 
-/// Heat source kind. To add a source: add a variant here, to [`Source::ALL`] and to the
-/// match in [`Source::as_str`], to the item names the model validation knows
+use super::choice::{choice, Choice};
+
+/// Heat source kind. To add a source: add a variant here, to [`Source::ALL`] and to its
+/// names (the `choice!` below), to the item names the model validation knows
 /// (`model::thermal::LossItemNames`) and to the scene that compiles its items; per-source
 /// arrays ([`PerSource`]), output columns (`<source>_w`), summary keys and heat-rule names
 /// follow from this list.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Source {
     /// Oil drag on an immersed gear (load-independent).
     Churning,
@@ -27,6 +28,16 @@ pub enum Source {
     /// Torque-converter slip (engine side minus turbine side power).
     Converter,
 }
+choice!(Source {
+    Churning = "churning",
+    Pocketing = "pocketing",
+    Sliding = "sliding",
+    Bearing = "bearing",
+    Seal = "seal",
+    ClutchDrag = "clutch_drag",
+    Pump = "pump",
+    Converter = "converter",
+});
 
 /// Number of loss sources.
 pub const N_SOURCES: usize = Source::ALL.len();
@@ -54,21 +65,12 @@ impl Source {
 
     /// Lower-case name (output columns `<name>_w`, summary keys, heat rules `<name>:<item>`).
     pub fn as_str(self) -> &'static str {
-        match self {
-            Source::Churning => "churning",
-            Source::Pocketing => "pocketing",
-            Source::Sliding => "sliding",
-            Source::Bearing => "bearing",
-            Source::Seal => "seal",
-            Source::ClutchDrag => "clutch_drag",
-            Source::Pump => "pump",
-            Source::Converter => "converter",
-        }
+        self.name()
     }
 
     /// The source named `s`.
     pub fn parse(s: &str) -> Option<Source> {
-        Source::ALL.into_iter().find(|x| x.as_str() == s)
+        Source::from_name(s)
     }
 
     /// The names of all sources, comma-separated (for error messages).
@@ -83,10 +85,16 @@ mod tests {
 
     #[test]
     fn index_is_the_position_in_all_and_names_round_trip() {
+        assert_eq!(Source::NAMES.len(), Source::ALL.len());
         for (k, s) in Source::ALL.into_iter().enumerate() {
             assert_eq!(s.index(), k);
             assert_eq!(Source::parse(s.as_str()), Some(s));
         }
         assert_eq!(Source::parse("windage"), None);
+        // The model file reads a source by the same name (heat rules `source = "…"`).
+        for s in Source::ALL {
+            let v: Source = serde_json::from_value(serde_json::Value::from(s.as_str())).unwrap();
+            assert_eq!(v, s);
+        }
     }
 }

@@ -9,7 +9,7 @@
 //! call: the pack drags at the current oil viscosity. No allocation after compile.
 
 use crate::cycle::LaunchDevice;
-use crate::model::automatic::{PumpDrive, PumpModel};
+use crate::model::pump::{PumpDrive, PumpModel};
 use crate::model::Gearbox;
 use crate::physics::losses::clutch_drag::ClutchPack;
 use crate::physics::oil::OilProperties;

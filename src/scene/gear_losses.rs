@@ -45,6 +45,8 @@ pub(super) struct ChurnEntry {
     pub(super) law: Option<ChangenetSum>,
     /// Per gear state: the law's terms of the gear's speed ratio ([`ChangenetSum::ratio_terms`]).
     pub(super) ratio_terms: Vec<[f64; 3]>,
+    /// Reference (pitch) radius of the gear, m (its pitch-line speed for the range warnings).
+    pub(super) pitch_radius: f64,
 }
 
 #[derive(Debug, Clone)]
@@ -167,6 +169,7 @@ pub(super) fn compile_churning(
             // `evaluate_all` measures the scene without its per-sample laws.
             law: churn_sample::sum_law(&models).filter(|_| !needs.evaluate_all),
             ratio_terms: Vec::new(),
+            pitch_radius: churning_gear(gb, gi).pitch_radius,
             models,
         });
         if cfg.model == ChurningModel::Stavytskyi {

@@ -275,6 +275,20 @@ impl LossScene {
             .flat_map(move |(e, k)| e.models.iter().map(move |(m, _)| (e.item, m, k * input_speed)))
     }
 
+    /// Every churning item with its gear's pitch-line speed (m/s) at `input_speed` (rad/s) in
+    /// `state` (range warnings).
+    pub fn churning_pitch_speeds(
+        &self,
+        state: usize,
+        input_speed: f64,
+    ) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let st = &self.states[state];
+        self.churn
+            .iter()
+            .zip(&st.churn_speed)
+            .map(move |(e, k)| (e.item, k * input_speed * e.pitch_radius))
+    }
+
     /// Churning and pocketing at `op` into `out`; churning from the sample's laws `churn` when
     /// given (prepared for `op`'s state and speed).
     fn evaluate_load_independent(&self, op: &OperatingPoint, churn: Option<&[ChurnSample]>, out: &mut [f64]) {

@@ -6,6 +6,7 @@
 //! the points a command evaluates ([`RangeLog::check`]) and summarised per item and range with
 //! the span of the quantity seen ([`RangeLog::warnings`]).
 
+use crate::physics::losses::churning::ranges::above_dip_speed;
 use crate::physics::losses::churning::{OilState, RangeCheck};
 
 use super::items::OperatingPoint;
@@ -31,7 +32,8 @@ impl RangeLog {
         }
     }
 
-    /// Check every churning model of `scene` at `op`.
+    /// Check every churning model of `scene` at `op`, and every churning gear's pitch-line speed
+    /// against the dip-lubrication range.
     pub fn check(&mut self, scene: &LossScene, op: &OperatingPoint) {
         self.points += 1;
         let oil = OilState {
@@ -47,6 +49,14 @@ impl RangeLog {
                     e.0 += 1;
                 }
                 last = (item, c.index());
+                e.1 = e.1.min(v);
+                e.2 = e.2.max(v);
+            }
+        }
+        for (item, speed) in scene.churning_pitch_speeds(op.state, op.input_speed) {
+            if let Some((c, v)) = above_dip_speed(speed) {
+                let e = &mut self.seen[item][c.index()];
+                e.0 += 1;
                 e.1 = e.1.min(v);
                 e.2 = e.2.max(v);
             }

@@ -277,7 +277,7 @@ fn heat_destination(net: &ThermalNetwork, it: &LossItem) -> Vec<(usize, f64)> {
             net.heat
                 .iter()
                 .rev()
-                .find(|r| r.target == HeatTarget::Source(it.source.as_str().to_string()))
+                .find(|r| r.target == HeatTarget::Source(it.source))
         });
     let mut to: Vec<(usize, f64)> = match rule {
         Some(r) => r.to.clone(),

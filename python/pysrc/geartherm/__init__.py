@@ -190,6 +190,32 @@ class Model:
         }
         return _frame(self._m.map(o))
 
+    def rating(
+        self,
+        gear: str,
+        speed_rpm: Union[float, Sequence[float]],
+        oil_limit_c: float,
+        vehicle_speed_kmh: float = 0.0,
+        ambient_c: Optional[float] = None,
+        torque_min_nm: float = 0.0,
+        torque_max_nm: Optional[float] = None,
+    ) -> Dict[str, Any]:
+        """Thermal rating, as ``geartherm rating``: at each input speed the highest input torque
+        whose equilibrium oil temperature stays at or below ``oil_limit_c`` (the ``rating.json``
+        document as a dict: ``points`` with ``rated_torque_nm``, ``rated_power_w``, ``status``, the
+        equilibrium at that torque)."""
+        speeds = [float(speed_rpm)] if isinstance(speed_rpm, (int, float)) else [float(s) for s in speed_rpm]
+        o = {
+            "gear": str(gear),
+            "speed_rpm": speeds,
+            "oil_limit_c": float(oil_limit_c),
+            "vehicle_speed_kmh": float(vehicle_speed_kmh),
+            "ambient_c": None if ambient_c is None else float(ambient_c),
+            "torque_min_nm": float(torque_min_nm),
+            "torque_max_nm": None if torque_max_nm is None else float(torque_max_nm),
+        }
+        return json.loads(self._m.rating(o))
+
     def run(
         self,
         cycle: str = "wltc",

@@ -5,6 +5,7 @@
 //! - [`render_map`]: `map_efficiency.png`, `map_total_loss.png`, `map_oil_temp.png` and
 //!   `report.md` from a map directory (`map.csv`, `map.json`).
 //! - [`render_bench`]: `work_precision.png` from a bench directory (`bench.csv`, `bench.json`).
+//! - [`rating::render`]: `rating.png`, the thermal rating curve of a `rating` sweep.
 //!
 //! Every PNG is 1600×1000 px. Each output is rendered to a temporary file in the target
 //! directory and all outputs of one call are renamed into place only after every one of them
@@ -27,6 +28,7 @@ pub mod index;
 pub mod losses;
 pub mod map_index;
 pub mod panel;
+pub mod rating;
 pub mod study;
 pub mod style;
 pub mod temperatures;

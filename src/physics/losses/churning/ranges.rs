@@ -23,14 +23,33 @@ pub enum RangeCheck {
     StavytskyiAboveFillingLimit,
     /// Seetharaman–Kahraman with turbulent faces.
     SeetharamanTurbulentFaces,
+    /// Any model: the gear's pitch-line speed above the dip-lubrication range
+    /// ([`DIP_PITCH_SPEED_MAX`]).
+    DipSpeed,
+}
+
+/// Highest pitch-line speed of dip (splash) lubrication, m/s: "suitable for up to 12.5 m/s
+/// (2500 ft/min) peripheral speed" for a typical helical gear unit with guards and tanks for
+/// individual gears, M. J. Neale (ed.), *The Tribology Handbook*, section C16 "Dip, splash
+/// systems" (a high-speed unit with a guard: "normally satisfactory up to 25 m/s"). No fitted
+/// speed range of the Changenet–Velex laws was found (the paper was not accessible); the
+/// measurements behind the three churning models are dip-lubrication tests, so a gear churning
+/// faster than dip lubrication is used is outside what they describe.
+pub const DIP_PITCH_SPEED_MAX: f64 = 12.5;
+
+/// The out-of-range use of any churning model at pitch-line speed `v` (m/s, sign irrelevant):
+/// above [`DIP_PITCH_SPEED_MAX`], with the speed.
+pub fn above_dip_speed(v: f64) -> Option<(RangeCheck, f64)> {
+    (v.abs() > DIP_PITCH_SPEED_MAX).then_some((RangeCheck::DipSpeed, v.abs()))
 }
 
 impl RangeCheck {
     /// Every check, in output order.
-    pub const ALL: [RangeCheck; 3] = [
+    pub const ALL: [RangeCheck; 4] = [
         RangeCheck::ChangenetBridge,
         RangeCheck::StavytskyiAboveFillingLimit,
         RangeCheck::SeetharamanTurbulentFaces,
+        RangeCheck::DipSpeed,
     ];
 
     /// Position in [`Self::ALL`].
@@ -50,6 +69,10 @@ impl RangeCheck {
             RangeCheck::SeetharamanTurbulentFaces => {
                 "Seetharaman–Kahraman faces above the laminar transition Re_L: derived mixed plate law"
             }
+            RangeCheck::DipSpeed => {
+                "pitch-line speed above 12.5 m/s, the upper end of dip lubrication (Tribology Handbook C16): \
+                 faster than the dip-lubrication tests behind the churning models"
+            }
         }
     }
 
@@ -59,6 +82,7 @@ impl RangeCheck {
             RangeCheck::ChangenetBridge => "Re_c",
             RangeCheck::StavytskyiAboveFillingLimit => "speed rpm",
             RangeCheck::SeetharamanTurbulentFaces => "Re_L",
+            RangeCheck::DipSpeed => "pitch-line speed m/s",
         }
     }
 }
@@ -153,6 +177,13 @@ mod tests {
         assert!(g.out_of_range(w(3000.0), &oil).is_none());
         assert!(g.out_of_range(w(12000.0), &oil).is_none());
         assert!(g.out_of_range(0.0, &oil).is_none());
+    }
+
+    #[test]
+    fn dip_speed_is_reported_above_its_limit_only() {
+        assert!(above_dip_speed(12.5).is_none());
+        assert!(above_dip_speed(-3.0).is_none());
+        assert_eq!(above_dip_speed(-14.0), Some((RangeCheck::DipSpeed, 14.0)));
     }
 
     #[test]

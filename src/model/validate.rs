@@ -1,0 +1,218 @@
+//! Validation: a parsed [`ModelFile`] → a checked [`Gearbox`] in SI units, or the list of every
+//! problem found (key path, value, what is allowed).
+//!
+//! Each section's checks live beside its serde struct in [`super::sections`]; [`validate`] runs
+//! them in order. The checks keep going after a failure, so one run of `geartherm check` shows
+//! everything that is wrong. Checks that need earlier sections (a mesh needs its two gears'
+//! geometry) are skipped for entries whose inputs already failed, so one mistake is reported once.
+
+use std::collections::BTreeSet;
+
+use super::catalogue;
+use super::file::ModelFile;
+use super::gearbox::Gearbox;
+use super::problems::Problems;
+use super::sections::*;
+use super::source::Source;
+use crate::cycle::GearTable as RatioTable;
+use crate::physics::kinematics::{Constraint, GearTrain};
+
+/// The kinematic structure: members, gears, meshes, sets, shift elements and gear states.
+struct Structure {
+    members: Vec<members::Member>,
+    gears: Vec<gears::Gear>,
+    meshes: Vec<meshes::Mesh>,
+    sets: Vec<planetary_sets::PlanetarySet>,
+    elements: Vec<shift_elements::ShiftElement>,
+    train: Option<GearTrain>,
+    gear_states: Vec<gear_states::GearState>,
+    io: (Option<usize>, Option<usize>),
+    oil_level: f64,
+}
+
+/// Validate a parsed file. `problems` receives every problem; `None` if there was any.
+pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
+    let start = problems.len();
+    model::validate_meta(&file.model, problems);
+    let oil = oil::validate_oil(&file.oil, problems);
+    let (s, parts) = structure(file, problems);
+    let nodes: BTreeSet<&str> = file
+        .thermal
+        .as_ref()
+        .map(|t| t.nodes.iter().map(|n| n.name.as_str()).collect())
+        .unwrap_or_default();
+    let catalogue_oil = file.oil.catalogue.as_deref().and_then(catalogue::find);
+    let bath = bearings::OilBath {
+        level: s.oil_level,
+        catalogue: catalogue_oil.as_ref(),
+    };
+    let bearings = bearings::validate_bearings(&file.bearings, &nodes, &parts, &s.gears, &bath, problems);
+    let seals = seals::validate_seals(&file.seals, &parts.members, &nodes, problems);
+    let lub = &file.lubrication;
+    let oil_x_l = oil.as_ref().map_or(1.0, |o| o.lubricant_factor_or_default().0);
+    let losses = losses::validate_losses(
+        &file.losses.clone().unwrap_or_default(),
+        lub.sump_volume_l,
+        oil_x_l,
+        problems,
+    );
+    let element_names: Vec<&str> = file.shift_elements.iter().map(|e| e.name.as_str()).collect();
+    let member_names: Vec<&str> = file.members.iter().map(|m| m.name.as_str()).collect();
+    let clutch_packs = clutch_packs::validate_clutch_packs(&file.clutch_packs, &element_names, problems);
+    let pump = file
+        .pump
+        .as_ref()
+        .and_then(|p| pump::validate_pump(p, &member_names, problems));
+    let ratios = RatioTable::new(
+        s.gear_states
+            .iter()
+            .map(|g| (g.name.clone(), g.ratio()))
+            .collect(),
+    );
+    let launch = file
+        .launch
+        .as_ref()
+        .and_then(|spec| launch::validate_launch(spec, &ratios, problems));
+    let items = ItemNames {
+        gears: &s.gears,
+        meshes: &s.meshes,
+        bearings: &bearings,
+        seals: &seals,
+        packs: clutch_packs.iter().map(|c| c.name.as_str()).collect(),
+        pump: file.pump.is_some(),
+        converter: file.launch.is_some(),
+    };
+    let thermal = file
+        .thermal
+        .as_ref()
+        .and_then(|spec| check_thermal(spec, &items, problems));
+    let vehicle = file
+        .vehicle
+        .as_ref()
+        .and_then(|spec| vehicle::validate_vehicle(spec, &ratios, problems));
+
+    if problems.len() > start {
+        return None;
+    }
+    let (input, output) = s.io;
+    Some(Gearbox {
+        name: file.model.name.clone(),
+        description: file.model.description.clone().unwrap_or_default(),
+        oil: oil?,
+        members: s.members,
+        gears: s.gears,
+        meshes: s.meshes,
+        planetary_sets: s.sets,
+        shift_elements: s.elements,
+        gear_states: s.gear_states,
+        train: s.train?,
+        input: input?,
+        output: output?,
+        oil_level: s.oil_level,
+        sump_volume: lub.sump_volume_l.map(|v| v * 1e-3),
+        losses: losses?,
+        thermal,
+        vehicle,
+        clutch_packs,
+        pump,
+        launch,
+        bearings,
+        seals,
+    })
+}
+
+/// Members, gears, `[train]`, meshes, sets, shift elements and gear states (solved on a sound
+/// structure only), and `[lubrication]`; with the parts by name for the sections after them.
+fn structure<'a>(file: &'a ModelFile, problems: &mut Problems) -> (Structure, parts::Parts<'a>) {
+    let structure_start = problems.len();
+    let members = members::validate_members(&file.members, problems);
+    let planet_of = planetary_sets::planet_roles(&file.planetary_sets);
+    let roots = meshes::mating_tip_roots(&file.gears, &file.meshes);
+    let gears = gears::validate_gears(&file.gears, &members, &roots, problems);
+    let parts = parts::Parts {
+        members,
+        gears,
+        planet_of,
+    };
+    let io = train::validate_train(&file.train, &parts.members, problems);
+
+    let mut meshes = Vec::new();
+    let mut fixed_rows = Vec::new();
+    meshes::validate_meshes(&file.meshes, &parts, &mut meshes, &mut fixed_rows, problems);
+    let (sets, mounts) = planetary_sets::validate_sets(
+        &file.planetary_sets,
+        &parts,
+        &mut meshes,
+        &mut fixed_rows,
+        problems,
+    );
+    // Fixed members.
+    for (i, m) in file.members.iter().enumerate() {
+        if m.fixed {
+            fixed_rows.push(Constraint::Brake { member: i });
+        }
+    }
+    let elements = shift_elements::validate_shift_elements(&file.shift_elements, &parts.members, problems);
+    let sound = problems.len() == structure_start;
+    let (train, gear_states) = gear_states::validate_gear_states(
+        &file.gear_states,
+        &elements,
+        &file.members,
+        fixed_rows,
+        io,
+        sound,
+        problems,
+    );
+    let (gears, oil_level) =
+        lubrication::validate_lubrication(&file.lubrication, &parts, &sets, &meshes, &mounts, problems);
+    let s = Structure {
+        members: parts.members.checked(),
+        gears,
+        meshes,
+        sets,
+        elements: elements.list,
+        train,
+        gear_states,
+        io,
+        oil_level,
+    };
+    (s, parts)
+}
+
+/// The loss items of the model by source, for heat rules (`"<source>:<name>"`).
+struct ItemNames<'a> {
+    gears: &'a [gears::Gear],
+    meshes: &'a [meshes::Mesh],
+    bearings: &'a [bearings::Bearing],
+    seals: &'a [seals::Seal],
+    packs: Vec<&'a str>,
+    pump: bool,
+    converter: bool,
+}
+
+/// `[thermal]` against the checked gears and the loss items of the model.
+fn check_thermal(
+    spec: &thermal::ThermalSpec,
+    it: &ItemNames<'_>,
+    problems: &mut Problems,
+) -> Option<thermal::ThermalNetwork> {
+    let infos: Vec<thermal::GearInfo<'_>> = it
+        .gears
+        .iter()
+        .map(|g| thermal::GearInfo {
+            name: &g.name,
+            radius: 0.5 * g.geometry.d_a.max(g.geometry.d_f),
+            face_width: g.geometry.spec.b,
+        })
+        .collect();
+    let mut names = thermal::LossItemNames::default();
+    names.set(Source::Churning, it.gears.iter().map(|g| g.name.as_str()));
+    names.set(Source::Pocketing, it.meshes.iter().map(|m| m.name.as_str()));
+    names.set(Source::Sliding, it.meshes.iter().map(|m| m.name.as_str()));
+    names.set(Source::ClutchDrag, it.packs.iter().copied());
+    names.set(Source::Pump, it.pump.then_some("pump"));
+    names.set(Source::Converter, it.converter.then_some("converter"));
+    names.set(Source::Bearing, it.bearings.iter().map(|b| b.name.as_str()));
+    names.set(Source::Seal, it.seals.iter().map(|s| s.name.as_str()));
+    thermal::validate_thermal(spec, &infos, &names, problems)
+}
