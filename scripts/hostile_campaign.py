@@ -9,7 +9,7 @@ Families (share of the cases; modules under scripts/hostile/):
 
 | family | what | module |
 |---|---|---|
-| cli | mutated and extreme model files, generated cycles, malformed and extreme options on `check`, `info`, `losses`, `steady`, `map`, `run` | cli.py |
+| cli | mutated and extreme model files, generated cycles, malformed and extreme options on `check`, `info`, `losses`, `steady`, `map`, `run`, `rating` | cli.py |
 | set | `--set` key paths (real, mutated, malformed) and values (hostile numbers and types, malformed TOML) on every model-reading command, `bench` included | cli.py |
 | study_spec | generated study files: plans, parameters, jobs, outputs, names, model paths; `--list`, `--shard`, default output directory; a directory holding another study | study.py |
 | study_kill | a study SIGKILLed at a random moment, then resumed | study.py |
@@ -72,7 +72,7 @@ def make_templates(ctx, tmp):
     """A complete previous result set of each writing command (copied into the output directory
     of the cases that start from one)."""
     fzg = os.path.join(ROOT, "models", "fzg_c.toml")
-    t = {k: os.path.join(tmp, "tpl", k) for k in ("run", "map", "bench", "study", "validate")}
+    t = {k: os.path.join(tmp, "tpl", k) for k in ("run", "map", "bench", "study", "validate", "rating")}
     cmds = {
         "run": ["run", fzg, "--cycle", ctx.rig, "--quiet", "--out", t["run"]],
         "map": ["map", fzg, "--gear", "1", "--speed-rpm", "1000:2000:2", "--torque-nm", "10:50:2", "--quiet",
@@ -81,6 +81,8 @@ def make_templates(ctx, tmp):
                   "--out", t["bench"]],
         "study": ["study", ctx.study_file, "--quiet", "--out", t["study"]],
         "validate": ["validate", os.path.join(ROOT, "validation"), "--out", t["validate"]],
+        "rating": ["rating", fzg, "--gear", "1", "--speed-rpm", "1000:2000:2", "--oil-limit-c", "90", "--quiet",
+                   "--out", t["rating"]],
     }
     for k, args in cmds.items():
         p = subprocess.run([ctx.bin] + args, capture_output=True, cwd=tmp)

@@ -23,8 +23,10 @@ EXPECTED = {
             "report.md", ".geartherm-output"},
     "map_no_plots": {"map.csv", "map.json", ".geartherm-output"},
     "bench": {"bench.csv", "bench.json", "work_precision.png", ".geartherm-output"},
+    "rating": {"rating.csv", "rating.json", "rating.png", ".geartherm-output"},
+    "rating_no_plots": {"rating.csv", "rating.json", ".geartherm-output"},
 }
-TEMPLATE_OF = {"run": "run", "map": "map", "bench": "bench"}
+TEMPLATE_OF = {"run": "run", "map": "map", "bench": "bench", "rating": "rating"}
 
 
 def model_texts(root):
@@ -101,6 +103,15 @@ def base_args(cmd, m, rng, v, gear):
         args = ["map", "MODEL", "--gear", gear, "--speed-rpm", ax(["500:1500:2", "1000:1000:1", "100:3000:3"]),
                 "--torque-nm", ax(["10:100:2", "0:0:1", "50:300:3"]), "--out", "OUT", "--quiet"]
         return args + (["--no-plots"] if rng.random() < 0.8 else [])
+    if cmd == "rating":
+        args = ["rating", "MODEL", "--gear", gear, "--speed-rpm", rng.choice(["1000", "500:3000:3", "0:1e300:2", "1000,2000", "x"])
+                if rng.random() < 0.2 else rng.choice(["1000", "500:3000:3"]), "--oil-limit-c",
+                v(["-30", "60", "90", "120", "199"]), "--out", "OUT", "--quiet"]
+        if rng.random() < 0.3:
+            args += ["--torque-max-nm", v(["50", "500", "1e6"])]
+        if rng.random() < 0.2:
+            args += ["--ambient-c", v(["-40", "23", "60"])]
+        return args + (["--no-plots"] if rng.random() < 0.5 else [])
     if cmd == "bench":
         return ["bench", "MODEL", "--cycle", "RIG", "--repeats", v(["1"]), "--min-rtol", v(["1e-4", "1e-3"]),
                 "--solvers", rng.choice(["ros3", "bdf", "ros3,tsit45", "nope"]), "--out", "OUT"]
@@ -136,7 +147,7 @@ def make_case(i, rng, texts, family):
             text = mutate_model(text, rng)
         elif r < 0.65:
             text = extreme_model(text, rng)
-    cmds = ["check", "info", "losses", "losses", "steady", "steady", "map", "run", "run"]
+    cmds = ["check", "info", "losses", "losses", "steady", "steady", "map", "run", "run", "rating"]
     cmd = rng.choice(cmds + (["bench"] if family == "set" else []))
     gear = GEAR[m] if rng.random() < 0.9 else rng.choice(["0", "R", "x", "1\n"])
     hostile_p = 0.3 if family == "cli" else 0.05
@@ -228,8 +239,8 @@ def expected_set(case, args):
     cmd = case["cmd"]
     if cmd == "run":
         return EXPECTED["run_summary" if "--summary-only" in args else "run"]
-    if cmd == "map":
-        return EXPECTED["map_no_plots" if "--no-plots" in args else "map"]
+    if cmd in ("map", "rating"):
+        return EXPECTED[cmd + "_no_plots" if "--no-plots" in args else cmd]
     return EXPECTED.get(cmd)
 
 

@@ -37,6 +37,7 @@ ADDRESS_SPACE = 8 << 30
 PRLIMIT = shutil.which("prlimit")
 NUM_RE = re.compile(r"(?<![A-Za-z_])(nan|NaN|-?inf|-?Infinity)(?![A-Za-z_])")
 TMP_RE = re.compile(r"geartherm-(tmp|old)-")
+OPTION_ECHOES = {"ambient_c", "initial_temp_c", "frozen_viscosity_c"}
 
 
 class Proc:
@@ -101,7 +102,8 @@ def json_problems(v, path=""):
             if "efficiency" in k and isinstance(x, (int, float)) and not isinstance(x, bool):
                 if not (0.0 <= x <= 1.0):
                     eff.append(p)
-            if x is None and k.endswith(("_w", "_j", "_c", "_s", "_k")):
+            # A null option echo (`ambient_c`: the model's own) is "not given", not a number.
+            if x is None and k.endswith(("_w", "_j", "_c", "_s", "_k")) and k not in OPTION_ECHOES:
                 nf.append(p)
             if isinstance(x, float) and not (x == x and abs(x) != float("inf")):
                 nf.append(p)

@@ -1,5 +1,5 @@
 """The Python API (family ``python``): bad arguments to every call (`Model.load`,
-`Model.from_text`, `override`, `losses`, `steady`, `map`, `run`, `study`), DataFrames, Series,
+`Model.from_text`, `override`, `losses`, `steady`, `map`, `rating`, `run`, `study`), DataFrames, Series,
 numpy scalars and arrays where numbers, lists or mappings belong, and every call once more
 through a process pool, whose exceptions must arrive with their type, message and key path.
 
@@ -65,6 +65,10 @@ def gen_call(rng, scenario, root, texts):
     elif scenario == "map":
         a["kwargs"] = {"gear": "1", "speed_rpm": good_or(rng, [1000.0, 2000.0], LISTS),
                        "torque_nm": good_or(rng, [10.0, 50.0], LISTS), "ambient_c": good_or(rng, None, NUMBERS, 0.15)}
+    elif scenario == "rating":
+        a["kwargs"] = {"gear": "1", "speed_rpm": good_or(rng, rng.choice([1000.0, [1000.0, 2000.0]]), NUMBERS + LISTS),
+                       "oil_limit_c": good_or(rng, rng.choice([60.0, 90.0, 120.0]), NUMBERS + [-60.0, -35.0, 200.5]),
+                       "torque_max_nm": good_or(rng, None, NUMBERS, 0.2), "ambient_c": good_or(rng, None, NUMBERS, 0.15)}
     elif scenario == "run":
         a["kwargs"] = {"cycle": good_or(rng, "RIG", [R("none"), "", "nope", R("path_dir"), R("dev_null"), 1, R("df")]),
                        "summary_only": rng.random() < 0.5}
@@ -73,7 +77,7 @@ def gen_call(rng, scenario, root, texts):
                 a["kwargs"][k] = rng.choice(NUMBERS + ["bdf", "nope", 100, -35.0, 0.0])
     else:
         gen_study(rng, a)
-    if rng.random() < 0.3 and scenario in ("losses", "steady", "map", "run"):
+    if rng.random() < 0.3 and scenario in ("losses", "steady", "map", "rating", "run"):
         a["values"] = gen_values(rng, texts)
     return a
 
@@ -100,7 +104,8 @@ def gen_study(rng, a):
     a["kwargs"] = kw
 
 
-SCENARIOS = ["load", "from_text", "override", "losses", "losses", "steady", "map", "run", "run", "study", "study"]
+SCENARIOS = ["load", "from_text", "override", "losses", "losses", "steady", "map", "rating", "run", "run", "study",
+             "study"]
 
 
 def make_case(i, rng, root, texts):

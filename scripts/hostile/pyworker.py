@@ -108,7 +108,7 @@ def call(scenario, a):
     if scenario == "override":
         return base.override(build(a["values"]))
     m = base.override(build(a["values"])) if a.get("values") else base
-    if scenario in ("losses", "steady", "map", "run"):
+    if scenario in ("losses", "steady", "map", "rating", "run"):
         return getattr(m, scenario)(*build(a.get("args", [])), **build(a.get("kwargs", {})))
     if scenario == "study":
         return geartherm.study(build(a.get("model_arg", fzg)), build(a["parameters"]), build(a.get("job")),

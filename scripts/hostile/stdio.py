@@ -35,6 +35,8 @@ def command(rng, m):
         ["run", "MODEL", "--cycle", "nope", "--out", "OUT"],
         ["run", "MODEL", "--cycle", "RIG", "--frozen-viscosity-c", "0", "--out", "OUT"],
         ["report", "RUNDIR"],
+        ["rating", "MODEL", "--gear", gear, "--speed-rpm", "1000:2000:2", "--oil-limit-c", "90", "--out", "OUT"],
+        ["rating", "MODEL", "--gear", gear, "--speed-rpm", "1000", "--oil-limit-c", "90", "--json"],
         ["bench", "MODEL", "--cycle", "RIG", "--repeats", "1", "--min-rtol", "1e-4", "--solvers", "ros3",
          "--out", "OUT"],
         ["study", "STUDY", "--list"],
@@ -59,7 +61,8 @@ def make_case(i, rng):
 
 def template_for(args):
     cmd = args[0]
-    return {"run": "run", "map": "map", "bench": "bench", "study": "study", "validate": "validate"}.get(cmd)
+    return {"run": "run", "map": "map", "bench": "bench", "study": "study", "validate": "validate",
+            "rating": "rating"}.get(cmd)
 
 
 def stream(mode, d, tag):
