@@ -27,9 +27,11 @@ on 2 cores).
 """
 import argparse
 import collections
+import json
 import concurrent.futures as cf
 import os
 import random
+import signal
 import subprocess
 import sys
 import tempfile
@@ -127,6 +129,7 @@ class Tally:
         self.exits = collections.defaultdict(collections.Counter)
         self.examples = collections.defaultdict(list)
         self.done = 0
+        self.log = None
 
     def add(self, r):
         self.done += 1
@@ -156,6 +159,10 @@ class Tally:
                       f"{str(r.get('detail', ''))[:400]}")
 
 
+def stop(*_):
+    raise KeyboardInterrupt
+
+
 def python_ok(python):
     p = subprocess.run([python, "-c", "import geartherm, pandas, numpy"], capture_output=True)
     return p.returncode == 0
@@ -170,7 +177,10 @@ def main():
     ap.add_argument("--python", default=sys.executable)
     ap.add_argument("--families", default="all")
     ap.add_argument("--limit", type=float, default=core.LIMIT_S)
+    ap.add_argument("--log", help="append each failing case (JSON, one per line) to this file as it happens")
     a = ap.parse_args()
+    # A SIGTERM ends the campaign like Ctrl-C: the worker interpreters are stopped on the way out.
+    signal.signal(signal.SIGTERM, stop)
     a.bin = os.path.abspath(a.bin)
     families = dict(WEIGHTS) if a.families == "all" else {f: WEIGHTS[f] for f in a.families.split(",")}
     if "python" in families and not python_ok(a.python):
@@ -180,6 +190,7 @@ def main():
     start = time.time()
     with tempfile.TemporaryDirectory(prefix="hostile_campaign_") as tmp:
         ctx = Context(a, tmp)
+        tally.log = open(a.log, "a") if a.log else None
         try:
             run_all(a, ctx, families, tally)
         finally:
@@ -205,6 +216,9 @@ def run_all(a, ctx, families, tally):
 
 def record(tally, r):
     tally.add(r)
+    if r["classes"] and tally.log:
+        tally.log.write(json.dumps(r, default=str) + "\n")
+        tally.log.flush()
     if tally.done % 1000 == 0:
         print(f"{tally.done} cases: {dict(tally.counts)}", file=sys.stderr, flush=True)
 

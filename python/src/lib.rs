@@ -308,6 +308,11 @@ fn run_cases(
     indices: Vec<usize>,
     threads: Option<usize>,
 ) -> PyResult<String> {
+    if let Some(n) = threads {
+        geartherm::job::limits::THREADS
+            .check(n as f64)
+            .map_err(job_error)?;
+    }
     let s = load_study(spec, text, file)?;
     let all = s.cases();
     let mut cases = Vec::with_capacity(indices.len());
@@ -328,7 +333,7 @@ fn run_cases(
         };
         match threads {
             Some(n) => rayon::ThreadPoolBuilder::new()
-                .num_threads(n.max(1))
+                .num_threads(n)
                 .build()
                 .map_err(|e| e.to_string())?
                 .install(work),

@@ -58,6 +58,10 @@ def test_bad_arguments_and_dataframes_get_clear_errors():
             geartherm.study(m, params, job, cases=[i])
     with pytest.raises(TypeError):
         geartherm.study(m, params, job, cases=[0.5])
+    # A million threads would each be started before the first case runs.
+    for n in (0, 1025, 10**6):
+        with pytest.raises(geartherm.InputError, match=r"threads_per_task .* must lie in \[1, 1024\]"):
+            geartherm.study(m, params, job, threads_per_task=n)
     with pytest.raises(geartherm.InputError, match=r"oil_temp_c .* must lie in \[-35, 200\]"):
         m.losses(gear="1", speed_rpm=1450.0, torque_nm=50.0, oil_temp_c=-60.0)
 

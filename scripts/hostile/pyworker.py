@@ -17,6 +17,7 @@ import json
 import math
 import os
 import pickle
+import re
 import sys
 import traceback
 
@@ -149,7 +150,7 @@ def remote(scenario, a):
         # The exception object crosses the process boundary; its type, message and key path
         # must arrive intact.
         e2 = pickle.loads(pickle.dumps(e))
-        return ("raised", type(e2).__name__, str(e2), getattr(e2, "path", None), getattr(e2, "problems", None))
+        return ("raised", type(e2).__name__, plain(str(e2)), getattr(e2, "path", None), getattr(e2, "problems", None))
 
 
 def outcome_of(scenario, a):
@@ -157,7 +158,12 @@ def outcome_of(scenario, a):
         v = call(scenario, a)
         return ("ok", type(v).__name__)
     except BaseException as e:
-        return ("raised", type(e).__name__, str(e), getattr(e, "path", None), getattr(e, "problems", None))
+        return ("raised", type(e).__name__, plain(str(e)), getattr(e, "path", None), getattr(e, "problems", None))
+
+
+def plain(message):
+    """A message without object addresses (`<object object at 0x7f…>` differs between processes)."""
+    return re.sub(r"0x[0-9a-f]+", "0x…", message)
 
 
 def here_result(scenario, a):

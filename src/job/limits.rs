@@ -219,7 +219,8 @@ pub const RATING_TORQUE_MAX_NM: Limit = Limit {
 };
 
 /// Every limit, for tables and tests.
-pub const ALL: [Limit; 17] = [
+pub const ALL: [Limit; 18] = [
+    THREADS,
     SPEED_RPM,
     TORQUE_NM,
     DRIVE_TORQUE_NM,
@@ -238,6 +239,17 @@ pub const ALL: [Limit; 17] = [
     RATING_TORQUE_MIN_NM,
     RATING_TORQUE_MAX_NM,
 ];
+
+/// Threads of one batch of study cases in Python (`threads_per_task`): one per core is the
+/// most that helps (more only share the same cores, each with its own stack); 1024 covers the
+/// largest machines; a million would each be started before the first case runs.
+pub const THREADS: Limit = Limit {
+    name: "threads_per_task",
+    flag: "threads_per_task",
+    lo: 1.0,
+    hi: 1024.0,
+    unit: "",
+};
 
 /// Points per map axis.
 pub const MAP_AXIS_POINTS: Limit = Limit {
