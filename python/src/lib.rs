@@ -340,14 +340,35 @@ fn pick_cases(s: &Study, indices: Option<Vec<usize>>, shard: Option<(usize, usiz
             None => all,
         });
     };
+    let mut seen = std::collections::HashSet::with_capacity(indices.len());
+    if let Some(i) = indices.iter().find(|&&i| !seen.insert(i)) {
+        return Err(input_error(format!(
+            "cases: {i} is given more than once; each case runs once"
+        )));
+    }
     indices
         .iter()
         .map(|&i| {
             all.get(i)
                 .copied()
-                .ok_or_else(|| input_error(format!("case index {i}: the study has {} cases", all.len())))
+                .ok_or_else(|| {
+                    input_error(format!(
+                        "cases: {i}: must lie in [0, {n}) (the study has {n} cases)",
+                        n = all.len()
+                    ))
+                })
         })
         .collect()
+}
+
+/// `threads` held to [`geartherm::job::limits::THREADS`] before any pool is built.
+fn check_threads(threads: Option<usize>) -> PyResult<()> {
+    match threads {
+        Some(n) => geartherm::job::limits::THREADS
+            .check(n as f64)
+            .map_err(job_error),
+        None => Ok(()),
+    }
 }
 
 fn in_pool<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> Result<T, String> {
@@ -374,6 +395,7 @@ fn run_cases(
     indices: Vec<usize>,
     threads: Option<usize>,
 ) -> PyResult<String> {
+    check_threads(threads)?;
     let s = load_study(spec, text, file)?;
     let cases = pick_cases(&s, Some(indices.clone()), None)?;
     let rows = py.detach(|| {
@@ -414,6 +436,7 @@ fn run_study(
     progress: Option<Py<PyAny>>,
     compact: bool,
 ) -> PyResult<(String, Py<PyDict>)> {
+    check_threads(threads)?;
     let s = load_study(spec, text, file)?;
     let cases = pick_cases(&s, indices, shard)?;
     let output = out.as_ref().map(|dir| Output {

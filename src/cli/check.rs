@@ -37,7 +37,7 @@ pub struct LossesArgs {
     /// Input torque, N m (0 … 1e6: drive).
     #[arg(long, allow_negative_numbers = true)]
     pub torque_nm: f64,
-    /// Oil temperature, °C (−60 … 250).
+    /// Oil temperature, °C (within the oil's range, at most −60 … 200).
     #[arg(long, allow_negative_numbers = true)]
     pub oil_temp_c: f64,
     /// Print one JSON document instead of tables.

@@ -31,14 +31,15 @@ pub struct RunArgs {
     /// Absolute tolerance on temperatures, K (1e-14 … 1).
     #[arg(long, default_value_t = DEFAULT_ATOL)]
     pub atol: f64,
-    /// Initial temperature of every node, °C (−60 … 250; default: the model's).
+    /// Initial temperature of every node, °C (within the oil's range, at most −60 … 200;
+    /// default: the model's).
     #[arg(long, allow_negative_numbers = true)]
     pub initial_temp_c: Option<f64>,
     /// Ambient temperature, °C (−60 … 150; default: the model's ambient boundary).
     #[arg(long, allow_negative_numbers = true)]
     pub ambient_c: Option<f64>,
-    /// Freeze the oil properties at this temperature, °C (−60 … 250; switches the viscosity
-    /// feedback off).
+    /// Freeze the oil properties at this temperature, °C (within the oil's range, at most
+    /// −60 … 200; switches the viscosity feedback off).
     #[arg(long, allow_negative_numbers = true)]
     pub frozen_viscosity_c: Option<f64>,
     /// Also write PNG plots and report.md.

@@ -3,6 +3,7 @@
 //! the message names both, so that it reads the same from each.
 
 use super::JobError;
+use crate::solve::equilibrium::OIL_RANGE_C;
 
 /// A closed range of a numeric option.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -97,22 +98,23 @@ pub const DRIVE_TORQUE_NM: Limit = Limit {
     unit: "N m",
 };
 
-/// Oil temperature of a loss evaluation, °C (the oil catalogue's Walther fits are stated from
-/// −60 °C; above 250 °C every gear oil has cracked).
+/// Oil temperature of a loss evaluation, °C: the widest oil range of the envelope
+/// ([`OIL_RANGE_C`]); each job narrows it to its oil's range
+/// ([`super::envelope::OilRange`]), where the Walther fit holds.
 pub const OIL_TEMP_C: Limit = Limit {
     name: "oil_temp_c",
     flag: "--oil-temp-c",
-    lo: -60.0,
-    hi: 250.0,
+    lo: OIL_RANGE_C.0,
+    hi: OIL_RANGE_C.1,
     unit: "°C",
 };
 
-/// Initial temperature of every node, °C.
+/// Initial temperature of every node (the oil's among them), °C: as [`OIL_TEMP_C`].
 pub const INITIAL_TEMP_C: Limit = Limit {
     name: "initial_temp_c",
     flag: "--initial-temp-c",
-    lo: -60.0,
-    hi: 250.0,
+    lo: OIL_RANGE_C.0,
+    hi: OIL_RANGE_C.1,
     unit: "°C",
 };
 
@@ -125,12 +127,12 @@ pub const AMBIENT_C: Limit = Limit {
     unit: "°C",
 };
 
-/// Temperature at which the oil properties are frozen, °C.
+/// Temperature at which the oil properties are frozen, °C: as [`OIL_TEMP_C`].
 pub const FROZEN_VISCOSITY_C: Limit = Limit {
     name: "frozen_viscosity_c",
     flag: "--frozen-viscosity-c",
-    lo: -60.0,
-    hi: 250.0,
+    lo: OIL_RANGE_C.0,
+    hi: OIL_RANGE_C.1,
     unit: "°C",
 };
 
@@ -217,7 +219,8 @@ pub const RATING_TORQUE_MAX_NM: Limit = Limit {
 };
 
 /// Every limit, for tables and tests.
-pub const ALL: [Limit; 17] = [
+pub const ALL: [Limit; 18] = [
+    THREADS,
     SPEED_RPM,
     TORQUE_NM,
     DRIVE_TORQUE_NM,
@@ -236,6 +239,17 @@ pub const ALL: [Limit; 17] = [
     RATING_TORQUE_MIN_NM,
     RATING_TORQUE_MAX_NM,
 ];
+
+/// Threads of one batch of study cases in Python (`threads_per_task`): one per core is the
+/// most that helps (more only share the same cores, each with its own stack); 1024 covers the
+/// largest machines; a million would each be started before the first case runs.
+pub const THREADS: Limit = Limit {
+    name: "threads_per_task",
+    flag: "threads_per_task",
+    lo: 1.0,
+    hi: 1024.0,
+    unit: "",
+};
 
 /// Points per map axis.
 pub const MAP_AXIS_POINTS: Limit = Limit {

@@ -7,6 +7,7 @@ use crate::physics::oil::KELVIN_OFFSET;
 use crate::report::losses::{losses as report, LossReport};
 use crate::scene::{LossScene, OperatingPoint};
 
+use super::envelope::OilRange;
 use super::limits::{self, short};
 use super::{JobError, Model};
 
@@ -38,6 +39,7 @@ impl LossesOptions {
 pub fn losses(m: &Model, o: &LossesOptions) -> Result<LossReport, JobError> {
     let state = m.state(&o.gear)?;
     o.check()?;
+    OilRange::of(&m.gearbox.oil).check_option(&limits::OIL_TEMP_C, o.oil_temp_c)?;
     let scene =
         LossScene::compile(&m.gearbox).map_err(|e| JobError::invalid(format!("{}: {e}", m.label())))?;
     let op = OperatingPoint {

@@ -6,8 +6,9 @@ use serde::{Deserialize, Serialize};
 use crate::solve::steady::SteadyOptions as NewtonOptions;
 use crate::solve::sweep::{self, MapPoint};
 
+use super::envelope::Envelope;
 use super::limits::{self, short, MAX_MAP_POINTS};
-use super::steady::{check_equilibrium, point_scene};
+use super::steady::{check_envelope, check_equilibrium, point_scene};
 use super::{JobError, Model};
 
 /// Options of a map (`geartherm map`, `Model.map`).
@@ -241,12 +242,15 @@ fn warnings(
 }
 
 fn failures(scene: &crate::scene::Scene, points: &[MapPoint]) -> Vec<String> {
+    let envelope = Envelope::of(scene);
     points
         .iter()
         .filter_map(|p| {
             let why = match &p.equilibrium {
                 None => "no equilibrium".to_string(),
-                Some(e) => check_equilibrium(scene, e).err()?,
+                Some(e) => check_equilibrium(scene, e)
+                    .and_then(|()| check_envelope(&envelope, e))
+                    .err()?,
             };
             Some(format!(
                 "{} rpm, {} N m: {why}",

@@ -14,12 +14,16 @@
 //! | `bench` | [`BenchOptions`] | [`bench::bench`] | [`BenchResult`] |
 //! | `validate` | [`ValidateOptions`] | [`validate::validate`] | [`ValidateResult`] |
 //!
+//! Every job checks its result against the same envelope of states where its models hold
+//! ([`envelope`]).
+//!
 //! A study case is a `run` or a `steady` job on a model with overrides; its stand-alone command
 //! line is rendered from its options by [`command`].
 
 pub mod bench;
 pub mod calibrate;
 pub mod command;
+pub mod envelope;
 pub mod error;
 pub mod limits;
 pub mod losses;

@@ -11,6 +11,7 @@ use crate::physics::oil::KELVIN_OFFSET;
 use crate::scene::{OperatingPoint, RangeLog, RangeWarning, Scene};
 use crate::solve::equilibrium::Equilibrium;
 
+use super::envelope::{Envelope, OilRange};
 use super::limits::{self, short};
 use super::steady::{self, point_scene, SteadyOptions, SteadyResult};
 use super::{JobError, Model};
@@ -219,6 +220,7 @@ pub struct Prepared {
 /// Check the options and compile the scene: everything that can fail as invalid input.
 pub fn prepare(m: &Model, o: &RatingOptions) -> Result<Prepared, JobError> {
     o.check()?;
+    OilRange::of(&m.gearbox.oil).check_option(&limits::OIL_LIMIT_C, o.oil_limit_c)?;
     let (scene, state) = point_scene(m, &o.gear, o.vehicle_speed_kmh, o.ambient_c)?;
     Ok(Prepared { scene, state })
 }
@@ -256,8 +258,13 @@ pub fn solve(
         })
         .collect();
     let mut points = Vec::with_capacity(found.len());
+    let envelope = Envelope::of(&p.scene);
     for (r, &rpm) in found.into_iter().zip(&o.speed_rpm) {
-        let s = r.map_err(|(rpm, t, why)| {
+        let s = r.and_then(|s| match steady::check_envelope(&envelope, &s.payload) {
+            Ok(()) => Ok(s),
+            Err(why) => Err((rpm, s.torque, why)),
+        });
+        let s = s.map_err(|(rpm, t, why)| {
             JobError::numerical(format!(
                 "{}: rating of gear {} at {} rpm failed at {} N m: {why}; nothing written",
                 m.label(),

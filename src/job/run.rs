@@ -12,6 +12,7 @@ use crate::solve::transient::{
     check_stored_values, integrate, Method, Restart, Segment, Trajectory, TransientOptions,
 };
 
+use super::envelope::{Envelope, OilRange};
 use super::limits::{self, Limit};
 use super::{JobError, Model};
 
@@ -127,6 +128,9 @@ pub struct Prepared {
 /// can fail as invalid input fails here, before any output directory is touched.
 pub fn prepare(m: &Model, o: &RunOptions) -> Result<Prepared, JobError> {
     let method = o.check()?;
+    let oil = OilRange::of(&m.gearbox.oil);
+    oil.check_option_opt(&limits::INITIAL_TEMP_C, o.initial_temp_c)?;
+    oil.check_option_opt(&limits::FROZEN_VISCOSITY_C, o.frozen_viscosity_c)?;
     let cycle = DriveCycle::resolve(&o.cycle)?;
     let (sched, segs) =
         segments(&m.gearbox, &cycle).map_err(|e| JobError::invalid(format!("{}: {e}", m.label())))?;
@@ -140,6 +144,14 @@ pub fn prepare(m: &Model, o: &RunOptions) -> Result<Prepared, JobError> {
     m.set_ambient(&mut scene, o.ambient_c)?;
     scene.frozen_oil_temp = o.frozen_viscosity_c.map(|c| c + KELVIN_OFFSET);
     let opts = o.transient(method);
+    let start = scene.initial_state(opts.initial_temp);
+    Envelope::of(&scene).check(&start[..scene.nodes()]).map_err(|b| {
+        JobError::invalid(format!(
+            "{}: the initial state is outside the range where the models hold: {b} \
+                 (thermal.initial_temp_c, the node's initial_temp_c or --initial-temp-c)",
+            m.label()
+        ))
+    })?;
     check_stored_values(&scene, &segs, &opts)
         .map_err(|e| JobError::invalid(format!("{}: {e}", m.label())))?;
     Ok(Prepared {
@@ -203,6 +215,9 @@ fn finish(m: &Model, p: &Prepared, traj: &Trajectory) -> Result<RunResult, JobEr
     );
     let numerical = |what: String| JobError::numerical(format!("{}: {what}", m.label()));
     check_finite(&p.scene, traj, &rows, &sum).map_err(numerical)?;
+    Envelope::of(&p.scene)
+        .check_run(&p.scene, &p.segs, traj)
+        .map_err(numerical)?;
     if sum.energy_balance_relative > MAX_ENERGY_RESIDUAL {
         return Err(numerical(format!(
             "energy balance residual {:.2e} exceeds {MAX_ENERGY_RESIDUAL:e}: the integration is not trustworthy \

@@ -10,6 +10,7 @@ use crate::scene::{Inputs, Needs, OperatingPoint, RangeLog, RangeWarning, Scene}
 use crate::solve::equilibrium::{equilibrium, Equilibrium};
 use crate::solve::steady::{SteadyError, SteadyOptions as NewtonOptions};
 
+use super::envelope::Envelope;
 use super::limits::{self, short};
 use super::{JobError, Model};
 
@@ -142,6 +143,7 @@ pub fn steady(m: &Model, o: &SteadyOptions) -> Result<SteadyResult, JobError> {
         ))
     })?;
     check_equilibrium(&scene, &eq)
+        .and_then(|()| check_envelope(&Envelope::of(&scene), &eq))
         .map_err(|what| JobError::numerical(format!("{}: {}: {what}", m.label(), o.describe())))?;
     Ok(result(m, o, &scene, state, &eq))
 }
@@ -221,6 +223,13 @@ pub fn check_equilibrium(scene: &Scene, eq: &Equilibrium) -> Result<(), String> 
         ));
     }
     Ok(())
+}
+
+/// The equilibrium's temperatures inside the envelope, else the node that left it.
+pub fn check_envelope(envelope: &Envelope, eq: &Equilibrium) -> Result<(), String> {
+    envelope
+        .check(&eq.solution.temperatures)
+        .map_err(|b| format!("the equilibrium is outside the range where the models hold: {b}"))
 }
 
 /// A steady-solver failure in words, with node names.

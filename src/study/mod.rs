@@ -145,25 +145,80 @@ fn jobs_of(spec: &JobSpec) -> Result<Vec<Job>, String> {
             speed_rpm,
             torque_nm,
             vehicle_speed_kmh,
-        } => speed_rpm
-            .iter()
-            .flat_map(|&s| {
-                torque_nm.iter().map(move |&t| {
-                    Job::Steady(SteadyOptions {
-                        gear: gear.clone(),
-                        speed_rpm: s,
-                        torque_nm: t,
-                        vehicle_speed_kmh: *vehicle_speed_kmh,
-                        ambient_c: None,
-                    })
-                })
-            })
-            .collect(),
+        } => map_jobs(job::MapOptions {
+            gear: gear.clone(),
+            speed_rpm: speed_rpm.clone(),
+            torque_nm: torque_nm.clone(),
+            vehicle_speed_kmh: *vehicle_speed_kmh,
+            ambient_c: None,
+        })?,
     };
     if jobs.is_empty() {
         return Err("job: no cycles or points".into());
     }
     Ok(jobs)
+}
+
+/// A map job's points, one steady job each; the grid's size and values are checked as
+/// `geartherm map` checks them, before its points are built.
+fn map_jobs(grid: job::MapOptions) -> Result<Vec<Job>, String> {
+    grid.check().map_err(|e| format!("job: {}", e.message))?;
+    let point = |s: f64, t: f64| {
+        Job::Steady(SteadyOptions {
+            gear: grid.gear.clone(),
+            speed_rpm: s,
+            torque_nm: t,
+            vehicle_speed_kmh: grid.vehicle_speed_kmh,
+            ambient_c: None,
+        })
+    };
+    Ok(grid
+        .speed_rpm
+        .iter()
+        .flat_map(|&s| grid.torque_nm.iter().map(move |&t| (s, t)))
+        .map(|(s, t)| point(s, t))
+        .collect())
+}
+
+/// A study's name names its default output directory (`studies/<name>`): a plain name
+/// ([`model::parse::is_plain_name`]) that is one path component, neither `.` nor `..`.
+fn check_name(name: &str) -> Result<(), String> {
+    if model::parse::is_plain_name(name) && !name.contains('/') && name != "." && name != ".." {
+        return Ok(());
+    }
+    Err(format!(
+        "study.name = {name:?}: must be a plain name usable as a directory name: 1–{} characters, \
+         no `/`, no control characters, none of , \" ' | \\ ; `, not `.` or `..`",
+        model::parse::MAX_NAME_LEN
+    ))
+}
+
+/// Run jobs whose cycles give one case-id key (the same cycle twice, or two files with one
+/// name) would share case ids, and a resumed study would take one for the other.
+fn check_distinct_cycles(jobs: &[Job]) -> Result<(), String> {
+    let mut seen = std::collections::BTreeMap::new();
+    for (k, j) in jobs.iter().enumerate() {
+        if let Job::Run(o) = j {
+            if let Some(first) = seen.insert(cycle_key(&o.cycle), k) {
+                return Err(format!(
+                    "job.cycles[{first}] and job.cycles[{k}] ({}) give the same case id `{}`: \
+                     each cycle once, with distinct file names",
+                    o.cycle,
+                    cycle_key(&o.cycle)
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The case-id key of a cycle: its file stem, made a plain directory-name part.
+fn cycle_key(cycle: &str) -> String {
+    key_of(
+        Path::new(cycle)
+            .file_stem()
+            .map_or(cycle, |s| s.to_str().unwrap_or("cycle")),
+    )
 }
 
 /// Every job's options checked before any case runs (their ranges, the cycles read, the gear
@@ -287,6 +342,7 @@ impl Study {
     /// exist in the model (or be accepted by its schema), the plan must be well formed.
     pub fn new(spec: StudySpec, model_text: String, model_file: PathBuf) -> Result<Study, StudyError> {
         let invalid = StudyError::Invalid;
+        check_name(&spec.study.name).map_err(invalid)?;
         let base_model =
             job::Model::from_text(&model_text, &model_file, &[]).map_err(|e| invalid(e.message))?;
         let mut problems = model::Problems::default();
@@ -330,7 +386,16 @@ impl Study {
             }
         }
         let jobs = jobs_of(&spec.job).map_err(invalid)?;
+        if samples.len().saturating_mul(jobs.len()) > plan::MAX_SAMPLES {
+            return Err(invalid(format!(
+                "{} samples × {} jobs: more than {} cases",
+                samples.len(),
+                jobs.len(),
+                plan::MAX_SAMPLES
+            )));
+        }
         check_jobs(&spec.job, &jobs, &base_model)?;
+        check_distinct_cycles(&jobs).map_err(invalid)?;
         let outputs = output_columns(&jobs, &base_model)?;
         check_outputs(&spec.outputs, &outputs)?;
         let spec_json = serde_json::to_string(&spec).map_err(|e| invalid(e.to_string()))?;
@@ -371,11 +436,7 @@ impl Study {
     /// Case id: `<sample>-<job>` (usable as a directory name).
     pub fn case_id(&self, c: &Case) -> String {
         let job = match &self.jobs[c.job] {
-            Job::Run(o) => key_of(
-                Path::new(&o.cycle)
-                    .file_stem()
-                    .map_or(&*o.cycle, |s| s.to_str().unwrap_or("cycle")),
-            ),
+            Job::Run(o) => cycle_key(&o.cycle),
             Job::Steady(_) => format!("p{:04}", c.job),
         };
         format!("{:06}-{job}", c.sample)

@@ -5,8 +5,24 @@
 use super::spec::{ParamSpec, Plan, Sampling};
 use super::ParamValue;
 
-/// Largest number of samples a plan may produce.
+/// Largest number of samples a plan may produce (and of cases a study may have).
 pub const MAX_SAMPLES: usize = 10_000_000;
+
+/// Largest number of sampled values (samples × parameters) a plan may hold: each takes about
+/// 55 bytes as built (a 10⁷-case grid of two parameters holds 1.1 GB), so this bounds a plan to
+/// about a gigabyte.
+pub const MAX_SAMPLED_VALUES: usize = 20_000_000;
+
+/// Refuse `n` samples of `params` parameters beyond [`MAX_SAMPLED_VALUES`], before building.
+fn check_values(n: usize, params: usize) -> Result<(), String> {
+    match n.checked_mul(params) {
+        Some(v) if v <= MAX_SAMPLED_VALUES => Ok(()),
+        _ => Err(format!(
+            "{n} samples × {params} parameters: more than {MAX_SAMPLED_VALUES} sampled values \
+             (about 1 GB); use fewer samples or parameters"
+        )),
+    }
+}
 
 /// SplitMix64 (Steele, Lea & Flood 2014): a small, fast generator with a fixed, documented
 /// sequence, so a seed gives the same plan on every platform and version.
@@ -118,6 +134,7 @@ fn grid(params: &[ParamSpec]) -> Result<Vec<Vec<ParamValue>>, String> {
             acc.checked_mul(level_count(p)).filter(|&t| t <= MAX_SAMPLES)
         })
         .ok_or_else(|| format!("the grid has more than {MAX_SAMPLES} cases"))?;
+    check_values(total, params.len())?;
     let lv: Vec<Vec<ParamValue>> = params.iter().map(levels).collect();
     Ok((0..total)
         .map(|mut k| {
@@ -209,6 +226,7 @@ pub fn samples(params: &[ParamSpec], s: &Sampling) -> Result<Vec<Vec<ParamValue>
             if n == 0 || n > MAX_SAMPLES {
                 return Err(format!("sampling.cases = {n}: must lie in [1, {MAX_SAMPLES}]"));
             }
+            check_values(n, params.len())?;
             Ok(lhs(params, n, s.seed))
         }
     }
@@ -261,6 +279,27 @@ mod tests {
         b.levels = Some(5_000);
         let e = samples(&[a, b], &Sampling::default()).unwrap_err();
         assert!(e.contains("more than 10000000 cases"), "{e}");
+    }
+
+    /// 10⁷ LHS samples of 64 parameters would hold 6.4·10⁸ values (about 35 GB): refused from
+    /// the counts, before any value is drawn; so is a grid within the case limit whose
+    /// parameters multiply its values beyond the limit.
+    #[test]
+    fn a_plan_with_too_many_values_is_refused_before_it_is_built() {
+        let params: Vec<ParamSpec> = (0..64).map(|k| range(&format!("p{k}"), 0.0, 1.0)).collect();
+        let lhs = Sampling {
+            plan: Plan::Lhs,
+            cases: Some(MAX_SAMPLES),
+            seed: 1,
+        };
+        let e = samples(&params, &lhs).unwrap_err();
+        assert!(e.contains("10000000 samples × 64 parameters"), "{e}");
+        let mut big = range("a", 0.0, 1.0);
+        big.levels = Some(MAX_SAMPLES);
+        let mut grid = vec![big];
+        grid.extend((0..2).map(|k| values(&format!("v{k}"), &["x"])));
+        let e = samples(&grid, &Sampling::default()).unwrap_err();
+        assert!(e.contains("× 3 parameters"), "{e}");
     }
 
     #[test]

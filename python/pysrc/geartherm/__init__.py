@@ -252,6 +252,8 @@ class Model:
         ModelError
             An unknown path or an invalid value (``.path``, ``.value``, ``.allowed``).
         """
+        if not isinstance(values, Mapping):
+            raise TypeError(f"override(): values must be a mapping of key path to value, not {type(values).__name__}")
         return Model(self._m.with_overrides([f"{k} = {toml_value(v)}" for k, v in values.items()]))
 
     @property

@@ -23,10 +23,15 @@ __all__ = ["Study", "study", "study_commands", "read_study"]
 
 
 def _spec(parameters, job, sampling, name: str, outputs) -> Dict[str, Any]:
-    if isinstance(parameters, Mapping):
+    if isinstance(parameters, Mapping) and all(isinstance(s, Mapping) for s in parameters.values()):
         params = [dict(spec, path=path) for path, spec in parameters.items()]
-    else:
+    elif isinstance(parameters, (list, tuple)) and all(isinstance(p, Mapping) for p in parameters):
         params = [dict(p) for p in parameters]
+    else:
+        raise TypeError(
+            "study(): parameters must be a mapping {key path: {\"range\" | \"values\" | \"scale\": ...}} "
+            f"or a list of such mappings with a \"path\", not {type(parameters).__name__}"
+        )
     return {
         "study": {"name": name, "model": ""},
         "job": dict(job) if job is not None else {"kind": "run", "cycles": ["wltc"]},
@@ -72,6 +77,19 @@ class _Bar:
             self.bar.close()
         elif self.text:
             sys.stderr.write("\n")
+
+
+def _case_indices(cases: Sequence[int], n: int) -> List[int]:
+    """``cases`` as distinct positions in [0, n), each once (a case run twice would be two rows)."""
+    import operator
+
+    todo = [operator.index(i) for i in cases]
+    for i in todo:
+        if not 0 <= i < n:
+            raise InputError(f"cases: {i}: must lie in [0, {n}) (the study has {n} cases)")
+    if len(set(todo)) != len(todo):
+        raise InputError("cases: a case is given more than once; each case runs once")
+    return todo
 
 
 def _batch(spec_json: str, text: str, file: str, indices: List[int], threads: Optional[int]) -> str:
@@ -186,14 +204,15 @@ class Study:
             ``True`` (default): a progress bar (tqdm when installed: a terminal bar or a Jupyter
             widget). ``False``: none. A callable is called as ``progress(done, total)``.
         threads : int, optional
-            Threads of a local run (default: every core).
+            Threads of a local run, 1 … 1024 (default: every core).
         cases : sequence of int, optional
             Only these positions in the case list.
         shard : (i, n), optional
             Only shard ``i`` of ``n`` (cases i, i+n, …), journaled as ``journal.shard-i-of-n``;
             a later run without ``shard`` merges the shards.
         batch_size, threads_per_task : int, optional
-            Dask batching and the threads one task uses.
+            Dask batching and the threads one task uses (1 … 1024; also the threads of a local
+            run when ``threads`` is not given).
         backend : {"pandas", "polars"}
             The DataFrame library of the result.
 
@@ -210,7 +229,9 @@ class Study:
         Ctrl-C (``KeyboardInterrupt``) stops the study cleanly: no new case starts, the running
         ones finish and are journaled, then the exception propagates; the same call resumes.
         """
-        indices = None if cases is None else [int(i) for i in cases]
+        indices = None if cases is None else _case_indices(cases, len(self.cases))
+        if client is None and threads is None:
+            threads = threads_per_task
         outdir = None if out is None else os.fspath(out)
         bar = _Bar(len(self.cases) if indices is None else len(indices), self.name, progress)
         try:

@@ -489,6 +489,39 @@ fn nearest(axis: &[f64], x: f64) -> usize {
     }
 }
 
+/// Most cells of a map grid: as many points as `geartherm map` writes at most
+/// (`job::limits::MAX_MAP_POINTS`; a test holds the two equal). A crafted `map.csv` of n rows
+/// with n distinct speeds and torques would otherwise ask for n² cells.
+pub const MAX_MAP_CELLS: usize = 40_000;
+
+/// Largest magnitude of a grid value: the heat map's cell edges and axis ticks (ten times the
+/// axis span) must stay finite.
+pub const MAX_AXIS_VALUE: f64 = 1e300;
+
+/// A grid the heat maps can draw: at most [`MAX_MAP_CELLS`] cells, values within
+/// ±[`MAX_AXIS_VALUE`].
+fn check_grid(path: &Path, speeds: &[f64], torques: &[f64]) -> Result<(), PlotError> {
+    let data = |what: String| PlotError::Data {
+        path: path.to_path_buf(),
+        what,
+    };
+    if speeds.len().saturating_mul(torques.len()) > MAX_MAP_CELLS {
+        return Err(data(format!(
+            "{} speeds × {} torques: more than {MAX_MAP_CELLS} grid cells (the most `geartherm map` writes)",
+            speeds.len(),
+            torques.len()
+        )));
+    }
+    for (name, axis) in [("speed_rpm", speeds), ("torque_nm", torques)] {
+        if let Some(v) = axis.iter().find(|v| v.abs() > MAX_AXIS_VALUE) {
+            return Err(data(format!(
+                "column `{name}`: {v:e} is too large to draw (|value| ≤ {MAX_AXIS_VALUE:e})"
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Read `map.csv` and `map.json` of the map output directory `dir` onto their grid.
 pub fn read_map(dir: &Path) -> Result<MapGrid, PlotError> {
     let path = dir.join("map.csv");
@@ -545,6 +578,7 @@ pub fn read_map(dir: &Path) -> Result<MapGrid, PlotError> {
             what: "no finite speed/torque values".into(),
         });
     }
+    check_grid(&path, &speeds, &torques)?;
     let mut cells = vec![None; speeds.len() * torques.len()];
     for r in rows {
         if !(r.speed_rpm.is_finite() && r.torque_nm.is_finite()) {

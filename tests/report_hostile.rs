@@ -1,0 +1,90 @@
+//! Crafted map directories the hostile campaign (family `report`) found `report` could not
+//! survive: a grid value of 1e308 made the heat map's axis infinite (plotters' tick search then
+//! never ends), and n rows of n distinct speeds and torques asked for an n² grid. Each is
+//! invalid input now (exit 1), the directory left byte for byte.
+
+use std::path::Path;
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+const HEADER: &str =
+    "speed_rpm,torque_nm,efficiency,total_loss_w,churning_w,pocketing_w,sliding_w,bearing_w,\
+seal_w,clutch_drag_w,pump_w,converter_w,oil_temp_c,iterations,converged";
+
+fn row(speed: f64, torque: &str) -> String {
+    format!("{speed},{torque},0.9,50,10,2,5,30,3,0,0,0,60,10,true")
+}
+
+fn map_dir(d: &Path, rows: &[String]) {
+    std::fs::create_dir_all(d).unwrap();
+    std::fs::write(d.join("map.csv"), format!("{HEADER}\n{}\n", rows.join("\n"))).unwrap();
+    std::fs::write(d.join("map.json"), r#"{"model": "m", "gear": "1"}"#).unwrap();
+}
+
+fn report_refuses(d: &Path, what: &str) {
+    let before: Vec<(String, Vec<u8>)> = files(d);
+    let start = Instant::now();
+    let o = Command::new(env!("CARGO_BIN_EXE_geartherm"))
+        .arg("report")
+        .arg(d)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        start.elapsed() < Duration::from_secs(10),
+        "took {:?}",
+        start.elapsed()
+    );
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains(what), "{err}");
+    assert_eq!(files(d), before, "the directory changed");
+}
+
+fn files(d: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| {
+            let p = e.unwrap().path();
+            (
+                p.file_name().unwrap().to_string_lossy().into_owned(),
+                std::fs::read(&p).unwrap(),
+            )
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn a_map_value_too_large_to_draw_is_invalid_input() {
+    let d = tempfile::tempdir().unwrap();
+    let m = d.path().join("m");
+    let rows = [
+        row(1000.0, "10"),
+        row(1000.0, "1e308"),
+        row(2000.0, "10"),
+        row(2000.0, "1e308"),
+    ];
+    map_dir(&m, &rows);
+    report_refuses(&m, "column `torque_nm`: 1e308 is too large to draw");
+}
+
+#[test]
+fn a_map_whose_grid_would_be_too_large_is_invalid_input() {
+    let d = tempfile::tempdir().unwrap();
+    let m = d.path().join("m");
+    let rows: Vec<String> = (0..70_000)
+        .map(|k| row(1000.0 + k as f64, &format!("{}", 10 + k)))
+        .collect();
+    map_dir(&m, &rows);
+    report_refuses(&m, "70000 speeds × 70000 torques: more than 40000 grid cells");
+}
+
+/// The grid bound of `report` is the point bound of `map`.
+#[test]
+fn the_report_grid_bound_is_the_map_point_bound() {
+    assert_eq!(
+        geartherm::report::plots::data::MAX_MAP_CELLS,
+        geartherm::job::limits::MAX_MAP_POINTS
+    );
+}
