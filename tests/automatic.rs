@@ -103,7 +103,12 @@ fn at6_has_clutch_drag_pump_and_converter_items_that_heat_the_oil() {
     ] {
         let mut pack = gb.clutch_packs.iter().find(|c| c.name == e).unwrap().pack;
         // the circuit feeds every AT6 pack: its flow replaces the pack's own
-        let feed = gb.circuit.consumers.iter().position(|c| c.name == format!("{e}_feed")).unwrap();
+        let feed = gb
+            .circuit
+            .consumers
+            .iter()
+            .position(|c| c.name == format!("{e}_feed"))
+            .unwrap();
         pack.oil_flow = scene.losses.circuit.flow(feed, &work.terms.circuit, oil.rho).0;
         assert!(pack.oil_flow > 0.0);
         let want = pack.drag(slip * 2000.0 * RPM, oil.mu, oil.rho).power;

@@ -38,7 +38,7 @@ fn trace_text(values: Option<&[Vec<f64>]>) -> String {
         let (w, t) = match k / 15 {
             0 => (3000.0, 200.0),
             1 => (1500.0, 100.0),
-            2 => (4000.0, 300.0),
+            2 => (4000.0, 250.0),
             _ => (500.0, 50.0),
         };
         let (a, b) = values.map_or((30.0, 30.0), |v| (v[k][0], v[k][1]));
@@ -208,13 +208,13 @@ fn a_parameter_the_trace_does_not_influence_is_warned_about() {
     let exact = synthetic(&text, &m, [400.0, 11.0], 1e-4);
     let trace = Trace::parse(&trace_text(Some(&exact)), "synthetic").unwrap();
     let o = CalibrateOptions {
-        fit: vec![H.into(), "losses.seetharaman_transition_reynolds=1e4:1e6".into()],
+        fit: vec![H.into(), "losses.stavytskyi_ks=0.2:0.9".into()],
         ..CalibrateOptions::default()
     };
     let r = calibrate::calibrate(&m, &text, &trace, &o).unwrap();
     let w = r.summary.warnings.join("\n");
     assert!(
-        w.contains("seetharaman_transition_reynolds") && w.contains("does not influence"),
+        w.contains("stavytskyi_ks") && w.contains("does not influence"),
         "{w}"
     );
     assert!(r.summary.parameters[1].ci95_low.is_none());

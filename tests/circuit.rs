@@ -31,7 +31,12 @@ fn the_at6_has_advection_links_and_fed_meshes() {
     }
     // every external planet mesh is fed, none is left out for an unknown density
     assert!(sc.losses.warnings.iter().all(|w| !w.range.contains("unknown")));
-    let pocketing = sc.losses.items.iter().filter(|i| i.source == Source::Pocketing).count();
+    let pocketing = sc
+        .losses
+        .items
+        .iter()
+        .filter(|i| i.source == Source::Pocketing)
+        .count();
     assert_eq!(pocketing, 4);
 }
 
@@ -40,13 +45,22 @@ fn at6_wltc_with_advection_closes_the_energy_balance_and_pockets_delivered_oil()
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("at6");
     let out = Command::new(env!("CARGO_BIN_EXE_geartherm"))
-        .args(["run", AT6, "--cycle", "wltc", "--out", dir.to_str().unwrap(), "--quiet"])
+        .args([
+            "run",
+            AT6,
+            "--cycle",
+            "wltc",
+            "--out",
+            dir.to_str().unwrap(),
+            "--quiet",
+        ])
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!stderr.contains("unknown"), "{stderr}");
-    let s: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap();
+    let s: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap();
     let bal = s["energy_balance_relative"].as_f64().unwrap();
     let e = &s["energy_lost_j"];
     let (pocketing, fling) = (e["pocketing"].as_f64().unwrap(), e["fling"].as_f64().unwrap());
@@ -154,7 +168,10 @@ fn jacobian_with_advection_links_matches_finite_differences_of_the_rhs() {
 fn circuit_mistakes_are_named_at_their_key_paths() {
     let text = std::fs::read_to_string(AT6).unwrap();
     let bad = text
-        .replace("share = 0.25                  # about a quarter", "share = 1.5 # about a quarter")
+        .replace(
+            "share = 0.25                  # about a quarter",
+            "share = 1.5 # about a quarter",
+        )
         .replace("target = \"RAV\"", "target = \"RAVX\"")
         .replace(
             "kind = \"bearing\"\ntarget = \"output_a\"\nshare = 0.1",
@@ -214,7 +231,11 @@ discharge_coefficient = 0.7
     let mut out = vec![0.0; sc.len()];
     sc.evaluate(&op, &mut out);
     let at = |s: Source, n: &str| {
-        let k = sc.items.iter().position(|i| i.source == s && i.name == n).unwrap();
+        let k = sc
+            .items
+            .iter()
+            .position(|i| i.source == s && i.name == n)
+            .unwrap();
         out[k]
     };
     // 2.5 L/min at 1500 rpm; the orifices (1 : 9 in C_d A) would pass more at 2 bar, so they

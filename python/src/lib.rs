@@ -349,14 +349,12 @@ fn pick_cases(s: &Study, indices: Option<Vec<usize>>, shard: Option<(usize, usiz
     indices
         .iter()
         .map(|&i| {
-            all.get(i)
-                .copied()
-                .ok_or_else(|| {
-                    input_error(format!(
-                        "cases: {i}: must lie in [0, {n}) (the study has {n} cases)",
-                        n = all.len()
-                    ))
-                })
+            all.get(i).copied().ok_or_else(|| {
+                input_error(format!(
+                    "cases: {i}: must lie in [0, {n}) (the study has {n} cases)",
+                    n = all.len()
+                ))
+            })
         })
         .collect()
 }
@@ -366,6 +364,7 @@ fn check_threads(threads: Option<usize>) -> PyResult<()> {
     match threads {
         Some(n) => geartherm::job::limits::THREADS
             .check(n as f64)
+            .map(|_| ())
             .map_err(job_error),
         None => Ok(()),
     }

@@ -228,7 +228,13 @@ fn check_thermal(
     names.set(Source::ClutchDrag, it.packs.iter().copied());
     let consumers = |k: circuit::ConsumerKindChoice| -> Vec<&str> {
         it.circuit
-            .map(|c| c.consumers.iter().filter(|x| x.kind == k).map(|x| x.name.as_str()).collect())
+            .map(|c| {
+                c.consumers
+                    .iter()
+                    .filter(|x| x.kind == k)
+                    .map(|x| x.name.as_str())
+                    .collect()
+            })
             .unwrap_or_default()
     };
     let e_pumps: Vec<&str> = it

@@ -8,7 +8,7 @@
 //! the engine speed and input torque). Per right-hand-side call: the flows at the oil density
 //! ([`CircuitScene::flow`]). No allocation after compile.
 
-use crate::model::gearbox::{Gearbox, GearMount, SourceKind, Split, Target};
+use crate::model::gearbox::{GearMount, Gearbox, SourceKind, Split, Target};
 use crate::model::sections::circuit::MAX_SOURCES;
 use crate::physics::losses::{fling::fling_power, jet};
 use crate::physics::lubrication::{orifice_coefficient, orifice_flow};
@@ -104,7 +104,11 @@ impl CircuitScene {
                 Target::Jet { mesh, speed, angle } => {
                     let m = &gb.meshes[mesh];
                     let r = m.geometry.r_w1;
-                    scene.speed.push((0..n).map(|si| gb.gear_speeds(si)[m.gear1].relative.abs() * r).collect());
+                    scene.speed.push(
+                        (0..n)
+                            .map(|si| gb.gear_speeds(si)[m.gear1].relative.abs() * r)
+                            .collect(),
+                    );
                     scene.losses.push(FlowLoss::Jet {
                         item: items.len(),
                         consumer: ci,
@@ -152,7 +156,9 @@ impl CircuitScene {
             let (supply, line) = match &src.kind {
                 SourceKind::Pump { share } => (share * auto.pump_flow, auto.line_pressure),
                 SourceKind::ElectricPump { flow, .. } => (flow.at(input_speed.abs()), 0.0),
-                SourceKind::Splash { flow, .. } => (flow.at(src.splash_speed[state] * input_speed.abs()), 0.0),
+                SourceKind::Splash { flow, .. } => {
+                    (flow.at(src.splash_speed[state] * input_speed.abs()), 0.0)
+                }
             };
             s.supply[k] = supply;
             s.pressure[k] = src.pressure.unwrap_or(line);
@@ -209,7 +215,11 @@ impl CircuitScene {
                     let vj = vj.unwrap_or_else(|| jet::jet_speed(p, oil.rho));
                     out[item] = jet::impulse_power(oil.rho * q, speed, vj, angle);
                 }
-                FlowLoss::Fling { item, consumer, radius } => {
+                FlowLoss::Fling {
+                    item,
+                    consumer,
+                    radius,
+                } => {
                     let q = self.flow(consumer, s, oil.rho).0;
                     out[item] = fling_power(oil.rho * q, speed, radius);
                 }

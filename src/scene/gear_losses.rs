@@ -297,7 +297,9 @@ pub(super) fn mesh_feeds(gb: &Gearbox, mi: usize) -> Vec<(usize, f64)> {
         .iter()
         .enumerate()
         .filter_map(|(c, x)| match x.target {
-            Target::Mesh(k) | Target::Jet { mesh: k, .. } if k == mi => Some((c, 1.0 / m.multiplicity as f64)),
+            Target::Mesh(k) | Target::Jet { mesh: k, .. } if k == mi => {
+                Some((c, 1.0 / m.multiplicity as f64))
+            }
             Target::Set { set, .. } if m.set == Some(set) => Some((c, 1.0 / set_instances(set))),
             _ => None,
         })

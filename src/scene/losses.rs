@@ -12,13 +12,13 @@ use crate::physics::losses::churning::{GearChurning, OilState as ChurnOil};
 use super::churn_sample::{ChurnSample, InputSpeedPowers};
 use super::circuit::{CircuitSample, CircuitScene};
 use super::gear_losses::{
-    compile_churning, compile_pocketing, compile_sliding, compile_windage, sliding, with_ratio_terms, ChurnEntry,
-    Compiled, Lists, PocketEntry, SlideEntry, StateFactors, WindEntry,
+    compile_churning, compile_pocketing, compile_sliding, compile_windage, sliding, with_ratio_terms,
+    ChurnEntry, Compiled, Lists, PocketEntry, SlideEntry, StateFactors, WindEntry,
 };
-use crate::physics::lubrication::{mixture_density, oil_fraction};
-use crate::physics::losses::windage::AIR;
 use super::usage::Usage;
 use super::warning::RangeWarning;
+use crate::physics::losses::windage::AIR;
+use crate::physics::lubrication::{mixture_density, oil_fraction};
 
 pub use super::gear_losses::{churning_gear, HELIX_POCKET_SLICES};
 pub use super::items::{
@@ -168,8 +168,15 @@ impl LossScene {
         let cs = self.circuit.sample(op.state, op.input_speed, &auto);
         self.evaluate_load_independent(op, None, &cs, out);
         let flow = |c| self.circuit.flow(c, &cs, op.oil.rho).0;
-        self.auto
-            .evaluate(op.state, op.input_speed, op.input_torque, &op.oil, &auto, flow, out);
+        self.auto.evaluate(
+            op.state,
+            op.input_speed,
+            op.input_torque,
+            &op.oil,
+            &auto,
+            flow,
+            out,
+        );
         self.circuit.evaluate(op.state, op.input_speed, &op.oil, &cs, out);
         let st = &self.states[op.state];
         for (e, f) in self.slide.iter().zip(&st.slide) {

@@ -530,7 +530,13 @@ impl Scene {
     /// The oil-state-dependent links' conductances and derivatives at oil state `oil` with the
     /// work area's inputs, into `oil_g`/`oil_dg` or, with `scratch`, `oil_g2`/`oil_dg2` (the
     /// circuit's flows into `mdot`/`dmdot` on the way).
-    fn oil_link_state(&self, oil: OilProperties, slopes: &crate::physics::oil::OilLogSlopes, work: &mut Work, scratch: bool) {
+    fn oil_link_state(
+        &self,
+        oil: OilProperties,
+        slopes: &crate::physics::oil::OilLogSlopes,
+        work: &mut Work,
+        scratch: bool,
+    ) {
         let op = self.op(&work.inputs, oil);
         self.losses
             .consumer_flows(&op, &work.terms, slopes.rho, &mut work.mdot, &mut work.dmdot);

@@ -286,8 +286,16 @@ pub(crate) fn validate_circuit(
             format!("at most {MAX_SOURCES} sources"),
         );
     }
-    check_unique(spec.sources.iter().map(|s| s.name.as_str()), "circuit.sources", problems);
-    check_unique(spec.consumers.iter().map(|c| c.name.as_str()), "circuit.consumers", problems);
+    check_unique(
+        spec.sources.iter().map(|s| s.name.as_str()),
+        "circuit.sources",
+        problems,
+    );
+    check_unique(
+        spec.consumers.iter().map(|c| c.name.as_str()),
+        "circuit.consumers",
+        problems,
+    );
     let sources: Vec<Option<FlowSource>> = spec
         .sources
         .iter()
@@ -299,7 +307,15 @@ pub(crate) fn validate_circuit(
         .consumers
         .iter()
         .enumerate()
-        .map(|(i, c)| consumer(c, &format!("circuit.consumers[{i}]"), &source_names, names, problems))
+        .map(|(i, c)| {
+            consumer(
+                c,
+                &format!("circuit.consumers[{i}]"),
+                &source_names,
+                names,
+                problems,
+            )
+        })
         .collect();
     check_splits(spec, &consumers, problems);
     if problems.len() > before {
@@ -324,9 +340,19 @@ fn check_unique<'a>(it: impl Iterator<Item = &'a str>, path: &str, problems: &mu
 }
 
 /// A flow table with the abscissa `key` (the other one absent), in SI (x scaled by `x_si`).
-fn flow_curve(t: &Option<FlowTable>, key: &str, x_si: f64, path: &str, problems: &mut Problems) -> Option<Curve> {
+fn flow_curve(
+    t: &Option<FlowTable>,
+    key: &str,
+    x_si: f64,
+    path: &str,
+    problems: &mut Problems,
+) -> Option<Curve> {
     let Some(t) = t else {
-        problems.push(format!("{path}.flow"), "", format!("required: {{ {key} = […], l_per_min = […] }}"));
+        problems.push(
+            format!("{path}.flow"),
+            "",
+            format!("required: {{ {key} = […], l_per_min = […] }}"),
+        );
         return None;
     };
     let (x, other) = match key {
@@ -369,7 +395,11 @@ fn source(s: &SourceSpec, p: &str, names: &CircuitNames<'_>, problems: &mut Prob
     });
     let unused = |key: &str, set: bool, problems: &mut Problems| {
         if set {
-            problems.push(format!("{p}.{key}"), "", format!("not used by kind {}", q(s.kind.name())));
+            problems.push(
+                format!("{p}.{key}"),
+                "",
+                format!("not used by kind {}", q(s.kind.name())),
+            );
         }
     };
     let kind = match s.kind {
@@ -435,7 +465,11 @@ fn zero_curve() -> Curve {
 fn position(list: &[&str], name: &str, path: &str, what: &str, problems: &mut Problems) -> Option<usize> {
     let r = list.iter().position(|n| *n == name);
     if r.is_none() {
-        problems.push(path, q(name), format!("unknown {what}; defined: {}", list_or_none(list)));
+        problems.push(
+            path,
+            q(name),
+            format!("unknown {what}; defined: {}", list_or_none(list)),
+        );
     }
     r
 }
@@ -472,7 +506,10 @@ fn consumer(
             problems.push(
                 format!("{p}.node"),
                 q(n),
-                format!("unknown thermal node; nodes: {}", list(names.nodes.iter().copied())),
+                format!(
+                    "unknown thermal node; nodes: {}",
+                    list(names.nodes.iter().copied())
+                ),
             );
         }
     }
@@ -495,24 +532,28 @@ fn split(c: &ConsumerSpec, p: &str, problems: &mut Problems) -> Option<Split> {
             if c.discharge_coefficient.is_some() {
                 problems.push(format!("{p}.discharge_coefficient"), "", "only with orifice_mm");
             }
-            (s > 0.0 && s <= 1.0)
-                .then_some(Split::Share(s))
-                .or_else(|| {
-                    problems.push(format!("{p}.share"), s, "must lie in (0, 1]");
-                    None
-                })
+            (s > 0.0 && s <= 1.0).then_some(Split::Share(s)).or_else(|| {
+                problems.push(format!("{p}.share"), s, "must lie in (0, 1]");
+                None
+            })
         }
         (None, Some(d)) => {
             let ok = problems.in_range(&format!("{p}.orifice_mm"), d, 0.05, 50.0, " mm");
             let cd = c.discharge_coefficient;
             match cd {
-                Some(cd) if problems.in_range(&format!("{p}.discharge_coefficient"), cd, 0.1, 1.0, "") && ok => {
+                Some(cd)
+                    if problems.in_range(&format!("{p}.discharge_coefficient"), cd, 0.1, 1.0, "") && ok =>
+                {
                     let r = 0.5 * d * MM;
                     Some(Split::Orifice(cd * std::f64::consts::PI * r * r))
                 }
                 Some(_) => None,
                 None => {
-                    problems.push(format!("{p}.discharge_coefficient"), "", "required with orifice_mm");
+                    problems.push(
+                        format!("{p}.discharge_coefficient"),
+                        "",
+                        "required with orifice_mm",
+                    );
                     None
                 }
             }
@@ -530,14 +571,35 @@ fn target(c: &ConsumerSpec, p: &str, names: &CircuitNames<'_>, problems: &mut Pr
     let kind = c.kind;
     let only = |key: &str, set: bool, allowed: &[ConsumerKindChoice], problems: &mut Problems| {
         if set && !allowed.contains(&kind) {
-            problems.push(format!("{p}.{key}"), "", format!("not used by kind {}", q(kind.name())));
+            problems.push(
+                format!("{p}.{key}"),
+                "",
+                format!("not used by kind {}", q(kind.name())),
+            );
         }
     };
-    only("jet_speed_m_s", c.jet_speed_m_s.is_some(), &[ConsumerKindChoice::Jet], problems);
-    only("jet_angle_deg", c.jet_angle_deg.is_some(), &[ConsumerKindChoice::Jet], problems);
-    only("fling_radius_mm", c.fling_radius_mm.is_some(), &[ConsumerKindChoice::Set], problems);
+    only(
+        "jet_speed_m_s",
+        c.jet_speed_m_s.is_some(),
+        &[ConsumerKindChoice::Jet],
+        problems,
+    );
+    only(
+        "jet_angle_deg",
+        c.jet_angle_deg.is_some(),
+        &[ConsumerKindChoice::Jet],
+        problems,
+    );
+    only(
+        "fling_radius_mm",
+        c.fling_radius_mm.is_some(),
+        &[ConsumerKindChoice::Set],
+        problems,
+    );
     match kind {
-        ConsumerKindChoice::Mesh => position(&names.meshes, &c.target, &tp, "mesh", problems).map(Target::Mesh),
+        ConsumerKindChoice::Mesh => {
+            position(&names.meshes, &c.target, &tp, "mesh", problems).map(Target::Mesh)
+        }
         ConsumerKindChoice::Jet => {
             let mesh = position(&names.meshes, &c.target, &tp, "mesh", problems);
             let speed = c.jet_speed_m_s;
@@ -563,9 +625,14 @@ fn target(c: &ConsumerSpec, p: &str, names: &CircuitNames<'_>, problems: &mut Pr
                 fling_radius: r.map(|r| r * MM),
             })
         }
-        ConsumerKindChoice::ClutchPack => {
-            position(&names.packs, &c.target, &tp, "clutch pack (by shift element)", problems).map(Target::ClutchPack)
-        }
+        ConsumerKindChoice::ClutchPack => position(
+            &names.packs,
+            &c.target,
+            &tp,
+            "clutch pack (by shift element)",
+            problems,
+        )
+        .map(Target::ClutchPack),
         ConsumerKindChoice::Bearing => {
             position(&names.bearings, &c.target, &tp, "bearing", problems).map(Target::Bearing)
         }
@@ -584,7 +651,10 @@ fn check_splits(spec: &CircuitSpec, consumers: &[Option<Consumer>], problems: &m
                 Split::Orifice(_) => None,
             })
             .sum();
-        let orifices = mine.iter().filter(|c| matches!(c.split, Split::Orifice(_))).count();
+        let orifices = mine
+            .iter()
+            .filter(|c| matches!(c.split, Split::Orifice(_)))
+            .count();
         let p = format!("circuit.sources[{si}]");
         if orifices > 0 && orifices < mine.len() {
             problems.push(
@@ -594,10 +664,18 @@ fn check_splits(spec: &CircuitSpec, consumers: &[Option<Consumer>], problems: &m
             );
         }
         if shares > 1.0 + 1e-9 {
-            problems.push(p.clone(), shares, "the shares of its consumers must sum to at most 1");
+            problems.push(
+                p.clone(),
+                shares,
+                "the shares of its consumers must sum to at most 1",
+            );
         }
         if orifices > 0 && s.pressure_bar.is_none() && s.kind != SourceKindChoice::Pump {
-            problems.push(format!("{p}.pressure_bar"), "", "required: its consumers have orifices");
+            problems.push(
+                format!("{p}.pressure_bar"),
+                "",
+                "required: its consumers have orifices",
+            );
         }
     }
     let mut packs = BTreeSet::new();

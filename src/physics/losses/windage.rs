@@ -36,13 +36,14 @@ pub struct GearWindage {
 impl GearWindage {
     /// Build the windage model `model` (Seetharaman or Stavytskyi; their coefficients from
     /// `config`) of `gear`; its immersion is replaced by full immersion.
-    pub fn new(model: ChurningModel, config: &ChurningConfig, gear: &ChurningGear) -> Result<Self, ChurningError> {
+    pub fn new(
+        model: ChurningModel,
+        config: &ChurningConfig,
+        gear: &ChurningGear,
+    ) -> Result<Self, ChurningError> {
         let mut g = *gear;
         g.immersion_depth = 2.0 * g.tip_radius;
-        let cfg = ChurningConfig {
-            model,
-            ..*config
-        };
+        let cfg = ChurningConfig { model, ..*config };
         Ok(GearWindage {
             model: GearChurning::new(&cfg, &g)?,
         })
@@ -109,7 +110,10 @@ mod tests {
             model: ChurningModel::Seetharaman,
             ..ChurningConfig::default()
         };
-        let churn = GearChurning::new(&cfg_s, &full).unwrap().power(w(3000.0), &oil).total;
+        let churn = GearChurning::new(&cfg_s, &full)
+            .unwrap()
+            .power(w(3000.0), &oil)
+            .total;
         assert!(churn > 100.0 * a);
     }
 }

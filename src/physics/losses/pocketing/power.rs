@@ -159,7 +159,11 @@ mod tests {
         let m = PocketingMesh::new(&cases::fzg_c(), 0.65).unwrap();
         let dv = 14.0 * ((68.30 - 5.723) + (68.33 - 5.635)) * 1e-9;
         let expect = 16.0 * dv / (2.0 * PI);
-        assert!((m.swept_flow(-1.0) / expect - 1.0).abs() < 2e-4, "{}", m.swept_flow(1.0) / expect);
+        assert!(
+            (m.swept_flow(-1.0) / expect - 1.0).abs() < 2e-4,
+            "{}",
+            m.swept_flow(1.0) / expect
+        );
     }
 
     #[test]
