@@ -256,3 +256,35 @@ discharge_coefficient = 0.7
     assert!((drive - supply * 2e5 / 0.5).abs() < 1e-9 * drive);
     assert!(sc.items.iter().any(|i| i.name == "e_pump" && i.engine_side));
 }
+
+#[test]
+fn the_advection_links_carry_the_oil_nodes_specific_heat() {
+    // Same sump capacity (7.6 kg × 2000 J/kgK), c_p doubled: every advection conductance ṁ c_p
+    // doubles, so the fed set node settles closer to the oil; with c_p as a constant it would not
+    // move at all.
+    let gap = |ovs: &[&str]| {
+        let ovs: Vec<model::Override> = ovs.iter().map(|s| s.parse().unwrap()).collect();
+        let gb = model::load_with(Path::new(AT6), &ovs).unwrap();
+        let sc = Scene::compile(&gb).unwrap();
+        let inp = Inputs {
+            state: gb.state_index("4").unwrap(),
+            input_speed: 2400.0 * std::f64::consts::PI / 30.0,
+            input_torque: 150.0,
+            vehicle_speed: 15.0,
+        };
+        let eq = equilibrium(&sc, inp, None, &SteadyOptions::default()).unwrap();
+        let t = &eq.solution.temperatures;
+        let set = sc.thermal.names.iter().position(|n| n == "ravigneaux").unwrap();
+        t[set] - t[sc.thermal.oil]
+    };
+    let base = gap(&[]);
+    let doubled = gap(&[
+        "thermal.nodes[\"sump\"].mass_kg = 3.8",
+        "thermal.nodes[\"sump\"].cp_j_per_kgk = 4000.0",
+    ]);
+    println!("ravigneaux − oil: {base:.4} K at c_p 2000, {doubled:.4} K at c_p 4000");
+    assert!(
+        base > 0.0 && doubled > 0.0 && doubled < 0.9 * base,
+        "{base} {doubled}"
+    );
+}

@@ -160,6 +160,9 @@ pub struct ThermalScene {
     radiation: Vec<Radiation>,
     coolers: Vec<CoolerTerm>,
     oil_model: Oil,
+    /// c_p of the oil carried by the advection links, J/(kg·K): the oil node's `cp_j_per_kgk`,
+    /// else [`OIL_SPECIFIC_HEAT`] (a node given by its capacity alone states no c_p).
+    advection_cp: f64,
 }
 
 /// Buffers and per-sample values of the network (one per solver; no allocation when used).
@@ -413,6 +416,7 @@ impl ThermalScene {
             radiation: links.radiation,
             coolers: cooler_terms(net),
             oil_model: gb.oil.clone(),
+            advection_cp: net.nodes[net.oil_node].specific_heat.unwrap_or(OIL_SPECIFIC_HEAT),
             fixed_partials: Vec::new(),
         };
         let mut fixed_partials = Vec::new();
@@ -591,8 +595,8 @@ impl ThermalScene {
                     (area * h, area * dh)
                 }
                 OilLaw::Advection { consumer } => (
-                    mdot[*consumer] * OIL_SPECIFIC_HEAT,
-                    dmdot[*consumer] * OIL_SPECIFIC_HEAT,
+                    mdot[*consumer] * self.advection_cp,
+                    dmdot[*consumer] * self.advection_cp,
                 ),
             };
         }

@@ -44,6 +44,8 @@ pub struct ThermalNode {
     pub capacity: f64,
     /// Initial temperature, K (None: the network's default).
     pub initial_temp: Option<f64>,
+    /// Specific heat c_p, J/(kg·K), when the node is given as `mass_kg` × `cp_j_per_kgk`.
+    pub specific_heat: Option<f64>,
     /// Gear indices whose bodies this node lumps.
     pub gears: Vec<usize>,
 }
@@ -82,6 +84,7 @@ pub(crate) fn check_nodes(
             name: n.name.clone(),
             capacity,
             initial_temp: n.initial_temp_c.map(|t| t + KELVIN_OFFSET),
+            specific_heat: n.cp_j_per_kgk,
             gears: gi,
         });
     }

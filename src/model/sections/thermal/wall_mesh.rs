@@ -167,6 +167,7 @@ pub fn mesh_wall(mut net: ThermalNetwork, spec: &WallMeshSpec, problems: &mut Pr
         name: patch_name(&base.name, i, j),
         capacity: base.capacity * scale,
         initial_temp: base.initial_temp,
+        specific_heat: base.specific_heat,
         gears: Vec::new(),
     };
     // Patch (0, 0) takes the node's index (other indices stay valid); the rest are appended.
