@@ -587,6 +587,15 @@ fn study_commands(spec: &str, text: String, file: &str) -> PyResult<Vec<String>>
     Ok(s.cases().iter().map(|c| s.command_line(c)).collect())
 }
 
+/// The loss sources in output order (the order of every per-source column and key).
+#[pyfunction]
+fn sources() -> Vec<&'static str> {
+    geartherm::model::source::Source::ALL
+        .iter()
+        .map(|s| s.as_str())
+        .collect()
+}
+
 /// Version of the geartherm library this binding was built with.
 #[pyfunction]
 fn version() -> &'static str {
@@ -608,5 +617,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(oils, m)?)?;
     m.add_function(wrap_pyfunction!(cycles, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
+    m.add_function(wrap_pyfunction!(sources, m)?)?;
     Ok(())
 }

@@ -324,6 +324,11 @@ pub(super) fn compile_windage(
     let cfg = gb.losses.churning.unwrap_or_default();
     for (gi, g) in gb.gears.iter().enumerate() {
         if g.is_immersed() {
+            // Listed, so that its column stays when an override lowers the oil below it.
+            lists.skipped.push(Skipped {
+                what: format!("windage of gear {}", g.name),
+                why: "dips in the oil (its churning is counted)".into(),
+            });
             continue;
         }
         // A gear on a member the housing holds never turns (nor does it in any state of the model).

@@ -59,7 +59,7 @@ __all__ = [
 __version__ = _native.version()
 
 #: The loss sources, in the order of every per-source column and key.
-SOURCES = ("churning", "pocketing", "sliding", "bearing", "seal", "clutch_drag", "pump", "converter")
+SOURCES = tuple(_native.sources())
 
 #: Solvers of :meth:`Model.run`.
 SOLVERS = ("auto", "ros3", "tr-bdf2", "esdirk34", "bdf", "tsit45")
