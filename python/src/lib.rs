@@ -238,7 +238,9 @@ impl Model {
     fn map(&self, py: Python<'_>, options: &Bound<'_, PyAny>) -> PyResult<String> {
         let o: MapOptions = self::options("map", options)?;
         let m = self.m.clone();
-        let r = py.detach(|| job::map::map(&m, &o, &|| {})).map_err(job_error)?;
+        let r = py
+            .detach(|| in_process_pool(|| job::map::map(&m, &o, &|| {})))
+            .map_err(job_error)?;
         Ok(r.csv)
     }
 
@@ -247,7 +249,7 @@ impl Model {
         let o: RatingOptions = self::options("rating", options)?;
         let m = self.m.clone();
         let r = py
-            .detach(|| job::rating::rating(&m, &o, &|| {}))
+            .detach(|| in_process_pool(|| job::rating::rating(&m, &o, &|| {})))
             .map_err(job_error)?;
         to_json(&r)
     }
@@ -280,7 +282,7 @@ impl Model {
             .map_err(|e| job_error(JobError::invalid(e.to_string())))?;
         let (m, text) = (self.m.clone(), self.state.text.clone());
         let r = py
-            .detach(|| job::calibrate::calibrate(&m, &text, &trace, &o))
+            .detach(|| in_process_pool(|| job::calibrate::calibrate(&m, &text, &trace, &o)))
             .map_err(job_error)?;
         Ok((to_json(&r.summary)?, r.fit_csv, r.calibrated_model, r.cycle_csv))
     }
@@ -377,7 +379,37 @@ fn in_pool<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> 
             .build()
             .map_err(|e| e.to_string())?
             .install(work)),
-        None => Ok(work()),
+        None => Ok(in_process_pool(work)),
+    }
+}
+
+/// This process's rayon pool. rayon's global pool does not survive a fork: a child forked (a
+/// `multiprocessing` pool's default on Linux) from a process whose global pool had started
+/// inherits a registry whose threads do not exist, and its first parallel call waits forever.
+/// Every parallel call of the binding runs in this pool instead, built again in a forked child
+/// (the parent's copy is leaked there: dropping it would signal threads that do not exist).
+fn process_pool() -> Option<Arc<rayon::ThreadPool>> {
+    static POOL: Mutex<Option<(u32, Arc<rayon::ThreadPool>)>> = Mutex::new(None);
+    let pid = std::process::id();
+    let mut slot = POOL.lock().unwrap_or_else(|e| e.into_inner());
+    match slot.take() {
+        Some((p, pool)) if p == pid => {
+            *slot = Some((p, pool.clone()));
+            return Some(pool);
+        }
+        Some(inherited) => std::mem::forget(inherited),
+        None => {}
+    }
+    let pool = Arc::new(rayon::ThreadPoolBuilder::new().build().ok()?);
+    *slot = Some((pid, pool.clone()));
+    Some(pool)
+}
+
+/// `work` in [`process_pool`] (on the calling thread when no pool can be built).
+fn in_process_pool<T: Send>(work: impl FnOnce() -> T + Send) -> T {
+    match process_pool() {
+        Some(pool) => pool.install(work),
+        None => work(),
     }
 }
 

@@ -27,6 +27,24 @@ def _frozen_solve(path):
     geartherm.Model.load(path).run(cycle="wltc", frozen_viscosity_c=0.0, summary_only=True)
 
 
+def _child_map(path):
+    m = geartherm.Model.load(path).map(gear="1", speed_rpm=[1000.0, 2000.0], torque_nm=[10.0, 50.0])
+    return len(m)
+
+
+@pytest.mark.parametrize("method", ["fork", "spawn", "forkserver"])
+def test_parallel_jobs_run_in_a_pool_forked_after_a_parallel_call(method):
+    # A forked child inherits rayon's pool without its threads: its first parallel call (a map,
+    # a rating, a study) waited forever when the parent had made one before the fork.
+    import multiprocessing as mp
+
+    here = geartherm.Model.load(FZG).map(gear="1", speed_rpm=[1000.0, 3000.0], torque_nm=[10.0, 50.0])
+    with cf.ProcessPoolExecutor(1, mp_context=mp.get_context(method)) as pool:
+        assert pool.submit(_child_map, str(FZG)).result(timeout=60) == len(here) == 4
+        r = pool.submit(_child_map, str(FZG)).result(timeout=60)
+        assert r == 4
+
+
 def test_errors_cross_a_process_pool_with_their_class_and_key_path():
     with pytest.raises(geartherm.ModelError) as here:
         _bad_override(str(FZG))

@@ -31,6 +31,13 @@ fn log_label(v: f64) -> String {
 /// Tick values for a log axis over [lo, hi]: 1, 2, 5 × 10^k over narrow ranges, decades (or every
 /// n-th decade) over wide ones; and the remaining 1..9 × 10^k as light grid lines.
 pub fn log_ticks(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
+    // Held to the positive finite doubles: 0 would start the decades at i32::MIN.
+    let lo = if lo > 0.0 {
+        lo.min(f64::MAX)
+    } else {
+        f64::MIN_POSITIVE
+    };
+    let hi = if hi.is_finite() { hi.max(lo) } else { f64::MAX };
     let (k0, k1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
     let decades = (hi / lo).log10();
     let mults: &[f64] = if decades <= 2.5 { &[1.0, 2.0, 5.0] } else { &[1.0] };
@@ -68,7 +75,8 @@ fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     } else {
         (hi / lo).powf(0.06).max(1.15)
     };
-    (lo / f, hi * f)
+    // Within the normal doubles: a padded 1e-308 would underflow to 0.
+    ((lo / f).max(f64::MIN_POSITIVE), (hi * f).min(f64::MAX))
 }
 
 /// True for a row with a positive finite error and wall time (drawn on the log–log axes).
@@ -262,4 +270,31 @@ fn draw_rtol_labels(chart: &LogChart, placed: Placement) -> DrawResult {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A wall time of 1e-308 (a crafted bench.csv) padded to 0 made the decades start at
+    /// i32::MIN and the light ticks fill memory; the axis now stays within the doubles.
+    #[test]
+    fn log_axes_of_extreme_values_stay_bounded() {
+        let (lo, hi) = log_range([1e-308, 3.6e-5, 1.2e29].into_iter());
+        assert!(lo > 0.0 && hi.is_finite(), "{lo} {hi}");
+        for (a, b) in [
+            (lo, hi),
+            (0.0, 1e-4),
+            (f64::MIN_POSITIVE, f64::MAX),
+            (1e-4, f64::INFINITY),
+        ] {
+            let (keys, light) = log_ticks(a, b);
+            assert!(
+                keys.len() + light.len() < 10 * 640,
+                "{a} {b}: {}",
+                keys.len() + light.len()
+            );
+            assert!(keys.iter().chain(&light).all(|v| v.is_finite() && *v > 0.0));
+        }
+    }
 }
