@@ -190,6 +190,24 @@ def test_a_model_error_crosses_a_dask_cluster_with_its_key_path():
     assert e.value.path == "thermal.coolers[0].effectiveness"
 
 
+def test_a_model_error_crosses_a_ray_task_with_its_key_path():
+    ray = pytest.importorskip("ray")
+    ray.init(num_cpus=1, include_dashboard=False, log_to_driver=False, ignore_reinit_error=True)
+    try:
+        # A lambda travels by value (this test module is not importable on Ray's workers).
+        task = ray.remote(lambda path, bad: geartherm.Model.load(path).override(bad))
+        # Ray re-raises a task's exception as a class deriving from both RayTaskError and the
+        # task's own class, the original (unpickled) object in `.cause`.
+        with pytest.raises(geartherm.ModelError) as e:
+            ray.get(task.remote(str(AT6), BAD), timeout=120)
+        cause = getattr(e.value, "cause", e.value)
+        assert isinstance(cause, geartherm.ModelError)
+        assert cause.path == "thermal.coolers[0].effectiveness"
+        assert cause.value and cause.allowed and cause.problems
+    finally:
+        ray.shutdown()
+
+
 def test_exceptions_pickle_with_their_fields_and_are_python_types(tmp_path):
     with pytest.raises(geartherm.ModelError) as e:
         geartherm.Model.load(AT6).override(BAD)
