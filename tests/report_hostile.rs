@@ -88,3 +88,39 @@ fn the_report_grid_bound_is_the_map_point_bound() {
         geartherm::job::limits::MAX_MAP_POINTS
     );
 }
+
+/// A run directory whose `time_s` jumps back to -1e308: `report` never ended (the time axis
+/// spanned 1e308). Times must increase from row to row and stay within ±1e300 s.
+#[test]
+fn a_time_column_that_does_not_increase_is_invalid_input() {
+    let d = tempfile::tempdir().unwrap();
+    let run = d.path().join("r");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let o = Command::new(env!("CARGO_BIN_EXE_geartherm"))
+        .args([
+            "run",
+            "models/fzg_c.toml",
+            "--cycle",
+            "tests/data/rig_short.csv",
+            "--quiet",
+            "--out",
+        ])
+        .arg(&run)
+        .current_dir(root)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(run.join("timeseries.csv")).unwrap();
+    for (row, time) in [(3, "-1e+308"), (1, "1e308"), (2, "0")] {
+        let edited: Vec<String> = text
+            .lines()
+            .enumerate()
+            .map(|(k, l)| match (k == row, l.split_once(',')) {
+                (true, Some((_, rest))) => format!("{time},{rest}"),
+                _ => l.to_string(),
+            })
+            .collect();
+        std::fs::write(run.join("timeseries.csv"), edited.join("\n") + "\n").unwrap();
+        report_refuses(&run, "column `time_s`");
+    }
+}

@@ -111,9 +111,27 @@ fn oversized_map_jobs_and_case_counts_are_refused() {
 fn a_plan_with_too_many_sampled_values_is_refused() {
     let d = tempfile::tempdir().unwrap();
     let mut text = HEAD.replace("NAME", "s") + STEADY + "[sampling]\nplan = \"lhs\"\ncases = 10000000\n";
-    for _ in 0..64 {
-        text += "[[parameters]]\npath = \"thermal.initial_temp_c\"\nrange = [20.0, 30.0]\n";
+    // 64 distinct key paths (each path once; the count is refused before any is looked up).
+    for k in 0..64 {
+        text += &format!("[[parameters]]\npath = \"thermal.p{k}\"\nrange = [20.0, 30.0]\n");
     }
     let o = study(d.path(), &text, &["--list"]);
     refused(&o, "10000000 samples × 64 parameters");
+}
+
+/// `oil.catalogue` varied by two parameters (numbers, then names) ran, and the figures'
+/// colour key took a text parameter without text values and panicked (exit 101).
+#[test]
+fn a_key_path_varied_twice_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let twice =
+        "[sampling]\nplan = \"list\"\n[[parameters]]\npath = \"oil.catalogue\"\nvalues = [1.0, 1.0]\n\
+                 [[parameters]]\npath = \"oil.catalogue\"\nvalues = [\"fva_3a\", \"w326\"]\n";
+    let o = study(
+        d.path(),
+        &(HEAD.replace("NAME", "s") + STEADY + twice),
+        &["--out", "o"],
+    );
+    refused(&o, "parameters[1].path `oil.catalogue`: given twice");
+    assert!(!d.path().join("o").exists());
 }

@@ -45,6 +45,22 @@ def test_parallel_jobs_run_in_a_pool_forked_after_a_parallel_call(method):
         assert r == 4
 
 
+def _bad_frame_run(path):
+    try:
+        geartherm.Model.load(path).run(cycle=pd.DataFrame({"a": [0.0, 1.0]}))
+    except geartherm.InputError as e:
+        return str(e)
+
+
+def test_a_dataframe_cycle_is_named_as_such_not_by_a_temporary_file():
+    # The message named a temporary CSV (/tmp/geartherm-cycle-…/dataframe.csv), gone after the
+    # call and different in every process.
+    here = _bad_frame_run(str(FZG))
+    assert here.startswith("cycle: DataFrame, line 1: column a: unknown column"), here
+    with cf.ProcessPoolExecutor(1) as pool:
+        assert pool.submit(_bad_frame_run, str(FZG)).result(timeout=60) == here
+
+
 def test_errors_cross_a_process_pool_with_their_class_and_key_path():
     with pytest.raises(geartherm.ModelError) as here:
         _bad_override(str(FZG))

@@ -69,6 +69,7 @@ impl RunArgs {
     pub fn options(&self) -> RunOptions {
         RunOptions {
             cycle: self.cycle.clone(),
+            cycle_text: None,
             solver: self.solver.clone(),
             rtol: self.rtol,
             atol: self.atol,

@@ -45,6 +45,7 @@ fn run_options_round_trip() {
         RunOptions::default(),
         RunOptions {
             cycle: "my cycles/rig 1.csv".into(),
+            cycle_text: None,
             solver: "tr-bdf2".into(),
             rtol: 1.2345678901234e-7,
             atol: 3e-9,

@@ -29,8 +29,13 @@ pub const DEFAULT_MAX_STEPS: usize = 5_000_000;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct RunOptions {
-    /// Bundled cycle name or a CSV file (vehicle or rig cycle).
+    /// Bundled cycle name or a CSV file (vehicle or rig cycle); with `cycle_text`, the name the
+    /// cycle goes by in messages and the summary.
     pub cycle: String,
+    /// The cycle's CSV text, parsed instead of reading `cycle` (a DataFrame from Python, whose
+    /// messages then name `cycle`, not a temporary file); not part of a command line.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cycle_text: Option<String>,
     /// Solver name (auto, ros3, tr-bdf2, esdirk34, bdf, tsit45).
     pub solver: String,
     /// Relative tolerance.
@@ -56,6 +61,7 @@ impl Default for RunOptions {
     fn default() -> Self {
         RunOptions {
             cycle: "wltc".into(),
+            cycle_text: None,
             solver: DEFAULT_METHOD.name().into(),
             rtol: DEFAULT_RTOL,
             atol: DEFAULT_ATOL,
@@ -131,7 +137,10 @@ pub fn prepare(m: &Model, o: &RunOptions) -> Result<Prepared, JobError> {
     let oil = OilRange::of(&m.gearbox.oil);
     oil.check_option_opt(&limits::INITIAL_TEMP_C, o.initial_temp_c)?;
     oil.check_option_opt(&limits::FROZEN_VISCOSITY_C, o.frozen_viscosity_c)?;
-    let cycle = DriveCycle::resolve(&o.cycle)?;
+    let cycle = match &o.cycle_text {
+        Some(text) => DriveCycle::parse(text, &o.cycle)?,
+        None => DriveCycle::resolve(&o.cycle)?,
+    };
     let (sched, segs) =
         segments(&m.gearbox, &cycle).map_err(|e| JobError::invalid(format!("{}: {e}", m.label())))?;
     // Scene pruning: only the gear states this cycle visits, only the outputs asked for.

@@ -68,8 +68,14 @@ pub fn read_journals(dir: &Path, fingerprint: &str) -> std::io::Result<BTreeMap<
         .collect();
     files.sort();
     for f in files {
-        let mut lines = BufReader::new(File::open(&f)?).lines();
-        let Some(Ok(head)) = lines.next() else { continue };
+        let mut reader = BufReader::new(File::open(&f)?);
+        let mut head = String::new();
+        // A header without its newline is being written by a writer that has just created
+        // the journal (another shard starting at the same time): it holds no rows yet.
+        if reader.read_line(&mut head).is_err() || !head.ends_with('\n') {
+            continue;
+        }
+        let lines = reader.lines();
         let head: serde_json::Value = serde_json::from_str(&head).unwrap_or_default();
         if head.get("study").and_then(|s| s.as_str()) != Some(fingerprint) {
             return Err(std::io::Error::new(
@@ -338,6 +344,24 @@ pub fn study_parquet(t: &Table) -> parquet::errors::Result<Vec<u8>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Two shards starting at once: one reads the other's journal while its header is being
+    /// written (seen by the hostile campaign as "belongs to a different study", exit 1).
+    #[test]
+    fn a_journal_whose_header_is_being_written_holds_no_rows_yet() {
+        let dir = tempfile::tempdir().unwrap();
+        let fp = "0123456789abcdef";
+        let full = format!("{}\n", serde_json::json!({ "study": fp }));
+        std::fs::write(dir.path().join("journal.shard-1-of-2.jsonl"), &full[..9]).unwrap();
+        assert!(read_journals(dir.path(), fp).unwrap().is_empty());
+        std::fs::write(dir.path().join("journal.shard-1-of-2.jsonl"), &full).unwrap();
+        assert!(read_journals(dir.path(), fp).unwrap().is_empty());
+        // A complete header of another study is still refused.
+        let other = format!("{}\n", serde_json::json!({ "study": "fedcba9876543210" }));
+        std::fs::write(dir.path().join("journal.shard-1-of-2.jsonl"), other).unwrap();
+        let e = read_journals(dir.path(), fp).unwrap_err().to_string();
+        assert!(e.contains("belongs to a different study"), "{e}");
+    }
 
     fn row(i: usize, ok: bool) -> CaseRow {
         CaseRow {

@@ -357,6 +357,12 @@ impl Study {
                 .path
                 .parse()
                 .map_err(|e| invalid(format!("parameters[{k}].path `{}`: {e}", p.path)))?;
+            if let Some(j) = paths.iter().position(|q| *q == path) {
+                return Err(invalid(format!(
+                    "parameters[{k}].path `{}`: given twice (parameters[{j}] varies it already); each key path once",
+                    p.path
+                )));
+            }
             paths.push(path);
         }
         let samples = plan::samples(&spec.parameters, &spec.sampling).map_err(invalid)?;

@@ -25,7 +25,6 @@ from __future__ import annotations
 import json
 import math
 import os
-import tempfile
 from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Union
 
 from . import _native
@@ -133,22 +132,15 @@ def cycles():
     return pd.DataFrame.from_records(json.loads(_native.cycles()))
 
 
-def _cycle_arg(cycle: Any, tmp: List[str]) -> str:
-    """A cycle name, CSV path, or DataFrame (written to a temporary CSV with its columns as
-    they are: ``time_s`` and ``speed_kmh``, or a rig cycle's columns)."""
+def _cycle_options(cycle: Any) -> Dict[str, Any]:
+    """A cycle name or CSV path as ``cycle``; a DataFrame (pandas or polars, its columns as they
+    are: ``time_s`` and ``speed_kmh``, or a rig cycle's columns) as CSV text in ``cycle_text``,
+    named ``DataFrame`` in messages and the summary."""
     if hasattr(cycle, "to_csv"):
-        d = tempfile.mkdtemp(prefix="geartherm-cycle-")
-        tmp.append(d)
-        path = os.path.join(d, "dataframe.csv")
-        cycle.to_csv(path, index=False)
-        return path
+        return {"cycle": "DataFrame", "cycle_text": cycle.to_csv(index=False)}
     if hasattr(cycle, "write_csv"):  # polars
-        d = tempfile.mkdtemp(prefix="geartherm-cycle-")
-        tmp.append(d)
-        path = os.path.join(d, "dataframe.csv")
-        cycle.write_csv(path)
-        return path
-    return os.fspath(cycle)
+        return {"cycle": "DataFrame", "cycle_text": cycle.write_csv()}
+    return {"cycle": os.fspath(cycle)}
 
 
 # --- calibrate -------------------------------------------------------------------------------
@@ -517,9 +509,8 @@ class Model:
         SolveError
             A numerical failure (the message names the time, node or loss item).
         """
-        tmp: List[str] = []
         o: Dict[str, Any] = {
-            "cycle": _cycle_arg(cycle, tmp),
+            **_cycle_options(cycle),
             "solver": solver,
             "summary_only": bool(summary_only),
             "evaluate_all": bool(evaluate_all),
@@ -530,13 +521,7 @@ class Model:
                 o[k] = v
         o["initial_temp_c"] = initial_temp_c
         o["ambient_c"] = ambient_c
-        try:
-            summary, csv = self._m.run(o)
-        finally:
-            for d in tmp:
-                import shutil
-
-                shutil.rmtree(d, ignore_errors=True)
+        summary, csv = self._m.run(o)
         r = RunResult(summary, csv)
         _warn_ranges(r.summary.get("warnings"))
         return r

@@ -204,7 +204,24 @@ pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
                 ),
             })
         };
-        ts.time_s.push(num(c_time)?);
+        let t = num(c_time)?;
+        let prev = ts.time_s.last().copied().unwrap_or(f64::NEG_INFINITY);
+        // A run writes one row per sample, at increasing times (the axis and the energy weights
+        // rest on it).
+        {
+            if !(t > prev) || t.abs() > MAX_AXIS_VALUE {
+                return Err(PlotError::Csv {
+                    path: path.to_path_buf(),
+                    msg: format!(
+                        "line {line}, column `time_s`: {} does not follow {} (times increase \
+                         from row to row, |time| ≤ {MAX_AXIS_VALUE:e} s)",
+                        number(t),
+                        number(prev)
+                    ),
+                });
+            }
+        }
+        ts.time_s.push(t);
         ts.vehicle_speed_kmh.push(num(c_speed)?);
         ts.gear.push(record.get(c_gear).unwrap_or("").to_string());
         for (k, &c) in temp_cols.iter().enumerate() {

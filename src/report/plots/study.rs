@@ -52,6 +52,8 @@ impl ColourKey {
     fn of(t: &Table) -> ColourKey {
         let param = t.params.iter().find(|(_, text)| *text).map(|(k, _)| k.clone());
         let cats = param.as_deref().map_or_else(Vec::new, |p| categories(t, p));
+        // A text parameter without a text value among the rows colours nothing.
+        let param = param.filter(|_| !cats.is_empty());
         ColourKey { param, cats }
     }
 
