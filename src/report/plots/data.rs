@@ -209,7 +209,8 @@ pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
         // A run writes one row per sample, at increasing times (the axis and the energy weights
         // rest on it).
         {
-            if !(t > prev) || t.abs() > MAX_AXIS_VALUE {
+            let increases = t.partial_cmp(&prev) == Some(std::cmp::Ordering::Greater);
+            if !increases || t.abs() > MAX_AXIS_VALUE {
                 return Err(PlotError::Csv {
                     path: path.to_path_buf(),
                     msg: format!(
