@@ -205,6 +205,7 @@ pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
             })
         };
         let t = num(c_time)?;
+        let speed = num(c_speed)?;
         let prev = ts.time_s.last().copied().unwrap_or(f64::NEG_INFINITY);
         // A run writes one row per sample, at increasing times (the axis and the energy weights
         // rest on it).
@@ -223,7 +224,7 @@ pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
             }
         }
         ts.time_s.push(t);
-        ts.vehicle_speed_kmh.push(num(c_speed)?);
+        ts.vehicle_speed_kmh.push(speed);
         ts.gear.push(record.get(c_gear).unwrap_or("").to_string());
         for (k, &c) in temp_cols.iter().enumerate() {
             let v = num(c)?;
