@@ -288,3 +288,13 @@ fn the_advection_links_carry_the_oil_nodes_specific_heat() {
         "{base} {doubled}"
     );
 }
+
+#[test]
+fn an_electric_pump_cannot_take_the_pumps_item_name() {
+    // An electric pump named `pump` beside a [pump] would give two items pump:pump.
+    let text = std::fs::read_to_string(AT6).unwrap()
+        + "\n[[circuit.sources]]\nname = \"pump\"\nkind = \"electric_pump\"\npressure_bar = 2.0\n\
+           efficiency = 0.5\nflow = { input_rpm = [0.0, 6000.0], l_per_min = [1.0, 2.0] }\n";
+    let err = model::from_str(&text, Path::new(AT6)).unwrap_err().report();
+    assert!(err.contains(".name") && err.contains("pump:pump"), "{err}");
+}

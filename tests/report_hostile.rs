@@ -1,7 +1,7 @@
-//! Crafted map directories the hostile campaign (family `report`) found `report` could not
-//! survive: a grid value of 1e308 made the heat map's axis infinite (plotters' tick search then
-//! never ends), and n rows of n distinct speeds and torques asked for an n² grid. Each is
-//! invalid input now (exit 1), the directory left byte for byte.
+//! Crafted result directories from the hostile campaign (family `report`): a grid value of 1e308
+//! (an infinite heat-map axis, on which plotters' tick search never ends), n rows of n distinct
+//! speeds and torques (an n² grid), a time column that does not increase. Each is invalid input
+//! (exit 1), the directory left byte for byte.
 
 use std::path::Path;
 use std::process::Command;
@@ -89,8 +89,8 @@ fn the_report_grid_bound_is_the_map_point_bound() {
     );
 }
 
-/// A run directory whose `time_s` jumps back to -1e308: `report` never ended (the time axis
-/// spanned 1e308). Times must increase from row to row and stay within ±1e300 s.
+/// A run directory whose `time_s` jumps back to -1e308 (a time axis spanning 1e308 is never
+/// drawn): times must increase from row to row and stay within ±1e300 s.
 #[test]
 fn a_time_column_that_does_not_increase_is_invalid_input() {
     let d = tempfile::tempdir().unwrap();

@@ -119,8 +119,8 @@ fn a_plan_with_too_many_sampled_values_is_refused() {
     refused(&o, "10000000 samples × 64 parameters");
 }
 
-/// `oil.catalogue` varied by two parameters (numbers, then names) ran, and the figures'
-/// colour key took a text parameter without text values and panicked (exit 101).
+/// `oil.catalogue` varied by two parameters (numbers, then names): refused, each key path once
+/// (such a study's figures had a text parameter without text values to colour by).
 #[test]
 fn a_key_path_varied_twice_is_refused() {
     let d = tempfile::tempdir().unwrap();

@@ -222,7 +222,9 @@ impl Model {
     fn losses(&self, py: Python<'_>, options: &Bound<'_, PyAny>) -> PyResult<String> {
         let o: LossesOptions = self::options("losses", options)?;
         let m = self.m.clone();
-        let r = py.detach(|| job::losses::losses(&m, &o)).map_err(job_error)?;
+        let r = py
+            .detach(|| in_process_pool(|| job::losses::losses(&m, &o)))
+            .map_err(job_error)?;
         to_json(&r)
     }
 
@@ -230,7 +232,9 @@ impl Model {
     fn steady(&self, py: Python<'_>, options: &Bound<'_, PyAny>) -> PyResult<String> {
         let o: SteadyOptions = self::options("steady", options)?;
         let m = self.m.clone();
-        let r = py.detach(|| job::steady::steady(&m, &o)).map_err(job_error)?;
+        let r = py
+            .detach(|| in_process_pool(|| job::steady::steady(&m, &o)))
+            .map_err(job_error)?;
         to_json(&r)
     }
 
@@ -260,7 +264,7 @@ impl Model {
         let o: RunOptions = self::options("run", options)?;
         let m = self.m.clone();
         let r = py
-            .detach(|| job::run::run(&m, &o, &mut |_, _| {}))
+            .detach(|| in_process_pool(|| job::run::run(&m, &o, &mut |_, _| {})))
             .map_err(job_error)?;
         Ok((to_json(&r.summary)?, r.timeseries_csv))
     }
@@ -391,18 +395,28 @@ fn in_pool<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> 
 fn process_pool() -> Option<Arc<rayon::ThreadPool>> {
     static POOL: Mutex<Option<(u32, Arc<rayon::ThreadPool>)>> = Mutex::new(None);
     let pid = std::process::id();
-    let mut slot = POOL.lock().unwrap_or_else(|e| e.into_inner());
-    match slot.take() {
-        Some((p, pool)) if p == pid => {
-            *slot = Some((p, pool.clone()));
-            return Some(pool);
+    {
+        let mut slot = POOL.lock().unwrap_or_else(|e| e.into_inner());
+        match slot.take() {
+            Some((p, pool)) if p == pid => {
+                *slot = Some((p, pool.clone()));
+                return Some(pool);
+            }
+            Some(inherited) => std::mem::forget(inherited),
+            None => {}
         }
-        Some(inherited) => std::mem::forget(inherited),
-        None => {}
     }
+    // Built without the lock held: a fork while its threads start must not leave the child a
+    // locked mutex.
     let pool = Arc::new(rayon::ThreadPoolBuilder::new().build().ok()?);
-    *slot = Some((pid, pool.clone()));
-    Some(pool)
+    let mut slot = POOL.lock().unwrap_or_else(|e| e.into_inner());
+    match &*slot {
+        Some((p, other)) if *p == pid => Some(other.clone()),
+        _ => {
+            *slot = Some((pid, pool.clone()));
+            Some(pool)
+        }
+    }
 }
 
 /// `work` in [`process_pool`] (on the calling thread when no pool can be built).

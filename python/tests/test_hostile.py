@@ -29,6 +29,9 @@ def _frozen_solve(path):
 
 def _child_map(path):
     m = geartherm.Model.load(path).map(gear="1", speed_rpm=[1000.0, 2000.0], torque_nm=[10.0, 50.0])
+    model = geartherm.Model.load(path)
+    model.run(cycle=str(ROOT / "tests" / "data" / "rig_short.csv"), summary_only=True)
+    model.steady(gear="1", speed_rpm=1500.0, torque_nm=50.0)
     return len(m)
 
 

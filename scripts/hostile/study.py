@@ -125,6 +125,10 @@ def gen_spec(rng, root, small):
     n = rng.randint(1, 3)
     spec = {"study": {"name": "s", "model": "MODEL"}, "job": gen_job(rng, small),
             "parameters": [gen_parameter(rng, root, small) for _ in range(n)]}
+    if small:
+        # A study that must run (kill and resume, two writers): each key path once.
+        seen = set()
+        spec["parameters"] = [p for p in spec["parameters"] if not (p["path"] in seen or seen.add(p["path"]))]
     plan = rng.choice(["grid", "grid", "lhs", "list"])
     spec["sampling"] = {"plan": plan}
     if plan == "lhs":
@@ -175,7 +179,7 @@ def make_case(i, rng, root, sub):
     small = sub != "study_spec"
     case = {"id": i, "family": sub, "garble": sub == "study_spec" and rng.random() < 0.15}
     if sub == "study_huge":
-        spec = huge_spec(rng)
+        spec = huge_spec(rng, root)
     else:
         spec = gen_spec(rng, root, small)
     case["text"] = study_text(rng, case, spec)
@@ -187,12 +191,15 @@ def make_case(i, rng, root, sub):
     return case
 
 
-def huge_spec(rng):
+def huge_spec(rng, root):
     n = rng.choice([2, 3, 8, 20, 64])
     levels = rng.choice([10, 100, 3163, 10 ** 6, 10 ** 7, 10 ** 7 + 1, 2 ** 40])
     params = [{"path": "lubrication.oil_level_mm", "range": [30.0, 50.0], "levels": levels}]
-    params += [{"path": "thermal.initial_temp_c", "values": [float(20 + k) for k in range(rng.choice([2, 10, 1000]))]}
-               for _ in range(n - 1)]
+    # Each key path once (a study refuses a path varied twice): real numeric leaves of the model,
+    # scaled around their values.
+    others = [p for p, _ in numeric_paths(root) if p != "lubrication.oil_level_mm"]
+    params += [{"path": p, "scale": [0.9, 1.1], "levels": rng.choice([2, 10, 1000])}
+               for p in rng.sample(others, min(n - 1, len(others)))]
     samp = {"plan": "grid"} if rng.random() < 0.7 else {"plan": "lhs", "cases": rng.choice([10 ** 7, 10 ** 7 + 1, 2 ** 63])}
     return {"study": {"name": "huge", "model": "MODEL"}, "sampling": samp,
             "job": {"kind": "steady", "points": [{"gear": "1", "speed_rpm": 1000.0, "torque_nm": 10.0}]},

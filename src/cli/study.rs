@@ -93,6 +93,15 @@ fn catch_sigint() {
     }
 }
 
+/// Ctrl-C at its default again (after the cases: a Ctrl-C during the compaction ends the
+/// process, the journals already hold every case).
+fn release_sigint() {
+    #[cfg(unix)]
+    unsafe {
+        libc::signal(libc::SIGINT, libc::SIG_DFL);
+    }
+}
+
 fn runner_failure(e: RunnerError) -> Failure {
     match e {
         RunnerError::Foreign(m) => invalid(m),
@@ -137,12 +146,13 @@ pub fn study(a: &StudyArgs) -> Result<(), Failure> {
         a.quiet,
     );
     catch_sigint();
-    let (tally, _) = runner::run(&study, &cases, Some(&out), &INTERRUPTED, &|_| {
+    let solved = runner::run(&study, &cases, Some(&out), &INTERRUPTED, &|_| {
         if let Some(b) = &b {
             b.inc(1);
         }
-    })
-    .map_err(runner_failure)?;
+    });
+    release_sigint();
+    let (tally, _) = solved.map_err(runner_failure)?;
     if let Some(b) = &b {
         b.finish_and_clear();
     }

@@ -417,6 +417,14 @@ fn source(s: &SourceSpec, p: &str, names: &CircuitNames<'_>, problems: &mut Prob
             SourceKind::Pump { share }
         }
         SourceKindChoice::ElectricPump => {
+            if names.pump && s.name == "pump" {
+                // Its drive is loss item pump:<name>, the [pump]'s is pump:pump.
+                problems.push(
+                    format!("{p}.name"),
+                    q("pump"),
+                    "the [pump]'s loss item is pump:pump; name the electric pump otherwise",
+                );
+            }
             unused("share", s.share.is_some(), problems);
             unused("gear", s.gear.is_some(), problems);
             if s.pressure_bar.is_none() {

@@ -276,8 +276,8 @@ fn draw_rtol_labels(chart: &LogChart, placed: Placement) -> DrawResult {
 mod tests {
     use super::*;
 
-    /// A wall time of 1e-308 (a crafted bench.csv) padded to 0 made the decades start at
-    /// i32::MIN and the light ticks fill memory; the axis now stays within the doubles.
+    /// A wall time of 1e-308 (a crafted bench.csv), padded, would reach 0 and start the decades
+    /// at i32::MIN; the axis stays within the positive doubles and its ticks are bounded.
     #[test]
     fn log_axes_of_extreme_values_stay_bounded() {
         let (lo, hi) = log_range([1e-308, 3.6e-5, 1.2e29].into_iter());
