@@ -8,9 +8,9 @@ use super::ParamValue;
 /// Largest number of samples a plan may produce (and of cases a study may have).
 pub const MAX_SAMPLES: usize = 10_000_000;
 
-/// Largest number of sampled values (samples × parameters) a plan may hold: each takes about
-/// 55 bytes as built (a 10⁷-case grid of two parameters holds 1.1 GB), so this bounds a plan to
-/// about a gigabyte.
+/// Largest number of sampled values (samples × parameters) a plan may hold: each is a
+/// `ParamValue` (`size_of` 24 bytes on a 64-bit target) in its sample's row, so this bounds the
+/// values of a plan to about half a gigabyte besides the rows' own vectors and any texts.
 pub const MAX_SAMPLED_VALUES: usize = 20_000_000;
 
 /// Refuse `n` samples of `params` parameters beyond [`MAX_SAMPLED_VALUES`], before building.
