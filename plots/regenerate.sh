@@ -10,3 +10,6 @@ cargo build --release
 ./target/release/geartherm map models/ev_reducer.toml --gear D --speed-rpm 0:16000:33 --torque-nm 0:90:31 --out plots/ev_reducer_map --quiet
 ./target/release/geartherm rating models/ev_reducer.toml --gear D --speed-rpm 500:16000:32 --oil-limit-c 110 --torque-max-nm 310 --out plots/ev_reducer_rating --quiet > /dev/null
 ./target/release/geartherm rating models/fzg_c.toml --gear 1 --speed-rpm 250:6000:24 --oil-limit-c 100 --out plots/fzg_c_rating --quiet > /dev/null
+rm -rf plots/at6_study
+./target/release/geartherm study models/studies/at6_wltc_lhs.toml --out plots/at6_study --quiet > /dev/null
+rm -f plots/at6_study/journal.jsonl plots/at6_study/study.parquet   # the table is study.csv
