@@ -253,7 +253,7 @@ pub(super) fn compile_pocketing(
         {
             Some((_, pm)) => *pm,
             None => {
-                let pm = PocketingMesh::with_options(&input, &popts).map_err(|e| SceneError {
+                let pm = pocketing_mesh(&input, &popts).map_err(|e| SceneError {
                     what: format!("pocketing of mesh {}", m.name),
                     why: e.to_string(),
                 })?;
@@ -304,6 +304,42 @@ pub(super) fn mesh_feeds(gb: &Gearbox, mi: usize) -> Vec<(usize, f64)> {
             _ => None,
         })
         .collect()
+}
+
+/// Most pocket models kept by [`pocketing_mesh`].
+const POCKET_MEMO: usize = 64;
+
+/// [`PocketingMesh::with_options`], remembered across compiles: the pocket geometry (most of a
+/// compile's time for a model with pocketing) depends only on the mesh's geometry and options,
+/// and the cases of a study mostly vary other values. A pure function's results, so a
+/// remembered model is the one the computation gives, bit for bit; the last [`POCKET_MEMO`]
+/// distinct inputs are kept.
+fn pocketing_mesh(
+    input: &PocketMeshInput,
+    opts: &crate::physics::losses::pocketing::PocketingOptions,
+) -> Result<PocketingMesh, crate::physics::losses::pocketing::PocketingError> {
+    type Memo = Vec<(
+        PocketMeshInput,
+        crate::physics::losses::pocketing::PocketingOptions,
+        PocketingMesh,
+    )>;
+    static MEMO: std::sync::Mutex<Memo> = std::sync::Mutex::new(Vec::new());
+    let found = {
+        let memo = MEMO.lock().unwrap_or_else(|e| e.into_inner());
+        memo.iter()
+            .find(|(i, o, _)| i == input && o == opts)
+            .map(|(_, _, pm)| *pm)
+    };
+    if let Some(pm) = found {
+        return Ok(pm);
+    }
+    let pm = PocketingMesh::with_options(input, opts)?;
+    let mut memo = MEMO.lock().unwrap_or_else(|e| e.into_inner());
+    if memo.len() >= POCKET_MEMO {
+        memo.remove(0);
+    }
+    memo.push((*input, *opts, pm));
+    Ok(pm)
 }
 
 /// Windage: one item per gear that does not reach the oil and turns (relative to the air) in a
