@@ -41,6 +41,16 @@ impl Model {
         })
     }
 
+    /// Check an already parsed model document (`file` names it in messages) with `overrides`.
+    pub fn from_document(doc: toml::Table, file: &Path, overrides: &[Override]) -> Result<Model, JobError> {
+        let gearbox = model::from_document_with(doc, file, overrides)?;
+        Ok(Model {
+            gearbox,
+            file: file.to_path_buf(),
+            overrides: overrides.to_vec(),
+        })
+    }
+
     /// The file as shown in messages.
     pub fn label(&self) -> String {
         self.file.display().to_string()

@@ -101,12 +101,26 @@ pub fn from_str_with(text: &str, file: &Path, overrides: &[Override]) -> Result<
         return from_str(text, file);
     }
     let mut problems = Problems::default();
+    let Some(doc) = parse::parse_document(text, &mut problems) else {
+        return Err(ModelError::Invalid {
+            file: file.to_path_buf(),
+            problems: problems.into_vec(),
+        });
+    };
+    from_document_with(doc, file, overrides)
+}
+
+/// As [`from_str_with`] on an already parsed document (a study parses its base model once and
+/// gives each case a copy).
+pub fn from_document_with(
+    mut doc: toml::Table,
+    file: &Path,
+    overrides: &[Override],
+) -> Result<Gearbox, ModelError> {
+    let mut problems = Problems::default();
     let invalid = |problems: Problems| ModelError::Invalid {
         file: file.to_path_buf(),
         problems: problems.into_vec(),
-    };
-    let Some(mut doc) = parse::parse_document(text, &mut problems) else {
-        return Err(invalid(problems));
     };
     let mut applied = Vec::with_capacity(overrides.len());
     for ov in overrides {

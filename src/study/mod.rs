@@ -550,7 +550,7 @@ impl Study {
     fn solve(&self, c: &Case, per_case: bool, row: &mut CaseRow) -> Result<CaseFiles, JobError> {
         let (ovs, used) = self.overrides(c.sample).map_err(JobError::invalid)?;
         row.params = used;
-        let m = job::Model::from_text(&self.model_text, &self.model_file, &ovs)?;
+        let m = job::Model::from_document(self.base.clone(), &self.model_file, &ovs)?;
         match self.case_job(c, per_case) {
             Job::Run(o) => {
                 let r = job::run::run(&m, &o, &mut |_, _| {})?;
