@@ -65,7 +65,8 @@ fn journal_ids(dir: &Path) -> Vec<String> {
 #[test]
 fn a_killed_study_resumes_without_recomputing_finished_cases() {
     let d = tempfile::tempdir().unwrap();
-    let n = 10;
+    // Enough cases (a few ms each) that the kill lands mid-study.
+    let n = 200;
     let s = study_file(d.path(), n, "");
     let out = d.path().join("out");
     // Run a first time and kill it (SIGKILL) once a few cases are journaled.
