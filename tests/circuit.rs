@@ -298,3 +298,21 @@ fn an_electric_pump_cannot_take_the_pumps_item_name() {
     let err = model::from_str(&text, Path::new(AT6)).unwrap_err().report();
     assert!(err.contains(".name") && err.contains("pump:pump"), "{err}");
 }
+
+#[test]
+fn a_circuit_needs_the_oil_nodes_specific_heat() {
+    // The advection links carry the oil node's c_p; a sump given by its capacity alone has none.
+    let text = std::fs::read_to_string(AT6).unwrap().replace(
+        "mass_kg = 7.6                 # 9 L ATF at 845 kg/m³ (the whole fill mixes through the pump)\ncp_j_per_kgk = 2000.0",
+        "capacity_j_per_k = 15200.0",
+    );
+    assert!(text.contains("capacity_j_per_k = 15200.0"));
+    let err = model::from_str(&text, Path::new(AT6)).unwrap_err().report();
+    assert!(
+        err.contains("thermal.nodes[0]") && err.contains("cp_j_per_kgk"),
+        "{err}"
+    );
+    // Without the [circuit] the same sump is accepted.
+    let cut = text.find("\n[circuit]").unwrap();
+    assert!(model::from_str(&text[..cut], Path::new(AT6)).is_ok());
+}

@@ -99,6 +99,9 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         };
         circuit::validate_circuit(spec, &names, problems)
     });
+    if let (Some(_), Some(net)) = (&circuit, &thermal) {
+        oil_node_gives_cp(net, problems);
+    }
     let vehicle = file
         .vehicle
         .as_ref()
@@ -255,4 +258,18 @@ fn check_thermal(
     names.set(Source::Bearing, it.bearings.iter().map(|b| b.name.as_str()));
     names.set(Source::Seal, it.seals.iter().map(|s| s.name.as_str()));
     thermal::validate_thermal(spec, &infos, &names, problems)
+}
+
+/// With a `[circuit]`, the oil its consumers carry back to the sump takes the oil node's c_p
+/// (advection links ṁ c_p ΔT, docs/physics.md §14): the oil node must state it.
+fn oil_node_gives_cp(net: &thermal::ThermalNetwork, problems: &mut Problems) {
+    let i = net.oil_node;
+    if net.nodes.get(i).is_some_and(|n| n.specific_heat.is_none()) {
+        problems.push(
+            format!("thermal.nodes[{i}]"),
+            &net.nodes[i].name,
+            "the oil node of a model with a [circuit] needs mass_kg and cp_j_per_kgk (the oil the \
+             circuit carries takes its c_p), not capacity_j_per_k alone",
+        );
+    }
 }

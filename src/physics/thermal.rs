@@ -81,9 +81,9 @@ pub const AIR_50C: FluidProperties = FluidProperties {
 /// PAO oils at 40–100 °C, e.g. Changenet et al. 2006]; taken constant.
 pub const OIL_CONDUCTIVITY: f64 = 0.13;
 
-/// Specific heat of gear oils, J/(kg·K) [recalled: 1.9–2.1 kJ/kgK at 40–100 °C]; used for the
-/// Prandtl number of the rotating-part correlation in oil, and for the heat the circuit's oil
-/// carries when the oil node gives its capacity alone (no `cp_j_per_kgk`).
+/// Specific heat of gear oils, J/(kg·K) [recalled: 1.9–2.1 kJ/kgK at 40–100 °C]; used only for the
+/// Prandtl number of the rotating-part correlation in oil (the heat the circuit's oil carries
+/// takes the oil node's own `cp_j_per_kgk`).
 pub const OIL_SPECIFIC_HEAT: f64 = 2000.0;
 
 /// Mean heat-transfer coefficient of a disc of radius `r` (m) rotating at `omega` (rad/s) in a

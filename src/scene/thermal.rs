@@ -160,8 +160,9 @@ pub struct ThermalScene {
     radiation: Vec<Radiation>,
     coolers: Vec<CoolerTerm>,
     oil_model: Oil,
-    /// c_p of the oil carried by the advection links, J/(kg·K): the oil node's `cp_j_per_kgk`,
-    /// else [`OIL_SPECIFIC_HEAT`] (a node given by its capacity alone states no c_p).
+    /// c_p of the oil carried by the advection links, J/(kg·K): the oil node's `cp_j_per_kgk`
+    /// (the model check requires it of a model with a `[circuit]`, the only source of advection
+    /// links; [`OIL_SPECIFIC_HEAT`] stands in for a model without links).
     advection_cp: f64,
 }
 
