@@ -208,3 +208,51 @@ fn bench_takes_set_like_every_command_that_reads_a_model() {
     assert_eq!(c, 1, "{e}");
     assert!(e.contains("oil.catalogue") && e.contains("no_such_oil"), "{e}");
 }
+
+/// A solver that fails at a tolerance (tsit45 on a housing of 10 mg: far too stiff for an
+/// explicit method) keeps its row: the message in `failure`, nulls in bench.json, and
+/// `FAILED: …` in its printed line in place of its figures, never `NaN`.
+#[test]
+fn a_failed_bench_row_prints_no_nan() {
+    let d = tempfile::tempdir().unwrap();
+    let out = bin()
+        .args([
+            "bench",
+            "models/fzg_c.toml",
+            "--set",
+            "thermal.nodes[\"housing\"].mass_kg=1e-08",
+            "--cycle",
+            "tests/data/rig_short.csv",
+            "--repeats",
+            "1",
+            "--min-rtol",
+            "1e-3",
+            "--solvers",
+            "ros3,tsit45",
+            "--out",
+        ])
+        .arg(d.path().join("b"))
+        .current_dir(root())
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{text}");
+    assert!(
+        text.contains("tsit45") && text.contains("FAILED: numerical failure"),
+        "{text}"
+    );
+    assert!(!text.contains("NaN"), "{text}");
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path().join("b/bench.json")).unwrap()).unwrap();
+    let failed = &json["rows"][1];
+    assert!(
+        failed["failure"]
+            .as_str()
+            .is_some_and(|f| f.contains("step budget")),
+        "{failed}"
+    );
+    assert!(
+        failed["wall_time_s"].is_null() && failed["err_max_k"].is_null(),
+        "{failed}"
+    );
+}

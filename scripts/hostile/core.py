@@ -97,13 +97,15 @@ def json_problems(v, path=""):
     """Paths of nulls that stand for numbers and of efficiencies outside [0, 1]."""
     nf, eff = [], []
     if isinstance(v, dict):
+        # A failed row (a bench solver that failed) says so in `failure`; its numbers are null.
+        failed = bool(v.get("failure"))
         for k, x in v.items():
             p = f"{path}.{k}"
             if "efficiency" in k and isinstance(x, (int, float)) and not isinstance(x, bool):
                 if not (0.0 <= x <= 1.0):
                     eff.append(p)
             # A null option echo (`ambient_c`: the model's own) is "not given", not a number.
-            if x is None and k.endswith(("_w", "_j", "_c", "_s", "_k")) and k not in OPTION_ECHOES:
+            if x is None and not failed and k.endswith(("_w", "_j", "_c", "_s", "_k")) and k not in OPTION_ECHOES:
                 nf.append(p)
             if isinstance(x, float) and not (x == x and abs(x) != float("inf")):
                 nf.append(p)

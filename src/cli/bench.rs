@@ -48,6 +48,13 @@ impl BenchArgs {
 }
 
 fn row_line(row: &BenchRow) -> String {
+    if let Some(f) = &row.failure {
+        // A failed row has no time or error: said in words, never as NaN.
+        return format!(
+            "{:<9} rtol {:>7.0e} atol {:>7.0e}: FAILED: {f}",
+            row.solver, row.rtol, row.atol
+        );
+    }
     format!(
         "{:<9} rtol {:>7.0e} atol {:>7.0e}: {:>9.4} ms, err max {:>9.2e} K final {:>9.2e} K, {:>6} steps, {:>5} rejected, {:>7} RHS, {:>5} LU{}",
         row.solver,
