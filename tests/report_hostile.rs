@@ -124,3 +124,42 @@ fn a_time_column_that_does_not_increase_is_invalid_input() {
         report_refuses(&run, "column `time_s`");
     }
 }
+
+/// A temperature of ±1e308 in `timeseries.csv`: the temperature axis would span 2e308 (infinite)
+/// and its tick search never end; every value read for a figure lies within ±1e300.
+#[test]
+fn a_value_too_large_to_draw_in_a_time_series_is_invalid_input() {
+    let d = tempfile::tempdir().unwrap();
+    let run = d.path().join("r");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let o = Command::new(env!("CARGO_BIN_EXE_geartherm"))
+        .args([
+            "run",
+            "models/fzg_c.toml",
+            "--cycle",
+            "tests/data/rig_short.csv",
+            "--quiet",
+            "--out",
+        ])
+        .arg(&run)
+        .current_dir(root)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(run.join("timeseries.csv")).unwrap();
+    let head: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = head.iter().position(|h| *h == "temp_housing_c").unwrap();
+    let edited: Vec<String> = text
+        .lines()
+        .enumerate()
+        .map(|(k, l)| {
+            let mut f: Vec<String> = l.split(',').map(str::to_string).collect();
+            if k == 2 {
+                f[col] = "-1e+308".into();
+            }
+            f.join(",")
+        })
+        .collect();
+    std::fs::write(run.join("timeseries.csv"), edited.join("\n") + "\n").unwrap();
+    report_refuses(&run, "column `temp_housing_c`");
+}

@@ -194,15 +194,20 @@ pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
             Err(e) => return Err(csv_err(path, e)),
         }
         line = record.position().map(|p| p.line()).unwrap_or(line + 1);
+        // Every value is drawn on an axis: finite and within ±MAX_AXIS_VALUE (an axis spanning
+        // ±1e308 has an infinite width, on which the tick search never ends).
         let num = |c: usize| -> Result<f64, PlotError> {
             let field = record.get(c).unwrap_or("");
-            parse_num(field).ok_or_else(|| PlotError::Csv {
-                path: path.to_path_buf(),
-                msg: format!(
-                    "line {line}, column `{}`: `{field}` is not a finite number",
-                    &headers[c]
-                ),
-            })
+            parse_num(field)
+                .filter(|v| v.is_nan() || v.abs() <= MAX_AXIS_VALUE)
+                .ok_or_else(|| PlotError::Csv {
+                    path: path.to_path_buf(),
+                    msg: format!(
+                        "line {line}, column `{}`: `{field}` is not a finite number within \
+                         ±{MAX_AXIS_VALUE:e}",
+                        &headers[c]
+                    ),
+                })
         };
         let t = num(c_time)?;
         let speed = num(c_speed)?;
