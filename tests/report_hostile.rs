@@ -89,13 +89,10 @@ fn the_report_grid_bound_is_the_map_point_bound() {
     );
 }
 
-/// A run directory whose `time_s` jumps back to -1e308 (a time axis spanning 1e308 is never
-/// drawn): times must increase from row to row and stay within ±1e300 s.
-#[test]
-fn a_time_column_that_does_not_increase_is_invalid_input() {
-    let d = tempfile::tempdir().unwrap();
-    let run = d.path().join("r");
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+/// A complete run directory of the FZG C over the short rig cycle under `parent`, and its
+/// `timeseries.csv` text.
+fn fzg_run(parent: &Path) -> (std::path::PathBuf, String) {
+    let run = parent.join("r");
     let o = Command::new(env!("CARGO_BIN_EXE_geartherm"))
         .args([
             "run",
@@ -106,11 +103,20 @@ fn a_time_column_that_does_not_increase_is_invalid_input() {
             "--out",
         ])
         .arg(&run)
-        .current_dir(root)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let text = std::fs::read_to_string(run.join("timeseries.csv")).unwrap();
+    (run, text)
+}
+
+/// A run directory whose `time_s` jumps back to -1e308 (a time axis spanning 1e308 is never
+/// drawn): times must increase from row to row and stay within ±1e300 s.
+#[test]
+fn a_time_column_that_does_not_increase_is_invalid_input() {
+    let d = tempfile::tempdir().unwrap();
+    let (run, text) = fzg_run(d.path());
     for (row, time) in [(3, "-1e+308"), (1, "1e308"), (2, "0")] {
         let edited: Vec<String> = text
             .lines()
@@ -130,23 +136,7 @@ fn a_time_column_that_does_not_increase_is_invalid_input() {
 #[test]
 fn a_value_too_large_to_draw_in_a_time_series_is_invalid_input() {
     let d = tempfile::tempdir().unwrap();
-    let run = d.path().join("r");
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let o = Command::new(env!("CARGO_BIN_EXE_geartherm"))
-        .args([
-            "run",
-            "models/fzg_c.toml",
-            "--cycle",
-            "tests/data/rig_short.csv",
-            "--quiet",
-            "--out",
-        ])
-        .arg(&run)
-        .current_dir(root)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let text = std::fs::read_to_string(run.join("timeseries.csv")).unwrap();
+    let (run, text) = fzg_run(d.path());
     let head: Vec<&str> = text.lines().next().unwrap().split(',').collect();
     let col = head.iter().position(|h| *h == "temp_housing_c").unwrap();
     let edited: Vec<String> = text
