@@ -237,6 +237,29 @@ impl ChangenetGear {
         }
     }
 
+    /// How far apart the two laws are at the bridge's ends for `oil`: the larger, over the two
+    /// speeds where Re_c = `re_c_low` and `re_c_high`, of max(C_low/C_high, C_high/C_low) (≥ 1;
+    /// 1 for a dry gear). [derived] At fixed ν both laws fall with speed (C_low ∝ ω^(2a_Fr + a_Re),
+    /// C_high ∝ ω^(2b_Fr)), so the bridge joins C_low(ω_a) to C_high(ω_b) across a 1.5× change of
+    /// Re_c; when this factor is large, the power changes by about that factor within that band,
+    /// and, since Re_c ∝ 1/ν, within the matching change of oil temperature.
+    pub fn law_factor(&self, oil: &OilState) -> f64 {
+        if !self.immersed || self.low_geo <= 0.0 || self.high_geo <= 0.0 {
+            return 1.0;
+        }
+        let ratio = |re_c: f64| {
+            let w = re_c * oil.kinematic_viscosity / (self.rp * self.b);
+            let r = self.low_law(w, oil) / self.high_law(w);
+            r.max(1.0 / r)
+        };
+        let f = ratio(self.re_c_low).max(ratio(self.re_c_high));
+        if f.is_finite() {
+            f
+        } else {
+            1.0
+        }
+    }
+
     fn low_law(&self, w: f64, oil: &OilState) -> f64 {
         let fr = w * w * self.rp / self.g;
         let re = w * self.rp * self.rp / oil.kinematic_viscosity;
@@ -387,6 +410,43 @@ mod tests {
                 w *= 1.02;
             }
         }
+    }
+
+    /// The laws' factor at the bridge ends: both ratios evaluated by hand, and the factor grows
+    /// with ν as ν^(2(a_Fr − b_Fr)) = ν^0.56 at fixed geometry (both ends scale alike).
+    #[test]
+    fn law_factor_is_the_larger_ratio_at_the_bridge_ends() {
+        let g = fzg_wheel(g_h());
+        let m = model(&g, ChangenetParams::default());
+        let rp = g.pitch_radius;
+        let d = 2.0 * rp;
+        let (hd, vd, bd) = (g_h() / d, 1.5e-3 / d.powi(3), g.face_width / d);
+        // C_low/C_high at Re_c for kinematic viscosity nu, by hand
+        let lo_over_hi = |re_c: f64, nu: f64| {
+            let w = re_c * nu / (rp * g.face_width);
+            let fr = w * w * rp / 9.80665;
+            let re = w * rp * rp / nu;
+            let lo = 1.366 * hd.powf(0.45) * vd.powf(0.1) * fr.powf(-0.6) * re.powf(-0.21);
+            let hi = 3.644 * hd.powf(0.1) * vd.powf(-0.35) * fr.powf(-0.88) * bd.powf(0.85);
+            lo / hi
+        };
+        for nu in [5e-6, 30e-6, 90e-6, 400e-6] {
+            let o = OilState {
+                density: 870.0,
+                kinematic_viscosity: nu,
+            };
+            let expect = [6000.0, 9000.0]
+                .map(|r| lo_over_hi(r, nu))
+                .into_iter()
+                .map(|r| r.max(1.0 / r))
+                .fold(1.0, f64::max);
+            assert!((m.law_factor(&o) / expect - 1.0).abs() < 1e-12, "nu {nu}");
+            // the laws' ratio scales as nu^(2(a_Fr - b_Fr)) = nu^0.56 at a fixed Re_c
+            let k = lo_over_hi(6000.0, 4.0 * nu) / lo_over_hi(6000.0, nu);
+            assert!((k / 4f64.powf(0.56) - 1.0).abs() < 1e-12);
+        }
+        let dry = model(&fzg_wheel(-0.01), ChangenetParams::default());
+        assert_eq!(dry.law_factor(&oil()), 1.0);
     }
 
     /// Finding (documented): inside the bridge P ∝ ω^(3 + s), s = ln(C_b/C_a)/ln 1.5. For a thick oil

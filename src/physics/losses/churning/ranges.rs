@@ -19,6 +19,10 @@ use super::{ChurningGear, GearChurning, OilState};
 pub enum RangeCheck {
     /// Changenet–Velex between its low and high Re_c laws.
     ChangenetBridge,
+    /// Changenet–Velex whose two laws differ by more than [`LAW_FACTOR_MAX`] at the bridge ends
+    /// for the current oil (whatever the speed: the result then depends steeply on the oil
+    /// temperature wherever the bridge is crossed).
+    ChangenetLawFactor,
     /// Stavytskyi above the filling limit speed.
     StavytskyiAboveFillingLimit,
     /// Seetharaman–Kahraman with turbulent faces.
@@ -45,8 +49,9 @@ pub fn above_dip_speed(v: f64) -> Option<(RangeCheck, f64)> {
 
 impl RangeCheck {
     /// Every check, in output order.
-    pub const ALL: [RangeCheck; 4] = [
+    pub const ALL: [RangeCheck; 5] = [
         RangeCheck::ChangenetBridge,
+        RangeCheck::ChangenetLawFactor,
         RangeCheck::StavytskyiAboveFillingLimit,
         RangeCheck::SeetharamanTurbulentFaces,
         RangeCheck::DipSpeed,
@@ -62,6 +67,11 @@ impl RangeCheck {
         match self {
             RangeCheck::ChangenetBridge => {
                 "Changenet–Velex Re_c between the low and high laws (6000–9000): no law in the paper, log-linear bridge"
+            }
+            RangeCheck::ChangenetLawFactor => {
+                "Changenet–Velex low and high laws more than a factor 2 apart at the bridge ends \
+                 (Re_c 6000 and 9000) for this oil: the log-linear bridge changes the power by that \
+                 factor within 1.5× in Re_c (a few kelvin of oil temperature)"
             }
             RangeCheck::StavytskyiAboveFillingLimit => {
                 "Stavytskyi above the filling limit: Coriolis term collapsed (reconstruction R3, not backed by the paper)"
@@ -80,6 +90,7 @@ impl RangeCheck {
     pub fn quantity(self) -> &'static str {
         match self {
             RangeCheck::ChangenetBridge => "Re_c",
+            RangeCheck::ChangenetLawFactor => "law factor",
             RangeCheck::StavytskyiAboveFillingLimit => "speed rpm",
             RangeCheck::SeetharamanTurbulentFaces => "Re_L",
             RangeCheck::DipSpeed => "pitch-line speed m/s",
@@ -109,7 +120,24 @@ pub fn stavytskyi_geometry(g: &ChurningGear) -> Vec<String> {
     v
 }
 
+/// Largest factor between the two Changenet–Velex laws at the bridge ends that is not warned
+/// (a choice: the bridge then changes C_m by at most 2 over 1.5× in Re_c, P ∝ ω^(3 ± 1.7)).
+pub const LAW_FACTOR_MAX: f64 = 2.0;
+
 impl GearChurning {
+    /// For Changenet–Velex: [`RangeCheck::ChangenetLawFactor`] with the factor
+    /// ([`super::ChangenetGear::law_factor`]) when it exceeds [`LAW_FACTOR_MAX`] at `oil` and the
+    /// gear dips and turns; `None` otherwise and for the other models.
+    pub fn law_disagreement(&self, omega: f64, oil: &OilState) -> Option<(RangeCheck, f64)> {
+        match self {
+            GearChurning::Changenet(g) if omega != 0.0 && g.is_immersed() => {
+                let f = g.law_factor(oil);
+                (f > LAW_FACTOR_MAX).then_some((RangeCheck::ChangenetLawFactor, f))
+            }
+            _ => None,
+        }
+    }
+
     /// The out-of-range use at ω (rad/s) and `oil`, with the value of [`RangeCheck::quantity`];
     /// `None` inside the range (or not immersed, or at rest).
     pub fn out_of_range(&self, omega: f64, oil: &OilState) -> Option<(RangeCheck, f64)> {
@@ -213,5 +241,40 @@ mod tests {
             g.out_of_range(2.0 * w_t, &oil).map(|x| x.0),
             Some(RangeCheck::SeetharamanTurbulentFaces)
         );
+    }
+
+    #[test]
+    fn changenet_law_factor_is_warned_above_two_only() {
+        let g = model(ChurningModel::Changenet);
+        let GearChurning::Changenet(c) = g else {
+            unreachable!()
+        };
+        // thin and thick oil: the factor changes as ν^0.56 at each end; warn only above 2
+        let mut seen = (false, false);
+        for nu in [3e-6, 30e-6, 300e-6, 3000e-6] {
+            let o = OilState {
+                density: 870.0,
+                kinematic_viscosity: nu,
+            };
+            let f = c.law_factor(&o);
+            match g.law_disagreement(100.0, &o) {
+                Some((k, v)) => {
+                    assert_eq!(k, RangeCheck::ChangenetLawFactor);
+                    assert_eq!(v, f);
+                    assert!(f > LAW_FACTOR_MAX);
+                    seen.0 = true;
+                }
+                None => {
+                    assert!(f <= LAW_FACTOR_MAX, "nu {nu}: {f}");
+                    seen.1 = true;
+                }
+            }
+            assert!(g.law_disagreement(0.0, &o).is_none());
+        }
+        // the FZG wheel meets both cases over these oils
+        assert_eq!(seen, (true, true));
+        assert!(model(ChurningModel::Seetharaman)
+            .law_disagreement(100.0, &oil())
+            .is_none());
     }
 }
