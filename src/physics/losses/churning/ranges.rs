@@ -99,11 +99,15 @@ impl RangeCheck {
 }
 
 /// The range of the gears Stavytskyi's model was compared with (Blok 1962, seed 001 §3 and
-/// table 1): module 1.5–5 mm, face width 14–24 mm, 20–102 teeth (helix 25°, h/r_a 0.55).
-pub const STAVYTSKYI_TESTED: &str =
-    "Stavytskyi compared with Blok's gears only: module 1.5–5 mm, face width 14–24 mm, 20–102 teeth (seed 001 §3, table 1)";
+/// table 1): module 1.5–5 mm, face width 14–24 mm, 20–102 teeth, nominal pitch diameter
+/// 90–159 mm, helix 25°, at one relative immersion h/r_a = 0.55 ("the relative depth of gear
+/// immersion in the oil bath is 0.55"). The speeds and oils of the comparison are in the paper's
+/// Fig. 1, which the seed does not reproduce: not checked.
+pub const STAVYTSKYI_TESTED: &str = "Stavytskyi compared with Blok's gears only: module 1.5–5 mm, face width 14–24 mm, \
+     20–102 teeth, pitch diameter 90–159 mm, at immersion h/r_a 0.55 only (seed 001 §3, table 1)";
 
-/// What lies outside [`STAVYTSKYI_TESTED`] for gear `g` (empty when inside).
+/// What lies outside [`STAVYTSKYI_TESTED`] for gear `g` (empty when inside). The immersion is
+/// listed when h/r_a differs from 0.55 by more than 0.005 (its printed precision).
 pub fn stavytskyi_geometry(g: &ChurningGear) -> Vec<String> {
     let mut v = Vec::new();
     let m = g.normal_module * 1e3;
@@ -116,6 +120,14 @@ pub fn stavytskyi_geometry(g: &ChurningGear) -> Vec<String> {
     }
     if !(20..=102).contains(&g.teeth) {
         v.push(format!("{} teeth", g.teeth));
+    }
+    let d = 2e3 * g.pitch_radius;
+    if !(90.0..=159.0).contains(&d) {
+        v.push(format!("pitch diameter {d:.1} mm"));
+    }
+    let h = (g.immersion_depth / g.tip_radius).clamp(0.0, 2.0);
+    if (h - 0.55).abs() > 0.005 {
+        v.push(format!("immersion h/r_a {h:.2}"));
     }
     v
 }
@@ -180,14 +192,22 @@ mod tests {
 
     #[test]
     fn stavytskyi_geometry_outside_blok_is_listed() {
-        // FZG wheel: m 4.5 mm inside, b 14 mm inside, 24 teeth inside.
-        assert!(stavytskyi_geometry(&fzg_wheel(0.05)).is_empty());
+        // FZG wheel: m 4.5 mm, b 14 mm, 24 teeth, d 108 mm inside; immersed to 0.55 r_a inside.
+        let r_a = fzg_wheel(0.05).tip_radius;
+        assert!(stavytskyi_geometry(&fzg_wheel(0.55 * r_a)).is_empty());
+        // to its centre: only the immersion is outside
+        assert_eq!(stavytskyi_geometry(&fzg_wheel(r_a)), vec!["immersion h/r_a 1.00".to_string()]);
         let g = ChurningGear {
             face_width: 40e-3,
             normal_module: 1e-3,
-            ..fzg_wheel(0.05)
+            ..fzg_wheel(0.55 * r_a)
         };
         assert_eq!(stavytskyi_geometry(&g).len(), 2);
+        let g = ChurningGear {
+            pitch_radius: 0.1,
+            ..fzg_wheel(0.55 * r_a)
+        };
+        assert_eq!(stavytskyi_geometry(&g), vec!["pitch diameter 200.0 mm".to_string()]);
     }
 
     #[test]
