@@ -103,7 +103,8 @@ impl RangeCheck {
 /// 90–159 mm, helix 25°, at one relative immersion h/r_a = 0.55 ("the relative depth of gear
 /// immersion in the oil bath is 0.55"). The speeds and oils of the comparison are in the paper's
 /// Fig. 1, which the seed does not reproduce: not checked.
-pub const STAVYTSKYI_TESTED: &str = "Stavytskyi compared with Blok's gears only: module 1.5–5 mm, face width 14–24 mm, \
+pub const STAVYTSKYI_TESTED: &str =
+    "Stavytskyi compared with Blok's gears only: module 1.5–5 mm, face width 14–24 mm, \
      20–102 teeth, pitch diameter 90–159 mm, at immersion h/r_a 0.55 only (seed 001 §3, table 1)";
 
 /// What lies outside [`STAVYTSKYI_TESTED`] for gear `g` (empty when inside). The immersion is
@@ -196,7 +197,10 @@ mod tests {
         let r_a = fzg_wheel(0.05).tip_radius;
         assert!(stavytskyi_geometry(&fzg_wheel(0.55 * r_a)).is_empty());
         // to its centre: only the immersion is outside
-        assert_eq!(stavytskyi_geometry(&fzg_wheel(r_a)), vec!["immersion h/r_a 1.00".to_string()]);
+        assert_eq!(
+            stavytskyi_geometry(&fzg_wheel(r_a)),
+            vec!["immersion h/r_a 1.00".to_string()]
+        );
         let g = ChurningGear {
             face_width: 40e-3,
             normal_module: 1e-3,
@@ -207,7 +211,10 @@ mod tests {
             pitch_radius: 0.1,
             ..fzg_wheel(0.55 * r_a)
         };
-        assert_eq!(stavytskyi_geometry(&g), vec!["pitch diameter 200.0 mm".to_string()]);
+        assert_eq!(
+            stavytskyi_geometry(&g),
+            vec!["pitch diameter 200.0 mm".to_string()]
+        );
     }
 
     #[test]
