@@ -1,11 +1,16 @@
 //! Where a churning model is used outside the range it was fitted or derived on.
 //!
-//! Only ranges the models themselves define are checked; the fitted ranges of geometry and
-//! immersion of Changenet & Velex 2007 could not be found in a source (docs/validation.md says
-//! what was searched), so they are not invented here.
+//! Checked: the ranges the models themselves define, Stavytskyi's comparison gears and the
+//! dip-lubrication speed; the fitted ranges of geometry and immersion of Changenet & Velex 2007
+//! and of Seetharaman–Kahraman could not be found in a source (docs/physics.md §5 "Tested
+//! ranges" says what was searched), so they are not invented here.
 //!
 //! - Changenet–Velex: `Re_c = ω r_p b/ν` between the two laws (6000–9000 by default): the paper
-//!   gives no law there; the power comes from the log-linear bridge (docs/physics.md §5).
+//!   gives no law there; the power comes from the log-linear bridge (docs/physics.md §5). And,
+//!   at every point, the two laws more than [`LAW_FACTOR_MAX`] apart at the bridge ends for the
+//!   current oil, with the factor: the result then jumps by about that factor where the bridge
+//!   is crossed.
+//! - Stavytskyi: the geometry of Blok's comparison gears ([`STAVYTSKYI_TESTED`], seed 001).
 //! - Stavytskyi: above the filling limit (V₃ = 0) the Coriolis term has collapsed; that regime
 //!   follows from reconstruction R3 (absolute bath pressure), and the paper reports only a
 //!   "slight" fall at 5000–7000 rpm, so the computed fall is not backed by the paper.
