@@ -95,6 +95,42 @@ fn mm82_wheel_is_flagged_at_every_oil_temperature_in_losses() {
             assert!((low / p - 1.0).abs() < 1e-9, "{t} °C: the low law applies");
         }
     }
+    // The same alternative as a model choice: `changenet_join = "crossing"` gives the low law
+    // here, and says that the low law is used above its Re_c regime.
+    let v = json(&[
+        "losses",
+        "models/mm82_wind_gearbox.toml",
+        "--set",
+        "losses.changenet_join=\"crossing\"",
+        "--gear",
+        "run",
+        "--speed-rpm",
+        "1680",
+        "--torque-nm",
+        "5000",
+        "--oil-temp-c",
+        "55",
+        "--json",
+    ]);
+    let p = v["items"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|i| i["source"] == "churning" && i["name"] == "wheel1")
+        .unwrap()["w"]
+        .as_f64()
+        .unwrap();
+    let (_, _, nu55, rho55) = at(55);
+    assert!((p / (p45 * (rho55 / rho45) * (nu55 / nu45).powf(0.21)) - 1.0).abs() < 1e-9);
+    assert!(
+        v["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| w["item"] == "churning of gear wheel1"
+                && w["range"].as_str().unwrap().contains("crossing"))
+    );
+    assert!(law_factor(&v["warnings"], "churning of gear wheel1").is_none());
 }
 
 #[test]

@@ -17,7 +17,7 @@
 //! - Seetharaman–Kahraman: face Reynolds number above the laminar–turbulent transition: the mixed
 //!   plate law there is derived (White), not part of seed 000's fitted or tested range.
 
-use super::{ChurningGear, GearChurning, OilState};
+use super::{ChangenetJoin, ChurningGear, GearChurning, OilState};
 
 /// One kind of out-of-range use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -35,6 +35,9 @@ pub enum RangeCheck {
     /// Any model: the gear's pitch-line speed above the dip-lubrication range
     /// ([`DIP_PITCH_SPEED_MAX`]).
     DipSpeed,
+    /// Changenet–Velex with the crossing join using a law outside its Re_c regime (the low law
+    /// above `re_c_high` or the high law below `re_c_low`).
+    ChangenetCrossingOutside,
 }
 
 /// Highest pitch-line speed of dip (splash) lubrication, m/s: "suitable for up to 12.5 m/s
@@ -54,12 +57,13 @@ pub fn above_dip_speed(v: f64) -> Option<(RangeCheck, f64)> {
 
 impl RangeCheck {
     /// Every check, in output order.
-    pub const ALL: [RangeCheck; 5] = [
+    pub const ALL: [RangeCheck; 6] = [
         RangeCheck::ChangenetBridge,
         RangeCheck::ChangenetLawFactor,
         RangeCheck::StavytskyiAboveFillingLimit,
         RangeCheck::SeetharamanTurbulentFaces,
         RangeCheck::DipSpeed,
+        RangeCheck::ChangenetCrossingOutside,
     ];
 
     /// Position in [`Self::ALL`].
@@ -84,6 +88,10 @@ impl RangeCheck {
             RangeCheck::SeetharamanTurbulentFaces => {
                 "Seetharaman–Kahraman faces above the laminar transition Re_L: derived mixed plate law"
             }
+            RangeCheck::ChangenetCrossingOutside => {
+                "Changenet–Velex joined where its laws cross (changenet_join = \"crossing\"): a law used outside \
+                 its Re_c regime (the low law above 9000 or the high law below 6000)"
+            }
             RangeCheck::DipSpeed => {
                 "pitch-line speed above 12.5 m/s, the upper end of dip lubrication (Tribology Handbook C16): \
                  faster than the dip-lubrication tests behind the churning models"
@@ -99,6 +107,7 @@ impl RangeCheck {
             RangeCheck::StavytskyiAboveFillingLimit => "speed rpm",
             RangeCheck::SeetharamanTurbulentFaces => "Re_L",
             RangeCheck::DipSpeed => "pitch-line speed m/s",
+            RangeCheck::ChangenetCrossingOutside => "Re_c",
         }
     }
 }
@@ -148,7 +157,9 @@ impl GearChurning {
     /// gear dips and turns; `None` otherwise and for the other models.
     pub fn law_disagreement(&self, omega: f64, oil: &OilState) -> Option<(RangeCheck, f64)> {
         match self {
-            GearChurning::Changenet(g) if omega != 0.0 && g.is_immersed() => {
+            GearChurning::Changenet(g)
+                if omega != 0.0 && g.is_immersed() && g.join() == ChangenetJoin::Bridge =>
+            {
                 let f = g.law_factor(oil);
                 (f > LAW_FACTOR_MAX).then_some((RangeCheck::ChangenetLawFactor, f))
             }
@@ -167,7 +178,16 @@ impl GearChurning {
             GearChurning::Changenet(g) => {
                 let re_c = g.critical_reynolds(w, oil);
                 let (lo, hi) = g.bridge();
-                (re_c > lo && re_c < hi).then_some((RangeCheck::ChangenetBridge, re_c))
+                match g.join() {
+                    ChangenetJoin::Bridge => {
+                        (re_c > lo && re_c < hi).then_some((RangeCheck::ChangenetBridge, re_c))
+                    }
+                    ChangenetJoin::Crossing => {
+                        let (cl, ch) = g.law_coefficients(w, oil);
+                        ((cl <= ch && re_c > hi) || (ch < cl && re_c < lo))
+                            .then_some((RangeCheck::ChangenetCrossingOutside, re_c))
+                    }
+                }
             }
             GearChurning::Stavytskyi(g) => (g.filling_velocity(w, oil) == 0.0).then_some((
                 RangeCheck::StavytskyiAboveFillingLimit,
