@@ -65,6 +65,12 @@ pub fn validate(a: &ValidateArgs) -> Result<(), Failure> {
     // result set as one transaction: the previous set stays whole until the commit.
     let out = OutputDir::begin(&a.out)?;
     let r = run_validate(&a.options())?;
+    for w in &r.warnings {
+        eprintln!(
+            "warning: case {} [{}]: {}: {} ({})",
+            w.case, w.model, w.warning.item, w.warning.range, w.warning.seen
+        );
+    }
     let texts = [
         ("validation.csv", rows_csv(&r.rows)),
         ("validation_summary.csv", summary_csv(&r.summary)),
@@ -79,6 +85,7 @@ pub fn validate(a: &ValidateArgs) -> Result<(), Failure> {
         emit_json(&ValidationReport {
             rows: &r.rows,
             summary: &r.summary,
+            warnings: &r.warnings,
         })?;
     } else {
         emit(&format!(

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use crate::reference::{run_all, summarise, Row, SummaryRow};
+use crate::reference::{run_all_with_warnings, summarise, CaseWarning, Row, SummaryRow};
 
 use super::JobError;
 
@@ -32,6 +32,8 @@ pub struct ValidateResult {
     pub rows: Vec<Row>,
     /// Summary per case and model.
     pub summary: Vec<SummaryRow>,
+    /// Loss models used outside their range, per case and model choice.
+    pub warnings: Vec<CaseWarning>,
 }
 
 /// Evaluate every reference case under `o.dir`.
@@ -44,7 +46,8 @@ pub fn validate(o: &ValidateOptions) -> Result<ValidateResult, JobError> {
             format!("validate: {}: not a directory", o.dir.display()),
         ));
     }
-    let rows = run_all(&o.dir).map_err(|e| JobError::invalid(format!("validate: {e}")))?;
+    let (rows, warnings) =
+        run_all_with_warnings(&o.dir).map_err(|e| JobError::invalid(format!("validate: {e}")))?;
     if rows.is_empty() {
         return Err(JobError::invalid(format!(
             "validate: {}: no case.toml found",
@@ -61,5 +64,9 @@ pub fn validate(o: &ValidateOptions) -> Result<ValidateResult, JobError> {
         )));
     }
     let summary = summarise(&rows);
-    Ok(ValidateResult { rows, summary })
+    Ok(ValidateResult {
+        rows,
+        summary,
+        warnings,
+    })
 }

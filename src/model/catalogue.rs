@@ -14,6 +14,9 @@ pub struct CatalogueOil {
     pub key: String,
     /// Full name.
     pub name: String,
+    /// Other names the oil's sources use for it (e.g. the FEUP/INEGI group's oil codes).
+    #[serde(default)]
+    pub aliases: Vec<String>,
     /// ν at 40 °C, cSt.
     pub nu40_cst: f64,
     /// ν at 100 °C, cSt.
@@ -63,12 +66,13 @@ pub fn oils() -> Vec<CatalogueOil> {
         .unwrap_or_default()
 }
 
-/// Find an oil by key or by name (case-insensitive; a name prefix up to its first parenthesis,
+/// Find an oil by key, alias or name (case-insensitive; a name prefix up to its first parenthesis,
 /// e.g. "FVA 3A reference oil", also matches).
 pub fn find(name: &str) -> Option<CatalogueOil> {
     let want = name.trim().to_lowercase();
     oils().into_iter().find(|o| {
         o.key.to_lowercase() == want
+            || o.aliases.iter().any(|a| a.to_lowercase() == want)
             || o.name.to_lowercase() == want
             || o.name
                 .split('(')
@@ -84,7 +88,7 @@ mod tests {
     #[test]
     fn catalogue_parses_and_has_every_oil() {
         let all: Vec<CatalogueOil> = toml::from_str::<CatalogueFile>(OILS_TOML).unwrap().oil;
-        assert_eq!(all.len(), 26);
+        assert_eq!(all.len(), 27);
         for o in &all {
             assert!(o.nu40_cst > o.nu100_cst && o.nu100_cst > 0.0, "{}", o.key);
             assert!((700.0..1100.0).contains(&o.rho15_kg_m3), "{}", o.key);
@@ -109,6 +113,33 @@ mod tests {
         ] {
             assert_eq!(find(k).and_then(|o| o.lubricant_factor), Some(xl), "{k}");
         }
+        // the FEUP/INEGI group's oil codes name the catalogue oils they are
+        for (code, key) in [
+            ("MINR", "m320"),
+            ("PAOR", "p320"),
+            ("ESTR", "e320"),
+            ("PAGD", "g320"),
+            ("MINE", "mine"),
+            ("p150", "p150"),
+        ] {
+            assert_eq!(find(code).map(|o| o.key), Some(key.to_string()), "{code}");
+        }
+        // MINE: its source's μ pairs, and no fitted X_L (the code's is its base class's)
+        let mine = find("MINE").unwrap();
+        assert_eq!(mine.bearing_mu_roller, Some([0.0435, 0.0078]));
+        assert_eq!(mine.bearing_mu_ball, Some([0.044, 0.027]));
+        assert!(mine.lubricant_factor.is_none());
+        // every key and alias names one oil only
+        let mut names: Vec<String> = all
+            .iter()
+            .flat_map(|o| {
+                std::iter::once(o.key.to_lowercase()).chain(o.aliases.iter().map(|a| a.to_lowercase()))
+            })
+            .collect();
+        let n = names.len();
+        names.sort();
+        names.dedup();
+        assert_eq!(names.len(), n);
         assert!(find("w211").is_some() && find("W326").is_some());
         assert!(find("FVA 3A reference oil").is_some());
         assert!(find("no such oil").is_none());

@@ -41,6 +41,20 @@ pub fn orifice_flow(k: f64, k_sum: f64, supply: f64, rho: f64) -> (f64, f64) {
     }
 }
 
+/// Pressure (Pa) ahead of the orifices of a line at nominal `pressure` whose orifices sum to
+/// `k_sum` ([`orifice_coefficient`] at that pressure), fed `supply` (m³/s) of oil of density
+/// `rho` \[derived from the orifice law above\]: when the orifices would pass more than the source
+/// delivers, the line pressure falls until they pass what it delivers; every orifice passes
+/// ∝ √p, so `p_delivered = p · min(1, supply √ρ / k_sum)²`. The nominal pressure with no
+/// orifice (`k_sum` ≤ 0).
+pub fn delivered_pressure(pressure: f64, k_sum: f64, supply: f64, rho: f64) -> f64 {
+    if k_sum <= 0.0 {
+        return pressure;
+    }
+    let cap = (supply.max(0.0) * rho.sqrt() / k_sum).min(1.0);
+    pressure * cap * cap
+}
+
 /// Oil volume fraction of the pockets of a mesh fed `delivered` (m³/s) whose closing pockets expel
 /// `swept` (m³/s): `min(1, delivered/swept)` (1 when nothing is swept).
 pub fn oil_fraction(delivered: f64, swept: f64) -> f64 {
@@ -74,6 +88,22 @@ mod tests {
         let (b, _) = orifice_flow(k2, k1 + k2, supply, rho);
         assert!((a + b - supply).abs() < 1e-15 && (b / a - 3.0).abs() < 1e-12);
         assert_eq!(sa, 0.0);
+    }
+
+    #[test]
+    fn a_short_source_lowers_the_line_pressure_to_what_its_flow_implies() {
+        let (rho, p): (f64, f64) = (850.0, 2e5);
+        let k = orifice_coefficient(0.6 * 4e-6, p);
+        let free = k / rho.sqrt();
+        // a generous source: the nominal pressure
+        assert_eq!(delivered_pressure(p, k, 2.0 * free, rho), p);
+        // half the flow the orifice asks for: a quarter of the pressure, and the orifice law at
+        // that pressure passes exactly the delivered flow
+        let pd = delivered_pressure(p, k, 0.5 * free, rho);
+        assert!((pd / p - 0.25).abs() < 1e-12);
+        let q = orifice_coefficient(0.6 * 4e-6, pd) / rho.sqrt();
+        assert!((q / (0.5 * free) - 1.0).abs() < 1e-12);
+        assert_eq!(delivered_pressure(p, 0.0, 1.0, rho), p);
     }
 
     #[test]

@@ -21,7 +21,7 @@ pub use stats::{summarise, SummaryRow};
 
 use crate::model::{self, Gearbox};
 use crate::physics::oil::KELVIN_OFFSET;
-use crate::scene::{LossScene, OperatingPoint, Source};
+use crate::scene::{LossScene, OperatingPoint, RangeLog, RangeWarning, Source};
 
 /// One row of `validation.csv`.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -85,34 +85,67 @@ pub fn case_dirs(dir: &Path) -> Result<Vec<PathBuf>, ReferenceError> {
     Ok(v)
 }
 
+/// A loss model used outside its range (or an item not counted) in one case and model choice,
+/// over the points that choice evaluated.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct CaseWarning {
+    /// Case name.
+    pub case: String,
+    /// Model choice label.
+    pub model: String,
+    /// The warning (item, range, what was seen).
+    #[serde(flatten)]
+    pub warning: RangeWarning,
+}
+
 /// Evaluate every case under `dir` with every model choice of its family.
 pub fn run_all(dir: &Path) -> Result<Vec<Row>, ReferenceError> {
+    Ok(run_all_with_warnings(dir)?.0)
+}
+
+/// [`run_all`] with the range warnings of every case and model choice.
+pub fn run_all_with_warnings(dir: &Path) -> Result<(Vec<Row>, Vec<CaseWarning>), ReferenceError> {
     let mut rows = Vec::new();
+    let mut warnings = Vec::new();
     for d in case_dirs(dir)? {
-        rows.extend(run_case(&Case::load(&d)?)?);
+        let (r, w) = run_case_with_warnings(&Case::load(&d)?)?;
+        rows.extend(r);
+        warnings.extend(w);
     }
-    Ok(rows)
+    Ok((rows, warnings))
 }
 
 /// Evaluate one case.
 pub fn run_case(c: &Case) -> Result<Vec<Row>, ReferenceError> {
+    Ok(run_case_with_warnings(c)?.0)
+}
+
+/// [`run_case`] with its range warnings per model choice.
+pub fn run_case_with_warnings(c: &Case) -> Result<(Vec<Row>, Vec<CaseWarning>), ReferenceError> {
     let mut rows = Vec::new();
+    let mut warnings = Vec::new();
     for (label, keys) in &c.choices {
         for oil in c.oils() {
-            rows.extend(run_choice(c, label, keys, oil.as_deref())?);
+            let (r, w) = run_choice(c, label, keys, oil.as_deref())?;
+            rows.extend(r);
+            warnings.extend(w.into_iter().map(|warning| CaseWarning {
+                case: c.name.clone(),
+                model: label.to_string(),
+                warning,
+            }));
         }
     }
-    Ok(rows)
+    Ok((rows, warnings))
 }
 
 /// One model choice of a case with one oil (`None`: the model's): its points, and with the
-/// model's own oil its range and trend checks.
+/// model's own oil its range and trend checks; and the range warnings over those points.
 fn run_choice(
     c: &Case,
     label: &str,
     keys: &[(&str, toml::Value)],
     oil: Option<&str>,
-) -> Result<Vec<Row>, ReferenceError> {
+) -> Result<(Vec<Row>, Vec<RangeWarning>), ReferenceError> {
     let mut rows = Vec::new();
     let gb = c.gearbox(keys, oil).map_err(|msg| ReferenceError::Model {
         path: c.model_path.clone(),
@@ -124,8 +157,9 @@ fn run_choice(
         choice: label.to_string(),
         msg: e.to_string(),
     })?;
+    let log = std::cell::RefCell::new(RangeLog::new(&scene));
     let eval = |gear: &str, rpm: f64, torque: f64, temp: f64| -> Result<f64, ReferenceError> {
-        value(&gb, &scene, c, gear, rpm, torque, temp).map_err(|msg| ReferenceError::Case {
+        value(&gb, &scene, c, (gear, rpm, torque, temp), &log).map_err(|msg| ReferenceError::Case {
             path: c.dir.join("case.toml"),
             msg,
         })
@@ -151,7 +185,7 @@ fn run_choice(
         rows.push(row(&name, p.speed_rpm, predicted, p.reference_w, c.kind));
     }
     if oil.is_some() {
-        return Ok(rows);
+        return Ok((rows, log.borrow().warnings(&scene)));
     }
     for r in &c.ranges {
         let predicted = eval(&r.gear, r.speed_rpm, r.torque_nm, r.oil_temp_c)?;
@@ -175,18 +209,18 @@ fn run_choice(
             Kind::Trend,
         ));
     }
-    Ok(rows)
+    let warnings = log.borrow().warnings(&scene);
+    Ok((rows, warnings))
 }
 
-/// The case's quantity at one point: W, or the efficiency (–).
+/// The case's quantity at one point (gear state, rpm, N·m, °C): W, or the efficiency (–); the
+/// point's range checks go into `log`.
 fn value(
     gb: &Gearbox,
     scene: &LossScene,
     c: &Case,
-    gear: &str,
-    rpm: f64,
-    torque: f64,
-    temp_c: f64,
+    (gear, rpm, torque, temp_c): (&str, f64, f64, f64),
+    log: &std::cell::RefCell<RangeLog>,
 ) -> Result<f64, String> {
     let state = gb
         .state_index(gear)
@@ -199,6 +233,7 @@ fn value(
     };
     let mut out = vec![0.0; scene.len()];
     scene.evaluate(&op, &mut out);
+    log.borrow_mut().check(scene, &op);
     let counts = |src: Source| match c.quantity.source() {
         Some(want) => src == want,
         None => c.sources.contains(&src),

@@ -140,6 +140,8 @@ pub struct Info {
     pub meshes: Vec<MeshInfo>,
     /// Gears.
     pub gears: Vec<GearInfo>,
+    /// Bearings: friction model and μ pair with its origin.
+    pub bearings: Vec<super::bearing_info::BearingInfo>,
 }
 
 /// Build the report.
@@ -254,6 +256,7 @@ pub fn info(gb: &Gearbox) -> Info {
         gear_states,
         meshes,
         gears,
+        bearings: super::bearing_info::bearing_infos(gb),
     }
 }
 
@@ -365,6 +368,7 @@ pub fn to_text(info: &Info, gb: &Gearbox) -> String {
             }
         );
     }
+    s.push_str(&super::bearing_info::bearings_text(&info.bearings));
     s
 }
 

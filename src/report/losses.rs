@@ -56,6 +56,8 @@ pub struct LossReport {
     pub skipped: Vec<Skipped>,
     /// Loss models used outside their fitted range at this point, items not counted.
     pub warnings: Vec<RangeWarning>,
+    /// Per bearing: friction model and μ pair with its origin.
+    pub bearings: Vec<super::bearing_info::BearingInfo>,
 }
 
 /// Evaluate the scene at `op` and build the report.
@@ -99,6 +101,7 @@ pub fn losses(gb: &Gearbox, scene: &LossScene, op: &OperatingPoint, oil_temp_c: 
             log.check(scene, op);
             log.warnings(scene)
         },
+        bearings: super::bearing_info::bearing_infos(gb),
     }
 }
 

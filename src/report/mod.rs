@@ -1,4 +1,5 @@
 //! Reports: text/JSON summaries, run outputs (CSV, JSON) and PNG plots.
+pub mod bearing_info;
 pub mod calibration;
 pub mod files;
 pub mod info;

@@ -164,4 +164,6 @@ pub struct ValidationReport<'a> {
     pub rows: &'a [Row],
     /// Summary per case and model.
     pub summary: &'a [SummaryRow],
+    /// Loss models used outside their range, per case and model choice.
+    pub warnings: &'a [crate::reference::CaseWarning],
 }

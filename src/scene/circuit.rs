@@ -11,7 +11,7 @@
 use crate::model::gearbox::{GearMount, Gearbox, SourceKind, Split, Target};
 use crate::model::sections::circuit::MAX_SOURCES;
 use crate::physics::losses::{fling::fling_power, jet};
-use crate::physics::lubrication::{orifice_coefficient, orifice_flow};
+use crate::physics::lubrication::{delivered_pressure, orifice_coefficient, orifice_flow};
 use crate::physics::oil::OilProperties;
 
 use super::automatic::AutoSample;
@@ -183,6 +183,13 @@ impl CircuitScene {
         }
     }
 
+    /// Pressure (Pa) ahead of source `src`'s orifices in sample `s` at oil density `rho`: the
+    /// nominal pressure, or, when the source delivers less than its orifices ask for, the lower
+    /// pressure its flow implies ([`delivered_pressure`]).
+    pub fn line_pressure(&self, src: usize, s: &CircuitSample, rho: f64) -> f64 {
+        delivered_pressure(s.pressure[src], s.k_sum[src], s.supply[src], rho)
+    }
+
     /// Mass flow (kg/s) of every consumer into `mdot`, and its temperature derivative (kg/s/K)
     /// into `dmdot` from the oil's d ln ρ/dT `dln_rho`. No allocation.
     pub fn mass_flows(&self, s: &CircuitSample, rho: f64, dln_rho: f64, mdot: &mut [f64], dmdot: &mut [f64]) {
@@ -198,7 +205,7 @@ impl CircuitScene {
     pub fn evaluate(&self, state: usize, w_in: f64, oil: &OilProperties, s: &CircuitSample, out: &mut [f64]) {
         for &(item, k) in &self.drives {
             if let SourceKind::ElectricPump { efficiency, .. } = self.sources[k].kind {
-                out[item] = s.supply[k] * s.pressure[k] / efficiency;
+                out[item] = s.supply[k] * self.line_pressure(k, s, oil.rho) / efficiency;
             }
         }
         for (l, v) in self.losses.iter().zip(&self.speed) {
@@ -211,7 +218,7 @@ impl CircuitScene {
                     angle,
                 } => {
                     let q = self.flow(consumer, s, oil.rho).0;
-                    let p = s.pressure[self.consumers[consumer].0];
+                    let p = self.line_pressure(self.consumers[consumer].0, s, oil.rho);
                     let vj = vj.unwrap_or_else(|| jet::jet_speed(p, oil.rho));
                     out[item] = jet::impulse_power(oil.rho * q, speed, vj, angle);
                 }

@@ -105,8 +105,9 @@ impl LossScene {
         let Lists {
             mut items,
             mut skipped,
-            warnings,
+            mut warnings,
         } = lists;
+        warnings.extend(super::warning::ineffective_key_warnings(gb));
 
         // The automatic's own parts: open clutch packs, pump, converter.
         let auto = super::automatic::AutoLosses::compile(

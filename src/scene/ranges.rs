@@ -40,36 +40,39 @@ impl RangeLog {
             density: op.oil.rho,
             kinematic_viscosity: op.oil.nu,
         };
-        let mut last = (usize::MAX, usize::MAX);
+        let mut last = [(usize::MAX, usize::MAX); 2];
         for (item, m, w) in scene.churning_models(op.state, op.input_speed) {
-            if let Some((c, v)) = m.out_of_range(w, &oil) {
-                let e = &mut self.seen[item][c.index()];
-                // a planet has several orbit nodes: count the point once per item and range
-                if last != (item, c.index()) {
-                    e.0 += 1;
+            let checks = [m.out_of_range(w, &oil), m.law_disagreement(w, &oil)];
+            for (slot, found) in checks.into_iter().enumerate() {
+                if let Some((c, v)) = found {
+                    // a planet has several orbit nodes: count the point once per item and range
+                    let first = last[slot] != (item, c.index());
+                    last[slot] = (item, c.index());
+                    self.record(item, c, v, first);
                 }
-                last = (item, c.index());
-                e.1 = e.1.min(v);
-                e.2 = e.2.max(v);
             }
         }
         for (item, speed) in scene.churning_pitch_speeds(op.state, op.input_speed) {
             if let Some((c, v)) = above_dip_speed(speed) {
-                let e = &mut self.seen[item][c.index()];
-                e.0 += 1;
-                e.1 = e.1.min(v);
-                e.2 = e.2.max(v);
+                self.record(item, c, v, true);
             }
         }
         let air = crate::physics::losses::windage::AIR;
         for (item, m, w) in scene.windage_models(op.state, op.input_speed) {
             if let Some((c, v)) = m.out_of_range(w, &air) {
-                let e = &mut self.seen[item][c.index()];
-                e.0 += 1;
-                e.1 = e.1.min(v);
-                e.2 = e.2.max(v);
+                self.record(item, c, v, true);
             }
         }
+    }
+
+    /// One out-of-range value `v` of check `c` for `item`; `count` adds the point.
+    fn record(&mut self, item: usize, c: RangeCheck, v: f64, count: bool) {
+        let e = &mut self.seen[item][c.index()];
+        if count {
+            e.0 += 1;
+        }
+        e.1 = e.1.min(v);
+        e.2 = e.2.max(v);
     }
 
     /// The static warnings of `scene` followed by one warning per item and range met.

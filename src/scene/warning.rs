@@ -30,3 +30,18 @@ pub fn above_oil_warning(mesh: &str, wet: f64) -> RangeWarning {
         seen: format!("{:.0} % of the mesh zone above the oil", 100.0 * (1.0 - wet).clamp(0.0, 1.0)),
     }
 }
+
+/// One warning per bearing key that has no effect in its combination (the model's
+/// `Bearing::ineffective`): the key path, why, and that the value is ignored.
+pub fn ineffective_key_warnings(gb: &crate::model::Gearbox) -> Vec<RangeWarning> {
+    gb.bearings
+        .iter()
+        .flat_map(|b| {
+            b.ineffective.iter().map(move |(key, why)| RangeWarning {
+                item: format!("bearing {}", b.name),
+                range: format!("{key} has no effect: {why}"),
+                seen: "the value given is ignored".into(),
+            })
+        })
+        .collect()
+}

@@ -136,8 +136,46 @@ pub(crate) struct SkfChoices {
     pub drag_form: DragForm,
     /// V_M of the drag term.
     pub drag_vm: Option<f64>,
-    /// The catalogue oil's fitted (μ_bl, μ_EHL) for this kind of bearing.
-    pub oil_mu: Option<[f64; 2]>,
+    /// The catalogue oil's fitted (μ_bl, μ_EHL) for this kind of bearing, with the oil's key and
+    /// the pair's source.
+    pub oil_mu: Option<([f64; 2], String)>,
+}
+
+/// The SKF sliding friction coefficients of one bearing and where each comes from.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct BearingMu {
+    /// μ_bl.
+    pub mu_bl: f64,
+    /// μ_EHL.
+    pub mu_ehl: f64,
+    /// Where μ_bl comes from: the model file's key, the catalogue oil's fitted pair, or SKF's
+    /// constant.
+    pub mu_bl_origin: String,
+    /// Where μ_EHL comes from (as `mu_bl_origin`).
+    pub mu_ehl_origin: String,
+}
+
+/// μ_bl and μ_EHL of a bearing of SKF form `kind`: the model file's keys, else the catalogue
+/// oil's fitted pair, else SKF's constants (μ_bl 0.12; μ_EHL by type), each with its origin.
+pub(crate) fn mu_pair(kind: SkfKind, c: &SkfChoices) -> BearingMu {
+    let skf_ehl = match kind {
+        SkfKind::CylindricalRoller => MU_EHL_CYLINDRICAL,
+        SkfKind::TaperedRoller => MU_EHL_TAPERED,
+        SkfKind::DeepGrooveBall | SkfKind::AngularContactBall | SkfKind::FourPointContactBall => MU_EHL,
+    };
+    let pick = |key: Option<f64>, name: &str, k: usize, skf: f64| match (key, &c.oil_mu) {
+        (Some(v), _) => (v, format!("model file key {name}")),
+        (None, Some((m, src))) => (m[k], format!("catalogue oil {src}")),
+        (None, None) => (skf, format!("SKF constant ({name} = {skf})")),
+    };
+    let (mu_bl, mu_bl_origin) = pick(c.mu_bl, "mu_bl", 0, MU_BL);
+    let (mu_ehl, mu_ehl_origin) = pick(c.mu_ehl, "mu_ehl", 1, skf_ehl);
+    BearingMu {
+        mu_bl,
+        mu_ehl,
+        mu_bl_origin,
+        mu_ehl_origin,
+    }
 }
 
 /// The SKF (2004) model of catalogue bearing `entry` at key path `p`: its series row; μ_bl and
@@ -181,15 +219,13 @@ pub(crate) fn skf(
     };
     let size = size_of(entry);
     let h = c.oil_above / size.mean();
-    let (mu_ehl, drag_vm) = match kind {
-        SkfKind::CylindricalRoller => (MU_EHL_CYLINDRICAL, drag_vm_roller(h)),
-        SkfKind::TaperedRoller => (MU_EHL_TAPERED, drag_vm_roller(h)),
+    let drag_vm = match kind {
+        SkfKind::CylindricalRoller | SkfKind::TaperedRoller => drag_vm_roller(h),
         SkfKind::DeepGrooveBall | SkfKind::AngularContactBall | SkfKind::FourPointContactBall => {
-            (MU_EHL, drag_vm_ball(h))
+            drag_vm_ball(h)
         }
     };
-    let mu_bl = c.mu_bl.or(c.oil_mu.map(|m| m[0])).unwrap_or(MU_BL);
-    let mu_ehl = c.mu_ehl.or(c.oil_mu.map(|m| m[1])).unwrap_or(mu_ehl);
+    let BearingMu { mu_bl, mu_ehl, .. } = mu_pair(kind, c);
     for (k, v) in [("mu_bl", mu_bl), ("mu_ehl", mu_ehl)] {
         problems.in_range(&format!("{p}.{k}"), v, 0.0, 0.5, "");
     }

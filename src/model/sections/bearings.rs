@@ -5,6 +5,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use serde::{Deserialize, Serialize};
 
+pub use super::bearing_friction::BearingMu;
 use super::bearing_friction::*;
 use super::common::*;
 use super::gears::{Gear, GearMount};
@@ -174,6 +175,10 @@ pub struct Bearing {
     pub preload: (f64, f64),
     /// Heat destinations named in the file.
     pub heat_to: Option<Vec<(String, f64)>>,
+    /// SKF model: μ_bl and μ_EHL with their origins (None: Palmgren).
+    pub mu: Option<BearingMu>,
+    /// Keys the file sets that have no effect in this combination (key path and why).
+    pub ineffective: Vec<(String, String)>,
 }
 
 fn normalise(s: &str) -> String {
@@ -248,9 +253,10 @@ pub(crate) fn validate_bearings(
         );
         problems.in_range(&format!("{p}.axial_preload_n"), b.axial_preload_n, 0.0, 1e7, " N");
         let axis = mount.and_then(|m| axis_height(m, parts, gears));
-        let Some(friction) = friction(b, entry, &series, axis, oil, &p, problems) else {
+        let Some((friction, mu)) = friction(b, entry, &series, axis, oil, &p, problems) else {
             continue;
         };
+        let ineffective = ineffective_keys(b, mu.is_some(), axis, oil, entry, &p);
         let heat = heat_to(&b.heat_to, nodes, &format!("{p}.heat_to"), problems);
         let Some(mount) = mount else { continue };
         let key = match mount {
@@ -267,6 +273,8 @@ pub(crate) fn validate_bearings(
             friction,
             preload: (b.radial_preload_n, b.axial_preload_n),
             heat_to: heat,
+            mu,
+            ineffective,
         });
     }
     check_statics(&per_body, parts, &mut out, problems);
@@ -351,8 +359,18 @@ fn axis_height(mount: BearingMount, parts: &Parts<'_>, gears: &[Gear]) -> Option
     }
 }
 
+/// Height of the oil above the lowest point of bearing `b` (SKF's H), m: 0 for grease or an
+/// unknown axis.
+fn oil_above(b: &BearingSpec, entry: &CatalogueBearing, axis: Option<f64>, oil: &OilBath<'_>) -> f64 {
+    match (axis, b.lubrication.unwrap_or_default().method()) {
+        (Some(h), Lubrication::OilBath) => oil.level - (h - 0.5 * size_of(entry).outside),
+        _ => 0.0,
+    }
+}
+
 /// The friction model of bearing `b` (`model`, default SKF where the catalogue has its row),
-/// with the oil height above its lowest point (SKF's H) for the drag term.
+/// with the oil height above its lowest point (SKF's H) for the drag term; for SKF also its μ
+/// pair with their origins.
 fn friction(
     b: &BearingSpec,
     entry: &CatalogueBearing,
@@ -361,42 +379,90 @@ fn friction(
     oil: &OilBath<'_>,
     p: &str,
     problems: &mut Problems,
-) -> Option<BearingFriction> {
-    let lubrication = b.lubrication.unwrap_or_default().method();
-    let choice = b
-        .model
-        .unwrap_or(if entry.kind.has_skf() && entry.series.is_some() {
-            BearingModelChoice::Skf
-        } else {
-            BearingModelChoice::Palmgren
-        });
-    let oil_above = match (axis, lubrication) {
-        (Some(h), Lubrication::OilBath) => oil.level - (h - 0.5 * size_of(entry).outside),
-        _ => 0.0,
-    };
-    match choice {
+) -> Option<(BearingFriction, Option<BearingMu>)> {
+    match model_choice(b, entry) {
         BearingModelChoice::Skf => {
             let fitted = oil.catalogue.and_then(|o| {
-                if entry.kind.is_roller() {
-                    o.bearing_mu_roller
+                let (pair, kind) = if entry.kind.is_roller() {
+                    (o.bearing_mu_roller, "roller")
                 } else {
-                    o.bearing_mu_ball
-                }
+                    (o.bearing_mu_ball, "ball")
+                };
+                let src = o.bearing_mu_source.as_deref().unwrap_or("no source given");
+                pair.map(|m| (m, format!("{} ({kind} pair: {src})", o.key)))
             });
             let choices = SkfChoices {
                 sealed: b.sealed,
-                lubrication,
-                oil_above,
+                lubrication: b.lubrication.unwrap_or_default().method(),
+                oil_above: oil_above(b, entry, axis, oil),
                 mu_bl: b.mu_bl,
                 mu_ehl: b.mu_ehl,
                 drag_form: b.drag_form.unwrap_or_default().form(),
                 drag_vm: b.drag_vm,
                 oil_mu: fitted,
             };
-            skf(entry, series, &choices, p, problems)
+            let f = skf(entry, series, &choices, p, problems)?;
+            let mu = skf_kind(entry.kind).map(|k| mu_pair(k, &choices));
+            Some((f, mu))
         }
-        BearingModelChoice::Palmgren => palmgren(entry, b.sealed, p, problems),
+        BearingModelChoice::Palmgren => palmgren(entry, b.sealed, p, problems).map(|f| (f, None)),
     }
+}
+
+/// The friction model bearing `b` asks for (default: SKF where the catalogue has its row).
+fn model_choice(b: &BearingSpec, entry: &CatalogueBearing) -> BearingModelChoice {
+    b.model
+        .unwrap_or(if entry.kind.has_skf() && entry.series.is_some() {
+            BearingModelChoice::Skf
+        } else {
+            BearingModelChoice::Palmgren
+        })
+}
+
+/// Keys bearing `b` (at key path `p`) sets that change nothing in its combination, each with
+/// the reason: the SKF keys (`mu_bl`, `mu_ehl`, `drag_form`, `drag_vm`) and `lubrication` with
+/// the Palmgren model (its f0 is the oil-bath value, no drag term); the drag keys with grease or
+/// with the bearing wholly above the static oil (SKF's drag term is zero there).
+fn ineffective_keys(
+    b: &BearingSpec,
+    skf: bool,
+    axis: Option<f64>,
+    oil: &OilBath<'_>,
+    entry: &CatalogueBearing,
+    p: &str,
+) -> Vec<(String, String)> {
+    let drag_keys = [
+        ("drag_form", b.drag_form.is_some()),
+        ("drag_vm", b.drag_vm.is_some()),
+    ];
+    let mut out = Vec::new();
+    if !skf {
+        let set = [
+            ("mu_bl", b.mu_bl.is_some()),
+            ("mu_ehl", b.mu_ehl.is_some()),
+            ("lubrication", b.lubrication.is_some()),
+        ];
+        for (k, _) in set.iter().chain(&drag_keys).filter(|x| x.1) {
+            out.push((
+                format!("{p}.{k}"),
+                "model = \"palmgren\" does not use it (SKF keys; Palmgren's f0 is the oil-bath value)".into(),
+            ));
+        }
+        return out;
+    }
+    let why = if b.lubrication.unwrap_or_default().method() == Lubrication::Grease {
+        Some("grease: the SKF drag term applies to an oil bath only")
+    } else if oil_above(b, entry, axis, oil) <= 0.0 {
+        Some("the bearing lies wholly above the static oil: the SKF drag term is zero")
+    } else {
+        None
+    };
+    if let Some(why) = why {
+        for (k, _) in drag_keys.iter().filter(|x| x.1) {
+            out.push((format!("{p}.{k}"), why.into()));
+        }
+    }
+    out
 }
 
 /// Statics: at most two bearings per body, at different positions; one locating (the one marked,

@@ -7,7 +7,9 @@ use crate::model::choice::choice;
 use crate::model::problems::Problems;
 use crate::model::source::Source;
 use crate::physics::losses::churning::{
-    changenet::ChangenetParams, seetharaman::CavityTerm, ChurningConfig, ChurningModel,
+    changenet::{ChangenetJoin, ChangenetParams},
+    seetharaman::CavityTerm,
+    ChurningConfig, ChurningModel,
 };
 use crate::physics::losses::sliding::friction::{
     BenedictKelley, ContactLineLoad, FrictionLaw, IsoTc60, Schlenk,
@@ -35,6 +37,20 @@ choice!(ChurningChoice {
     Seetharaman = "seetharaman",
     Stavytskyi = "stavytskyi",
     Off = "off",
+});
+
+/// `changenet_join`: how the two Changenet–Velex laws are joined (docs/physics.md §5).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum ChangenetJoinChoice {
+    /// The log-linear bridge between the regimes (default).
+    #[default]
+    Bridge,
+    /// Where the two laws cross (the smaller of the two).
+    Crossing,
+}
+choice!(ChangenetJoinChoice {
+    Bridge = "bridge",
+    Crossing = "crossing",
 });
 
 /// `windage`: the drag of gears that run above the oil, in air (docs/physics.md §14).
@@ -254,6 +270,9 @@ pub struct LossesSpec {
     /// Changenet–Velex high-Re law [factor, exp(h/D), exp(V0/D³), exp(Fr), exp(b/D)] \[recalled\].
     #[serde(default)]
     pub changenet_high: Option<[f64; 5]>,
+    /// How the two Changenet–Velex laws are joined (default `bridge`).
+    #[serde(default)]
+    pub changenet_join: Option<ChangenetJoinChoice>,
     /// Loss multipliers: a source (`churning = 1.3`) or one item (`"bearing:hss_a" = 0.8`).
     #[serde(default)]
     pub multiplier: Option<std::collections::BTreeMap<String, f64>>,
@@ -446,6 +465,10 @@ fn churning(l: &LossesSpec, sump_volume_l: Option<f64>, problems: &mut Problems)
             }
         }
     }
+    cfg.changenet.join = match l.changenet_join.unwrap_or_default() {
+        ChangenetJoinChoice::Bridge => ChangenetJoin::Bridge,
+        ChangenetJoinChoice::Crossing => ChangenetJoin::Crossing,
+    };
     if let Some(v) = sump_volume_l {
         cfg.changenet.sump_oil_volume = v * 1e-3;
     } else if model == ChurningChoice::Changenet {

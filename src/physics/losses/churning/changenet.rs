@@ -35,6 +35,20 @@ use super::immersion::immersion_angle;
 use super::{check_positive, ChurningError, ChurningGear, ChurningPower, OilState};
 use std::f64::consts::PI;
 
+/// How the low and the high law are joined between their Re_c regimes (docs/physics.md §5 "The
+/// bridge and its law factor").
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum ChangenetJoin {
+    /// Each law inside its own regime; ln C_m linear in ln Re_c between them (default).
+    #[default]
+    Bridge,
+    /// Where the two laws cross: C_m = min(C_low, C_high) at every Re_c — the low law below the
+    /// crossing speed, the high law above it (C_high/C_low ∝ ω^−0.35 at fixed ν), continuous in
+    /// ω and ν, but one law used outside its Re_c regime wherever the crossing lies outside
+    /// 6000–9000 \[derived\].
+    Crossing,
+}
+
 /// Parameters of the Changenet–Velex model (all \[recalled\] except V0 and g).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ChangenetParams {
@@ -53,6 +67,8 @@ pub struct ChangenetParams {
     pub include_flanks: bool,
     /// Gravity g, m/s².
     pub gravity: f64,
+    /// How the two laws are joined.
+    pub join: ChangenetJoin,
 }
 
 impl Default for ChangenetParams {
@@ -65,6 +81,7 @@ impl Default for ChangenetParams {
             re_c_high: 9000.0,
             include_flanks: true,
             gravity: super::STANDARD_GRAVITY,
+            join: ChangenetJoin::Bridge,
         }
     }
 }
@@ -91,6 +108,7 @@ pub struct ChangenetGear {
     ln_re_c_low: f64,
     inv_ln_span: f64,
     g: f64,
+    join: ChangenetJoin,
 }
 
 /// One gear's terms of a weighted sum of its immersions ([`ChangenetGear::sum_terms`]).
@@ -166,6 +184,7 @@ impl ChangenetGear {
             ln_re_c_low: p.re_c_low.ln(),
             inv_ln_span: 1.0 / (p.re_c_high / p.re_c_low).ln(),
             g: p.gravity,
+            join: p.join,
         })
     }
 
@@ -219,9 +238,18 @@ impl ChangenetGear {
         (self.re_c_low, self.re_c_high)
     }
 
-    /// Moment coefficient C_m (low law, log-linear bridge, high law; see the module docs).
+    /// How the two laws are joined.
+    pub fn join(&self) -> ChangenetJoin {
+        self.join
+    }
+
+    /// Moment coefficient C_m (low law, log-linear bridge, high law; see the module docs; with
+    /// [`ChangenetJoin::Crossing`] the smaller of the two laws).
     pub fn moment_coefficient(&self, omega: f64, oil: &OilState) -> f64 {
         let w = omega.abs();
+        if self.join == ChangenetJoin::Crossing {
+            return self.low_law(w, oil).min(self.high_law(w));
+        }
         let ln_rc = self.critical_reynolds(w, oil).ln();
         let t = (ln_rc - self.ln_re_c_low) * self.inv_ln_span;
         if t <= 0.0 {
@@ -235,6 +263,35 @@ impl ChangenetGear {
             let (ca, cb) = (self.low_law(wa, oil), self.high_law(wb));
             (ca.ln() + t * (cb / ca).ln()).exp()
         }
+    }
+
+    /// How far apart the two laws are at the bridge's ends for `oil`: the larger, over the two
+    /// speeds where Re_c = `re_c_low` and `re_c_high`, of max(C_low/C_high, C_high/C_low) (≥ 1;
+    /// 1 for a dry gear). [derived] At fixed ν both laws fall with speed (C_low ∝ ω^(2a_Fr + a_Re),
+    /// C_high ∝ ω^(2b_Fr)), so the bridge joins C_low(ω_a) to C_high(ω_b) across a 1.5× change of
+    /// Re_c; when this factor is large, the power changes by about that factor within that band,
+    /// and, since Re_c ∝ 1/ν, within the matching change of oil temperature.
+    pub fn law_factor(&self, oil: &OilState) -> f64 {
+        if !self.immersed || self.low_geo <= 0.0 || self.high_geo <= 0.0 {
+            return 1.0;
+        }
+        let ratio = |re_c: f64| {
+            let w = re_c * oil.kinematic_viscosity / (self.rp * self.b);
+            let r = self.low_law(w, oil) / self.high_law(w);
+            r.max(1.0 / r)
+        };
+        let f = ratio(self.re_c_low).max(ratio(self.re_c_high));
+        if f.is_finite() {
+            f
+        } else {
+            1.0
+        }
+    }
+
+    /// (C_low, C_high): both laws' moment coefficients at ω (rad/s) and `oil`, whatever the regime.
+    pub fn law_coefficients(&self, omega: f64, oil: &OilState) -> (f64, f64) {
+        let w = omega.abs();
+        (self.low_law(w, oil), self.high_law(w))
     }
 
     fn low_law(&self, w: f64, oil: &OilState) -> f64 {
@@ -387,6 +444,79 @@ mod tests {
                 w *= 1.02;
             }
         }
+    }
+
+    /// The laws' factor at the bridge ends: both ratios evaluated by hand, and the factor grows
+    /// with ν as ν^(2(a_Fr − b_Fr)) = ν^0.56 at fixed geometry (both ends scale alike).
+    #[test]
+    fn law_factor_is_the_larger_ratio_at_the_bridge_ends() {
+        let g = fzg_wheel(g_h());
+        let m = model(&g, ChangenetParams::default());
+        let rp = g.pitch_radius;
+        let d = 2.0 * rp;
+        let (hd, vd, bd) = (g_h() / d, 1.5e-3 / d.powi(3), g.face_width / d);
+        // C_low/C_high at Re_c for kinematic viscosity nu, by hand
+        let lo_over_hi = |re_c: f64, nu: f64| {
+            let w = re_c * nu / (rp * g.face_width);
+            let fr = w * w * rp / 9.80665;
+            let re = w * rp * rp / nu;
+            let lo = 1.366 * hd.powf(0.45) * vd.powf(0.1) * fr.powf(-0.6) * re.powf(-0.21);
+            let hi = 3.644 * hd.powf(0.1) * vd.powf(-0.35) * fr.powf(-0.88) * bd.powf(0.85);
+            lo / hi
+        };
+        for nu in [5e-6, 30e-6, 90e-6, 400e-6] {
+            let o = OilState {
+                density: 870.0,
+                kinematic_viscosity: nu,
+            };
+            let expect = [6000.0, 9000.0]
+                .map(|r| lo_over_hi(r, nu))
+                .into_iter()
+                .map(|r| r.max(1.0 / r))
+                .fold(1.0, f64::max);
+            assert!((m.law_factor(&o) / expect - 1.0).abs() < 1e-12, "nu {nu}");
+            // the laws' ratio scales as nu^(2(a_Fr - b_Fr)) = nu^0.56 at a fixed Re_c
+            let k = lo_over_hi(6000.0, 4.0 * nu) / lo_over_hi(6000.0, nu);
+            assert!((k / 4f64.powf(0.56) - 1.0).abs() < 1e-12);
+        }
+        let dry = model(&fzg_wheel(-0.01), ChangenetParams::default());
+        assert_eq!(dry.law_factor(&oil()), 1.0);
+    }
+
+    /// The crossing join: the smaller law at every speed, continuous, the low law below the
+    /// crossing and the high law above it; equal to the bridge wherever both use the same law.
+    #[test]
+    fn crossing_join_is_the_smaller_law_and_continuous() {
+        let g = fzg_wheel(g_h());
+        let cross = model(
+            &g,
+            ChangenetParams {
+                join: ChangenetJoin::Crossing,
+                ..Default::default()
+            },
+        );
+        let bridge = model(&g, ChangenetParams::default());
+        let o = oil();
+        let (mut low_side, mut high_side) = (false, false);
+        let mut prev = cross.power(1.0, &o).total;
+        let mut w = 1.0;
+        while w < 5000.0 {
+            let w2 = w * 1.01;
+            let v = cross.power(w2, &o).total;
+            assert!((v / prev - 1.0).abs() < 0.05, "jump at {w2}");
+            let (cl, ch) = (cross.low_law(w2, &o), cross.high_law(w2));
+            let c = cross.moment_coefficient(w2, &o);
+            assert_eq!(c, cl.min(ch));
+            low_side |= cl < ch;
+            high_side |= ch < cl;
+            let rc = cross.critical_reynolds(w2, &o);
+            if (rc <= 6000.0 && cl <= ch) || (rc >= 9000.0 && ch <= cl) {
+                assert!((v / bridge.power(w2, &o).total - 1.0).abs() < 1e-12);
+            }
+            prev = v;
+            w = w2;
+        }
+        assert!(low_side && high_side);
     }
 
     /// Finding (documented): inside the bridge P ∝ ω^(3 + s), s = ln(C_b/C_a)/ln 1.5. For a thick oil

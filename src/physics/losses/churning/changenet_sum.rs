@@ -52,9 +52,16 @@ pub struct ChangenetAtSpeed {
 
 impl ChangenetSum {
     /// The sum of `parts` (gear, weight); `None` when they are not immersions of one gear (r_p,
-    /// b, exponents, regime limits or g differ) or the list is empty.
+    /// b, exponents, regime limits or g differ), use the crossing join, or the list is empty.
     pub fn new(parts: &[(ChangenetGear, f64)]) -> Option<Self> {
         let (first, _) = parts.first()?;
+        // The crossing join has no closed sum here: those gears are evaluated one by one.
+        if parts
+            .iter()
+            .any(|(g, _)| g.join() != super::changenet::ChangenetJoin::Bridge)
+        {
+            return None;
+        }
         let t0 = first.sum_terms();
         let [rp, b, lf, lr, hf, re_lo, re_hi, _] = t0.form;
         let mut sum = ChangenetSum {

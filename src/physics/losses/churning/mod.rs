@@ -30,7 +30,7 @@ pub mod stavytskyi;
 use std::f64::consts::PI;
 use std::fmt;
 
-pub use changenet::{ChangenetGear, ChangenetParams};
+pub use changenet::{ChangenetGear, ChangenetJoin, ChangenetParams};
 pub use changenet_sum::{ChangenetAtSpeed, ChangenetSum};
 pub use immersion::Immersion;
 pub use ranges::RangeCheck;
