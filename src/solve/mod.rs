@@ -4,6 +4,7 @@ pub mod drive;
 pub(crate) mod driver;
 pub mod equations;
 pub mod equilibrium;
+pub(crate) mod events;
 pub mod rosenbrock;
 pub mod rows;
 pub mod sensitivity;

@@ -155,6 +155,11 @@ pub fn mesh_wall(mut net: ThermalNetwork, spec: &WallMeshSpec, problems: &mut Pr
         {
             problems.push(path, &spec.node, "a cooler side cannot be meshed as a wall")
         }
+        Some(h) if net.controls.iter().any(|c| c.reads_or_heats(h)) => problems.push(
+            path,
+            &spec.node,
+            "a controller's sensor or heater node cannot be meshed as a wall",
+        ),
         Some(_) => {}
     }
     let Some(h) = h.filter(|_| problems.len() == start) else {
