@@ -305,3 +305,60 @@ fn ten_thousand_switches_keep_the_energy_balance() {
         }
     }
 }
+
+/// Steady state with a switching heater: no mode has an equilibrium (on, the oil would settle
+/// above 45 °C; off, below 40 °C), so the steady job reports the limit cycle: its period against
+/// the analytic one (the switching instants of the exact solution once they repeat), the oil's
+/// band between the set points.
+#[test]
+fn steady_state_reports_the_limit_cycle() {
+    use geartherm::solve::equilibrium::equilibrium;
+    use geartherm::solve::steady::SteadyOptions;
+    let (scene, inputs, src) = scene();
+    let eq = equilibrium(&scene, inputs, None, &SteadyOptions::default()).unwrap();
+    let c = eq.limit_cycle.expect("a limit cycle");
+    let (switches, _) = analytic(src, 30_000.0, 1000.0);
+    let m = switches.len();
+    let exact = switches[m - 1] - switches[m - 3];
+    let k = KELVIN_OFFSET;
+    println!(
+        "period {} s (analytic {exact} s), oil mean {:.4} °C, band {:.6}–{:.6} °C",
+        c.period_s,
+        c.mean_k[0] - k,
+        c.min_k[0] - k,
+        c.max_k[0] - k
+    );
+    assert!(
+        (c.period_s - exact).abs() < 1e-5,
+        "period {} vs {exact}",
+        c.period_s
+    );
+    assert!(
+        (c.min_k[0] - (ON_C + k)).abs() < 1e-4,
+        "oil min {}",
+        c.min_k[0] - k
+    );
+    assert!(
+        (c.max_k[0] - (OFF_C + k)).abs() < 1e-4,
+        "oil max {}",
+        c.max_k[0] - k
+    );
+    assert!(c.mean_k[0] > ON_C + k && c.mean_k[0] < OFF_C + k);
+    assert_eq!(eq.solution.temperatures, c.mean_k);
+}
+
+/// A heater whose set points lie below the temperature the network settles at without it: the
+/// equilibrium with the heater off, no cycle.
+#[test]
+fn steady_state_with_a_consistent_mode_is_an_equilibrium() {
+    use geartherm::solve::equilibrium::equilibrium;
+    use geartherm::solve::steady::SteadyOptions;
+    let mut scene = fzg_with(&heater_network(5.0, 10.0, POWER, C1));
+    scene.frozen_oil_temp = Some(40.0 + KELVIN_OFFSET);
+    let inputs = steady_inputs(0.0, 0.0);
+    let eq = equilibrium(&scene, inputs, None, &SteadyOptions::default()).unwrap();
+    assert!(eq.limit_cycle.is_none());
+    // Off: no source but the (standstill) losses; the oil above the heater's off point.
+    assert!(eq.solution.temperatures[0] > 10.0 + KELVIN_OFFSET);
+    assert!(eq.solution.method.contains("newton"));
+}

@@ -5,6 +5,7 @@ pub(crate) mod driver;
 pub mod equations;
 pub mod equilibrium;
 pub(crate) mod events;
+pub mod limit_cycle;
 pub mod rosenbrock;
 pub mod rows;
 pub mod sensitivity;
