@@ -19,7 +19,6 @@ use geartherm::solve::transient::{integrate, LinearAlgebra, Method, TransientOpt
 mod wall;
 
 #[path = "../tests/common/mod.rs"]
-#[allow(dead_code)]
 mod common;
 
 const MODELS: [&str; 4] = [
