@@ -617,6 +617,10 @@ fn integrate_segment<M: JacobianMatrix, LS: IterationLu<M>>(
             retry = false;
             if *t < t1 {
                 r.eval_f(*t)?;
+                if event.is_some() {
+                    // f has jumped: a starting step for the new mode, at most the proposal.
+                    h = d.restart_step(r.y.host(), r.f.host(), h, t1 - *t);
+                }
             }
         } else {
             r.stats.rejected += 1;
