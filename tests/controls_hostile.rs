@@ -163,3 +163,34 @@ fn targets_are_checked() {
         "not a key of a two_point controller",
     );
 }
+
+/// `steady` on a network whose fan cycles: exit 0, `method` = `limit_cycle`, the oil's band
+/// between the set points, a period; the text names the controller.
+#[test]
+fn steady_reports_a_cycling_fan() {
+    let d = tempfile::tempdir().unwrap();
+    let m = model_with(d.path(), &two_point("60.0", "55.0", "oil", COOLER));
+    let args = [
+        m.to_str().unwrap(),
+        "--gear",
+        "1",
+        "--speed-rpm",
+        "3000",
+        "--torque-nm",
+        "150",
+    ];
+    let o = bin().arg("steady").args(args).arg("--json").output().unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["method"], "limit_cycle");
+    let c = &v["limit_cycle"];
+    let (lo, hi) = (
+        c["min_c"]["oil"].as_f64().unwrap(),
+        c["max_c"]["oil"].as_f64().unwrap(),
+    );
+    assert!((lo - 55.0).abs() < 1e-6 && (hi - 60.0).abs() < 1e-6, "{lo} {hi}");
+    assert!(c["period_s"].as_f64().unwrap() > 0.0);
+    let o = bin().arg("steady").args(args).output().unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("no equilibrium, controller fan cycles"), "{text}");
+}
