@@ -18,6 +18,9 @@ use geartherm::solve::transient::{integrate, LinearAlgebra, Method, TransientOpt
 #[path = "../tests/common/wall.rs"]
 mod wall;
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 const MODELS: [&str; 4] = [
     "models/at6_lepelletier.toml",
     "models/fzg_c.toml",
@@ -118,5 +121,71 @@ fn networks(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(solve, benches, networks);
+/// An hour of a thermostatic heater on a 50 J/K oil node with a 0.5 K band (the stress run of
+/// `tests/controls.rs`, about 36 000 switches), ROS3 and BDF: the run's time over its switches is
+/// the cost per event (docs/performance.md, "Controllers that switch"). Run alone with
+/// `cargo bench --bench solve -- switching`.
+fn switching(c: &mut Criterion) {
+    let net = r#"
+[thermal]
+oil_node = "oil"
+initial_temp_c = 30.0
+[[thermal.nodes]]
+name = "oil"
+capacity_j_per_k = 50.0
+[[thermal.nodes]]
+name = "casing"
+capacity_j_per_k = 5000.0
+[[thermal.boundaries]]
+name = "ambient"
+temp_c = 20.0
+[[thermal.links]]
+between = ["oil", "casing"]
+conductance_w_per_k = 20.0
+[[thermal.links]]
+between = ["casing", "ambient"]
+conductance_w_per_k = 10.0
+[[thermal.controls]]
+name = "heater"
+kind = "two_point"
+sensor = "oil"
+on_c = 40.0
+off_c = 40.5
+heater_w = 1500.0
+"#;
+    let mut scene = common::fzg_with(net);
+    scene.frozen_oil_temp = Some(40.0 + geartherm::physics::oil::KELVIN_OFFSET);
+    let inputs = common::steady_inputs(0.0, 0.0);
+    let segs: Vec<_> = (0..60)
+        .map(|k| geartherm::solve::transient::Segment {
+            t0: 60.0 * k as f64,
+            t1: 60.0 * (k + 1) as f64,
+            inputs,
+        })
+        .collect();
+    let mut g = c.benchmark_group("switching");
+    g.sample_size(10);
+    for m in [Method::Ros3, Method::Bdf] {
+        let o = TransientOptions {
+            method: m,
+            rtol: 1e-6,
+            atol: 1e-6,
+            ..TransientOptions::default()
+        };
+        let t = integrate(&scene, &segs, &o, &mut |_, _| {}).unwrap();
+        println!(
+            "switching/{}: {} switches, {} steps, {} rejected",
+            m.name(),
+            t.events.len(),
+            t.stats.steps,
+            t.stats.rejected
+        );
+        g.bench_function(m.name(), |b| {
+            b.iter(|| integrate(&scene, &segs, &o, &mut |_, _| {}).unwrap())
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(solve, benches, networks, switching);
 criterion_main!(solve);

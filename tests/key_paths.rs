@@ -79,6 +79,43 @@ to = { sump = 1.0 }
 item = "churning:s1_ring"
 to = { sump = 0.5, housing = 0.5 }
 
+[[thermal.coolers]]
+name = "fan_cooler"
+hot = "sump"
+cold = "coolant"
+effectiveness = 0.5
+capacity_rate_w_per_k = 40.0
+
+[[thermal.controls]]
+name = "fan"
+kind = "two_point"
+sensor = "sump"
+on_c = 90.0
+off_c = 85.0
+initial_on = false
+link = "shafts-oil"
+off_fraction = 0.2
+note = "test"
+
+[[thermal.controls]]
+name = "heater"
+kind = "two_point"
+sensor = "sump"
+on_c = 20.0
+off_c = 30.0
+heater_w = 500.0
+heater_node = "sump"
+
+[[thermal.controls]]
+name = "bypass"
+kind = "valve"
+sensor = "sump"
+closed_c = 70.0
+open_c = 85.0
+min_share = 0.05
+max_share = 0.95
+cooler = "fan_cooler"
+
 [thermal.wall_mesh]
 node = "housing"
 around = 4

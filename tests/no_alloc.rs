@@ -143,3 +143,73 @@ fn ros3_allocates_nothing_per_step_or_row() {
     assert!(long_steps > 5 * short_steps);
     assert_eq!(long, short, "{per_row} allocations per row");
 }
+
+/// With controllers of every kind: the right-hand side, the Jacobian, the switching functions and
+/// a switch allocate nothing.
+#[test]
+fn controllers_and_their_switches_allocate_nothing() {
+    use geartherm::scene::{Inputs, Scene};
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("models/fzg_c.toml")).unwrap();
+    let extra = r#"
+[[thermal.coolers]]
+name = "fan_cooler"
+hot = "oil"
+cold = "ambient"
+effectiveness = 0.5
+capacity_rate_w_per_k = 40.0
+[[thermal.controls]]
+name = "bypass"
+kind = "valve"
+sensor = "oil"
+closed_c = 20.0
+open_c = 60.0
+min_share = 0.1
+cooler = "fan_cooler"
+[[thermal.controls]]
+name = "fan"
+kind = "two_point"
+sensor = "oil"
+on_c = 60.0
+off_c = 55.0
+link = "housing-air"
+off_fraction = 0.3
+[[thermal.controls]]
+name = "heater"
+kind = "two_point"
+sensor = "oil"
+on_c = 20.0
+off_c = 30.0
+heater_w = 300.0
+"#;
+    let gb = model::from_str(&format!("{text}\n{extra}"), std::path::Path::new("m.toml")).unwrap();
+    let scene = Scene::compile(&gb).unwrap();
+    assert_eq!(scene.thermal.controls.len(), 3);
+    let inputs = Inputs {
+        state: 0,
+        input_speed: 250.0,
+        input_torque: 150.0,
+        vehicle_speed: 0.0,
+    };
+    let mut work = scene.work(inputs);
+    let mut y = scene.initial_state(None);
+    let mut dy = vec![0.0; y.len()];
+    let mut jac = vec![0.0; scene.jacobian_pattern().len()];
+    let mut g = vec![0.0; scene.switching_count()];
+    let before = allocs();
+    for k in 0..20 {
+        y[scene.thermal.oil] += 3.0; // through the valve's band and the set points
+        scene.rhs(k as f64, &y, &mut work, &mut dy);
+        scene.jacobian_values(k as f64, &y, &mut work, &mut jac);
+        scene.switching_functions(&y, &work, &mut g);
+        scene.settle_controls(&y, &mut work);
+    }
+    let after = allocs();
+    assert_eq!(after - before, 0, "rhs/Jacobian/switches allocated");
+    assert!(
+        work.net.switches.iter().sum::<usize>() >= 3,
+        "{:?}",
+        work.net.switches
+    );
+    assert!(dy.iter().chain(&jac).all(|x| x.is_finite()));
+}

@@ -123,15 +123,35 @@ pub fn steady(a: &SteadyArgs) -> Result<(), Failure> {
 }
 
 pub(super) fn steady_text(r: &SteadyResult) -> String {
-    let mut t = format!(
-        "{} gear {} at {} rpm, {} N·m: equilibrium after {} Newton + {} PTC iterations ({}), residual {:.1e} W\n",
-        r.model, r.gear, r.speed_rpm, r.torque_nm, r.iterations, r.ptc_iterations, r.method, r.residual_w
-    );
-    t.push_str("temperatures, °C\n");
-    for (n, v) in &r.temperatures_c {
-        t.push_str(&format!("  {n:<20} {v:>9.3}\n"));
+    let mut t = match &r.limit_cycle {
+        None => format!(
+            "{} gear {} at {} rpm, {} N·m: equilibrium after {} Newton + {} PTC iterations ({}), residual {:.1e} W\n",
+            r.model, r.gear, r.speed_rpm, r.torque_nm, r.iterations, r.ptc_iterations, r.method, r.residual_w
+        ),
+        Some(c) => format!(
+            "{} gear {} at {} rpm, {} N·m: no equilibrium, controller {} cycles with a period of {:.3} s\n",
+            r.model, r.gear, r.speed_rpm, r.torque_nm, c.controller, c.period_s
+        ),
+    };
+    match &r.limit_cycle {
+        None => {
+            t.push_str("temperatures, °C\n");
+            for (n, v) in &r.temperatures_c {
+                t.push_str(&format!("  {n:<20} {v:>9.3}\n"));
+            }
+        }
+        Some(c) => {
+            t.push_str("temperatures over the cycle, °C: mean, min, max\n");
+            for (n, v) in &c.mean_c {
+                let (lo, hi) = (c.min_c[n], c.max_c[n]);
+                t.push_str(&format!("  {n:<20} {v:>9.3} {lo:>9.3} {hi:>9.3}\n"));
+            }
+            t.push_str("losses at the mean temperatures, W\n");
+        }
     }
-    t.push_str("losses, W\n");
+    if r.limit_cycle.is_none() {
+        t.push_str("losses, W\n");
+    }
     for (n, q) in &r.losses_w {
         t.push_str(&format!("  {n:<44} {q:>10.3}\n"));
     }

@@ -98,6 +98,45 @@ pub struct SteadyResult {
     pub residual_w: f64,
     /// Loss models used outside their fitted range at the equilibrium.
     pub warnings: Vec<RangeWarning>,
+    /// With `[[thermal.controls]]` that have no equilibrium: the cycle they keep (`method` is
+    /// then `limit_cycle`, `temperatures_c` and the losses are the cycle's means).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limit_cycle: Option<LimitCycleReport>,
+}
+
+/// A limit cycle in °C per node.
+#[derive(Debug, Clone, Serialize)]
+pub struct LimitCycleReport {
+    /// The controller whose switches mark the period.
+    pub controller: String,
+    /// Period, s.
+    pub period_s: f64,
+    /// Time-mean temperature per node over a period, °C.
+    pub mean_c: BTreeMap<String, f64>,
+    /// Lowest, °C.
+    pub min_c: BTreeMap<String, f64>,
+    /// Highest, °C.
+    pub max_c: BTreeMap<String, f64>,
+}
+
+/// The report of a limit cycle of `scene`.
+fn cycle_report(scene: &Scene, c: &crate::solve::limit_cycle::LimitCycle) -> LimitCycleReport {
+    let by_node = |v: &[f64]| -> BTreeMap<String, f64> {
+        scene
+            .thermal
+            .names
+            .iter()
+            .zip(v)
+            .map(|(n, t)| (n.clone(), t - KELVIN_OFFSET))
+            .collect()
+    };
+    LimitCycleReport {
+        controller: c.controller.clone(),
+        period_s: c.period_s,
+        mean_c: by_node(&c.mean_k),
+        min_c: by_node(&c.min_k),
+        max_c: by_node(&c.max_k),
+    }
 }
 
 /// The scene of one gear state with the ambient set.
@@ -196,6 +235,7 @@ pub(crate) fn result(
         method: eq.solution.method,
         residual_w: eq.solution.residual_w,
         warnings: log.warnings(&scene.losses),
+        limit_cycle: eq.limit_cycle.as_ref().map(|c| cycle_report(scene, c)),
     }
 }
 
@@ -213,6 +253,12 @@ pub fn check_equilibrium(scene: &Scene, eq: &Equilibrium) -> Result<(), String> 
                 it.source.as_str(),
                 it.name
             ));
+        }
+    }
+    if let Some(c) = &eq.limit_cycle {
+        let all = c.mean_k.iter().chain(&c.min_k).chain(&c.max_k);
+        if !c.period_s.is_finite() || c.period_s <= 0.0 || all.clone().any(|v| !v.is_finite()) {
+            return Err(format!("the limit cycle of {} is not finite", c.controller));
         }
     }
     let total: f64 = eq.by_source.iter().sum();

@@ -105,6 +105,54 @@ pub struct Summary {
     /// Engine side of a run with a launch device (absent without one).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub launch: Option<LaunchSummary>,
+    /// Per controller of `[[thermal.controls]]`: switches, duty cycle, heat moved (absent
+    /// without controllers).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub controls: Vec<ControlSummary>,
+}
+
+/// A controller over the run.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct ControlSummary {
+    /// Name.
+    pub name: String,
+    /// Switches (located events).
+    pub switches: usize,
+    /// Time-mean share: a two-point controller's fraction of time on (its duty cycle), a
+    /// valve's mean share through the cooler.
+    pub duty_cycle: f64,
+    /// Heat moved, J: through its cooler or links (positive from the hot/first end), or its
+    /// heater's energy.
+    pub energy_j: f64,
+}
+
+/// The controllers' summaries from the first and last state of `traj`.
+pub fn control_summaries(scene: &Scene, traj: &Trajectory) -> Vec<ControlSummary> {
+    let (Some(y0), Some(y1)) = (traj.states.first(), traj.states.last()) else {
+        return Vec::new();
+    };
+    let r0 = scene.control_row_index();
+    let dur = traj.times.last().copied().unwrap_or(0.0) - traj.times.first().copied().unwrap_or(0.0);
+    let rows = crate::scene::controls::ROWS_PER_CONTROL;
+    scene
+        .thermal
+        .controls
+        .iter()
+        .enumerate()
+        .map(|(k, c)| {
+            let r = r0 + rows * k;
+            ControlSummary {
+                name: c.name.clone(),
+                switches: traj.switches.get(k).copied().unwrap_or(0),
+                duty_cycle: if dur > 0.0 {
+                    (y1[r + 1] - y0[r + 1]) / dur
+                } else {
+                    0.0
+                },
+                energy_j: y1[r] - y0[r],
+            }
+        })
+        .collect()
 }
 
 /// Engine side of a run with a launch device (torque converter), from the output rows: each row
@@ -281,6 +329,7 @@ pub fn summary(
         frozen_viscosity: scene.frozen_oil_temp.is_some(),
         warnings: run_warnings(scene, traj, rows),
         launch: launch_summary(&traj.times, rows),
+        controls: control_summaries(scene, traj),
     }
 }
 
@@ -316,7 +365,11 @@ pub fn timeseries_csv(
     for (source, name) in &left_out {
         let _ = write!(s, ",loss_{}_{name}_w", source.as_str());
     }
-    let _ = writeln!(s, ",{},loss_total_w,efficiency", csv_columns());
+    let _ = write!(s, ",{},loss_total_w,efficiency", csv_columns());
+    for c in &scene.thermal.controls {
+        let _ = write!(s, ",control_{}", c.name);
+    }
+    s.push('\n');
     for (k, t) in traj.times.iter().enumerate() {
         let r = &rows[k];
         let y = &traj.states[k];
@@ -361,6 +414,10 @@ pub fn timeseries_csv(
         s.push(',');
         if let Some(eta) = crate::physics::efficiency::efficiency(r.output_power_w, total) {
             num(&mut s, eta);
+        }
+        for x in traj.controls.get(k).unwrap_or(&[]) {
+            s.push(',');
+            num(&mut s, *x);
         }
         s.push('\n');
     }
@@ -496,6 +553,10 @@ impl Summary {
             named.push((format!("temperatures_c.{n}.min"), t.min));
             named.push((format!("temperatures_c.{n}.max"), t.max));
             named.push((format!("temperatures_c.{n}.final"), t.r#final));
+        }
+        for c in &self.controls {
+            named.push((format!("controls.{}.duty_cycle", c.name), c.duty_cycle));
+            named.push((format!("controls.{}.energy_j", c.name), c.energy_j));
         }
         if let Some(l) = &self.launch {
             named.push(("launch.engine_speed_max_rpm".into(), l.engine_speed_max_rpm));

@@ -4,6 +4,7 @@ pub mod automatic;
 pub mod bearing_loads;
 pub mod churn_sample;
 pub mod circuit;
+pub mod controls;
 pub mod element_losses;
 pub mod gear_losses;
 pub mod items;

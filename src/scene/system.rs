@@ -187,7 +187,81 @@ impl Scene {
 
     /// Length of the state vector.
     pub fn n_states(&self) -> usize {
-        self.nodes() + self.energies + 1
+        self.nodes() + self.energies + 1 + self.thermal.control_rows()
+    }
+
+    /// Index of the first controller row in the state (each controller has
+    /// [`ROWS_PER_CONTROL`](super::controls::ROWS_PER_CONTROL): the heat it moved, J, and its
+    /// time on, s).
+    pub fn control_row_index(&self) -> usize {
+        self.boundary_energy_index() + 1
+    }
+
+    /// Number of controllers' switching functions.
+    pub fn switching_count(&self) -> usize {
+        (self.thermal.controls.len() + self.thermal.kinks.len()) * super::controls::EVENTS_PER_CONTROL
+    }
+
+    /// The controllers' switching functions at state `y` in the work area's modes into `g`.
+    pub fn switching_functions(&self, y: &[f64], work: &Work, g: &mut [f64]) {
+        self.thermal.switching_functions(&y[..self.nodes()], &work.net, g);
+    }
+
+    /// Set controller `k` to `mode` (counting a switch when it changes) and refresh what depends
+    /// on it (the conductances of the links it switches).
+    pub fn set_control_mode(&self, k: usize, mode: u8, work: &mut Work) {
+        if work.net.mode[k] == mode {
+            return;
+        }
+        work.net.mode[k] = mode;
+        work.net.switches[k] += 1;
+        work.sample_id = work.sample_id.wrapping_add(1);
+        work.base = None;
+        work.col_key = None;
+        self.thermal
+            .sample_conductances(&Self::operating(&work.inputs), &mut work.net);
+    }
+
+    /// Switch the controller of switching function `idx` (the function's root was found).
+    pub fn switch_control(&self, idx: usize, work: &mut Work) {
+        let e = super::controls::EVENTS_PER_CONTROL;
+        let (k, slot) = (idx / e, idx % e);
+        if let Some(c) = self.thermal.controls.get(k) {
+            let m = c.flip(work.net.mode[k], slot);
+            self.set_control_mode(k, m, work);
+        } else if let Some(c) = self.thermal.kinks.get(k - self.thermal.controls.len()) {
+            let j = k - self.thermal.controls.len();
+            work.net.kink_mode[j] = c.flip(work.net.kink_mode[j], slot);
+        }
+    }
+
+    /// Settle every controller at state `y`: the modes in which no switching function is
+    /// positive (the events due at this point). Returns true when a mode changed.
+    pub fn settle_controls(&self, y: &[f64], work: &mut Work) -> bool {
+        let mut changed = false;
+        for (k, c) in self.thermal.controls.iter().enumerate() {
+            let m = c.settle(work.net.mode[k], y[c.sensor]);
+            changed |= m != work.net.mode[k];
+            self.set_control_mode(k, m, work);
+        }
+        for (j, c) in self.thermal.kinks.iter().enumerate() {
+            let m = c.settle(work.net.kink_mode[j], y[c.sensor]);
+            changed |= m != work.net.kink_mode[j];
+            work.net.kink_mode[j] = m;
+        }
+        changed
+    }
+
+    /// Set every controller's mode from the initial state `y` (as a fresh work area does).
+    pub fn initial_control_modes(&self, y: &[f64], work: &mut Work) {
+        for (k, c) in self.thermal.controls.iter().enumerate() {
+            let m = c.initial_mode(y[c.sensor]);
+            self.set_control_mode(k, m, work);
+            work.net.switches[k] = 0;
+        }
+        for (j, c) in self.thermal.kinks.iter().enumerate() {
+            work.net.kink_mode[j] = c.initial_mode(y[c.sensor]);
+        }
     }
 
     /// Index of the boundary-heat quadrature in the state.
@@ -366,6 +440,8 @@ impl Scene {
             dy[n + slot] += q;
         }
         dy[n + e] = to_b;
+        self.thermal
+            .control_rates(&y[..n], &work.net, &mut dy[n + e + 1..]);
         if !dy.iter().all(|v| v.is_finite()) {
             work.failure = Some(self.diagnose(t, y, &work.q));
         }
@@ -418,6 +494,8 @@ impl Scene {
         let e = self.energies;
         out[n..n + e].iter_mut().for_each(|x| *x = 0.0);
         out[n + e] = to_b;
+        self.thermal
+            .control_rate_derivative(&y[..n], &work.net, Some(&v[..n]), None, &mut out[n + e + 1..]);
         if self.frozen_oil_temp.is_some() || v[oil_i] == 0.0 {
             return;
         }
@@ -481,6 +559,7 @@ impl Scene {
             work.oil_col[n + slot] += (q1 - q0) / h;
         }
         work.oil_col[n + e] = (b1 - b0) / h;
+        work.oil_col[n + e + 1..].iter_mut().for_each(|x| *x = 0.0);
         work.col_key = Some(key);
     }
 
@@ -510,6 +589,9 @@ impl Scene {
             .network_heat_partials(&y[..n], &work.oil_g, &work.net, &mut |r, c, _| {
                 out.push((self.row_of(r), c))
             });
+        let r0 = self.control_row_index();
+        self.thermal
+            .control_rate_partials(&y[..n], &work.net, &mut |r, c, _| out.push((r0 + r, c)));
         out.extend((0..self.n_states()).map(|r| (r, self.thermal.oil)));
         out
     }
@@ -579,9 +661,14 @@ impl Scene {
         let n = self.nodes();
         let held = self.oil_conductances_at(t, y, work);
         let oil_g = if held { &work.oil_g } else { &work.oil_g2 };
-        let k = self
+        let mut k = self
             .thermal
             .network_partial_values(&y[..n], oil_g, &work.net, vals);
+        self.thermal
+            .control_rate_partials(&y[..n], &work.net, &mut |_, _, d| {
+                vals[k] = d;
+                k += 1;
+            });
         (k, held)
     }
 
@@ -679,6 +766,13 @@ impl Scene {
         let e = self.energies;
         out[n..n + e].iter_mut().for_each(|x| *x = 0.0);
         out[n + e] = to_b;
+        self.thermal.control_rate_derivative(
+            &y[..n],
+            &work.net,
+            None,
+            Some(&work.net.boundary_slope),
+            &mut out[n + e + 1..],
+        );
     }
 
     /// Heat flow into each node (W) and into boundaries at state `y` with the current inputs (for

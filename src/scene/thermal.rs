@@ -15,6 +15,7 @@ use crate::physics::thermal::{
     thermostat_opening, FluidProperties, HTable, AIR_50C, OIL_CONDUCTIVITY, OIL_SPECIFIC_HEAT,
 };
 
+use super::controls::{Action, ControlTerm, EVENTS_PER_CONTROL, ROWS_PER_CONTROL};
 use super::items::{DefaultHeat, LossItem};
 
 /// Endpoint of a compiled link: a state (capacity node) or a boundary.
@@ -46,6 +47,8 @@ struct Conductance {
 /// A conductance that depends on the operating point (vehicle speed or gear speed).
 #[derive(Debug, Clone)]
 enum SampleLaw {
+    /// A fixed conductance a controller switches, W/K.
+    Fixed(f64),
     Table {
         area: f64,
         table: HTable,
@@ -67,6 +70,8 @@ struct SampleLink {
     a: End,
     b: End,
     law: SampleLaw,
+    /// The controller that scales it, if any.
+    control: Option<usize>,
 }
 
 /// A link whose conductance depends on the oil state: a rotating part in oil (h follows the gear
@@ -106,6 +111,8 @@ struct CoolerTerm {
     g: f64,
     thermostat: Option<(f64, f64)>,
     two_way: bool,
+    /// The controller that scales it (two-point or valve), if any.
+    control: Option<usize>,
 }
 
 impl CoolerTerm {
@@ -118,6 +125,30 @@ impl CoolerTerm {
         }
         self.thermostat
             .map_or((1.0, 0.0), |(a, b)| thermostat_opening(th, a, b))
+    }
+
+    /// Opening x, dx/dT_hot and dx/dT_sensor of its controller (whose sensor is `sensor`, 0
+    /// without one) at node temperatures `temps` with hot and cold sides `th`, `tc`.
+    #[inline]
+    fn opening_controlled(
+        &self,
+        controls: &[ControlTerm],
+        mode: &[u8],
+        temps: &[f64],
+        th: f64,
+        tc: f64,
+    ) -> (f64, f64, f64) {
+        match self.control {
+            Some(c) => {
+                let k = &controls[c];
+                let (x, dx) = k.share(mode[c], temps[k.sensor]);
+                (x, 0.0, dx)
+            }
+            None => {
+                let (x, dx) = self.opening(th, tc);
+                (x, dx, 0.0)
+            }
+        }
     }
 }
 
@@ -159,6 +190,13 @@ pub struct ThermalScene {
     oil_links: Vec<OilLink>,
     radiation: Vec<Radiation>,
     coolers: Vec<CoolerTerm>,
+    /// Controllers.
+    pub controls: Vec<ControlTerm>,
+    /// The thermostats' opening and fully-open temperatures as switching surfaces: no mode
+    /// changes the right-hand side there, but the opening's second derivative jumps (from zero
+    /// to the band's), so a step across one would integrate as if the band were not there; the
+    /// integrators end a step at each crossing ([`ControlTerm`] valve-like regions).
+    pub kinks: Vec<ControlTerm>,
     oil_model: Oil,
     /// c_p of the oil carried by the advection links, J/(kg·K): the oil node's `cp_j_per_kgk`
     /// (the model check requires it of a model with a `[circuit]`, the only source of advection
@@ -175,6 +213,12 @@ pub struct NetworkWork {
     pub boundary_t: Vec<f64>,
     /// Their rates of change, K/s ([`ThermalScene::boundary_slopes`]).
     pub boundary_slope: Vec<f64>,
+    /// Mode of every controller ([`ControlTerm`]); the integrators change it only at events.
+    pub mode: Vec<u8>,
+    /// Region of every thermostat kink (below, in, above the band).
+    pub kink_mode: Vec<u8>,
+    /// Switches of every controller so far.
+    pub switches: Vec<usize>,
 }
 
 /// The oil as the fluid of the rotating-disc correlation (Pr = μ·c_p/k).
@@ -214,6 +258,35 @@ struct Links {
 }
 
 impl Links {
+    /// Mark the links called `name` as switched by controller `k` (a fixed one moves to the
+    /// operating-point links).
+    fn mark_controlled(&mut self, net: &ThermalNetwork, name: &str, k: usize) {
+        let ends: Vec<(End, End)> = net
+            .links
+            .iter()
+            .filter(|l| l.name == name)
+            .map(|l| (End::from(l.a), End::from(l.b)))
+            .collect();
+        let is_target = |a: End, b: End| ends.contains(&(a, b));
+        let mut moved = Vec::new();
+        self.fixed.retain(|c| {
+            let hit = is_target(c.a, c.b);
+            if hit {
+                moved.push(SampleLink {
+                    a: c.a,
+                    b: c.b,
+                    law: SampleLaw::Fixed(c.g),
+                    control: Some(k),
+                });
+            }
+            !hit
+        });
+        for l in self.sample.iter_mut().filter(|l| is_target(l.a, l.b)) {
+            l.control = Some(k);
+        }
+        self.sample.extend(moved);
+    }
+
     /// The links of `net`; `speeds[state][gear]` is a gear's speed relative to its fluid per
     /// unit input speed ([`fluid_speeds`]).
     fn compile(net: &ThermalNetwork, speeds: &[Vec<f64>]) -> Links {
@@ -221,7 +294,12 @@ impl Links {
         let mut links = Links::default();
         for l in &net.links {
             let (a, b) = (End::from(l.a), End::from(l.b));
-            let sample = |law| SampleLink { a, b, law };
+            let sample = |law| SampleLink {
+                a,
+                b,
+                law,
+                control: None,
+            };
             match &l.law {
                 LinkLaw::Conductance(g) => links.fixed.push(Conductance { a, b, g: *g }),
                 LinkLaw::Convection { area, h } => links.fixed.push(Conductance { a, b, g: area * h }),
@@ -313,10 +391,65 @@ fn cooler_terms(net: &ThermalNetwork) -> Vec<CoolerTerm> {
                 g: c.conductance,
                 thermostat: c.thermostat,
                 two_way: c.two_way,
+                control: None,
             }),
             NodeRef::Boundary(_) => None,
         })
         .collect()
+}
+
+/// The thermostats' band edges as switching surfaces on their hot nodes.
+fn thermostat_kinks(coolers: &[CoolerTerm]) -> Vec<ControlTerm> {
+    use super::controls::Law;
+    coolers
+        .iter()
+        .filter_map(|c| {
+            let (open, full) = c.thermostat?;
+            Some(ControlTerm {
+                name: String::new(),
+                sensor: c.hot,
+                law: Law::Valve {
+                    closed: open,
+                    open: full,
+                    min: 0.0,
+                    max: 1.0,
+                    lo: open,
+                    hi: full,
+                },
+                action: Action::Link,
+                off_fraction: 1.0,
+            })
+        })
+        .collect()
+}
+
+/// The controllers of `net`, compiled, and the coolers and links they act on marked with them:
+/// a switched fixed-conductance link moves to the operating-point links (its conductance is
+/// then set per sample and per mode).
+fn compile_controls(net: &ThermalNetwork, coolers: &mut [CoolerTerm], links: &mut Links) -> Vec<ControlTerm> {
+    use crate::model::thermal::ControlTarget;
+    // Compiled cooler index of model cooler i: those with a capacity hot side, in order.
+    let cooler_index = |i: usize| {
+        net.coolers[..i]
+            .iter()
+            .filter(|c| matches!(c.hot, NodeRef::Node(_)))
+            .count()
+    };
+    let mut out = Vec::with_capacity(net.controls.len());
+    for (k, c) in net.controls.iter().enumerate() {
+        let term = ControlTerm::compile(c, cooler_index);
+        match (&c.target, term.action) {
+            (_, Action::Cooler(i)) => {
+                if let Some(x) = coolers.get_mut(i) {
+                    x.control = Some(k);
+                }
+            }
+            (ControlTarget::Link { link, .. }, _) => links.mark_controlled(net, link, k),
+            _ => {}
+        }
+        out.push(term);
+    }
+    out
 }
 
 /// Where the heat of loss item `it` goes: (node, fraction), one entry per node, none with a zero
@@ -400,6 +533,8 @@ impl ThermalScene {
             .collect();
         let mut links = Links::compile(net, &fluid_speeds(gb));
         links.oil.extend(advection_links(gb, net));
+        let mut coolers = cooler_terms(net);
+        let controls = compile_controls(net, &mut coolers, &mut links);
         debug_assert!(net.oil_node < n);
         let mut scene = ThermalScene {
             names: net.nodes.iter().map(|x| x.name.clone()).collect(),
@@ -415,7 +550,9 @@ impl ThermalScene {
             sample: links.sample,
             oil_links: links.oil,
             radiation: links.radiation,
-            coolers: cooler_terms(net),
+            kinks: thermostat_kinks(&coolers),
+            coolers,
+            controls,
             oil_model: gb.oil.clone(),
             advection_cp: net.nodes[net.oil_node].specific_heat.unwrap_or(OIL_SPECIFIC_HEAT),
             fixed_partials: Vec::new(),
@@ -457,6 +594,17 @@ impl ThermalScene {
             sample_g: vec![0.0; self.sample.len()],
             boundary_t: self.boundaries.iter().map(|b| b.at(0.0)).collect(),
             boundary_slope: vec![0.0; self.boundaries.len()],
+            mode: self
+                .controls
+                .iter()
+                .map(|c| c.initial_mode(self.initial[c.sensor]))
+                .collect(),
+            switches: vec![0; self.controls.len()],
+            kink_mode: self
+                .kinks
+                .iter()
+                .map(|c| c.initial_mode(self.initial[c.sensor]))
+                .collect(),
         }
     }
 
@@ -471,7 +619,11 @@ impl ThermalScene {
     /// Conductances of the operating-point-dependent links (call once per cycle sample).
     pub fn sample_conductances(&self, op: &Operating, work: &mut NetworkWork) {
         for (g, l) in work.sample_g.iter_mut().zip(&self.sample) {
-            *g = match &l.law {
+            let x = l
+                .control
+                .map_or(1.0, |c| self.controls[c].share(work.mode[c], 0.0).0);
+            *g = x * match &l.law {
+                SampleLaw::Fixed(g) => *g,
                 SampleLaw::Table { area, table } => area * table.at(op.vehicle_speed),
                 SampleLaw::Law { area, h0, h1 } => area * h_power_law(*h0, *h1, op.vehicle_speed),
                 SampleLaw::RotatingAir {
@@ -559,11 +711,142 @@ impl ThermalScene {
         for c in &self.coolers {
             let th = temps[c.hot];
             let tc = Self::temp(c.cold, temps, bt);
-            let x = c.opening(th, tc).0;
+            let x = c.opening_controlled(&self.controls, &work.mode, temps, th, tc).0;
             let q = c.g * x * (th - tc);
             Self::flow(End::Node(c.hot), c.cold, q, heat, &mut to_b);
         }
+        for (c, &m) in self.controls.iter().zip(&work.mode) {
+            if let Action::Heater { node, power } = c.action {
+                // The heater's power comes from outside: a negative heat into the boundaries.
+                let p = if m == 1 { power } else { 0.0 };
+                heat[node] += p;
+                to_b -= p;
+            }
+        }
         to_b
+    }
+
+    /// Rows of the controllers in the state (after the boundary-energy quadrature).
+    pub fn control_rows(&self) -> usize {
+        self.controls.len() * ROWS_PER_CONTROL
+    }
+
+    /// Switching functions of every controller at node temperatures `temps` in the work area's
+    /// modes into `g` ([`EVENTS_PER_CONTROL`] each).
+    pub fn switching_functions(&self, temps: &[f64], work: &NetworkWork, g: &mut [f64]) {
+        let modes = work.mode.iter().chain(&work.kink_mode);
+        for ((c, &m), g) in self
+            .controls
+            .iter()
+            .chain(&self.kinks)
+            .zip(modes)
+            .zip(g.chunks_exact_mut(EVENTS_PER_CONTROL))
+        {
+            c.events(m, temps[c.sensor], g);
+        }
+    }
+
+    /// The rates of the controllers' rows at `temps`: per controller the heat it moves (W: its
+    /// cooler's or links' heat flow, its heater's power) and its share (on = 1).
+    pub fn control_rates(&self, temps: &[f64], work: &NetworkWork, out: &mut [f64]) {
+        out.iter_mut().for_each(|x| *x = 0.0);
+        let bt = &work.boundary_t;
+        for (k, c) in self.controls.iter().enumerate() {
+            let (x, _) = c.share(work.mode[k], temps[c.sensor]);
+            out[ROWS_PER_CONTROL * k + 1] = x;
+            if let Action::Heater { power, .. } = c.action {
+                out[ROWS_PER_CONTROL * k] = x * power;
+            }
+        }
+        for c in &self.coolers {
+            if let Some(k) = c.control {
+                let th = temps[c.hot];
+                let tc = Self::temp(c.cold, temps, bt);
+                let x = c.opening_controlled(&self.controls, &work.mode, temps, th, tc).0;
+                out[ROWS_PER_CONTROL * k] = c.g * x * (th - tc);
+            }
+        }
+        for (l, g) in self.sample.iter().zip(&work.sample_g) {
+            if let Some(k) = l.control {
+                out[ROWS_PER_CONTROL * k] += g * (Self::temp(l.a, temps, bt) - Self::temp(l.b, temps, bt));
+            }
+        }
+    }
+
+    /// Partials of [`Self::control_rates`]: calls `add(row, col, d)` with `row` the offset among
+    /// the controllers' rows; the sequence does not depend on the state.
+    pub fn control_rate_partials(
+        &self,
+        temps: &[f64],
+        work: &NetworkWork,
+        add: &mut impl FnMut(usize, usize, f64),
+    ) {
+        let bt = &work.boundary_t;
+        for (k, c) in self.controls.iter().enumerate() {
+            let (_, dx) = c.share(work.mode[k], temps[c.sensor]);
+            add(ROWS_PER_CONTROL * k + 1, c.sensor, dx);
+        }
+        for c in &self.coolers {
+            if let Some(k) = c.control {
+                let th = temps[c.hot];
+                let tc = Self::temp(c.cold, temps, bt);
+                let (x, _, dxs) = c.opening_controlled(&self.controls, &work.mode, temps, th, tc);
+                let r = ROWS_PER_CONTROL * k;
+                add(r, c.hot, c.g * x);
+                if let End::Node(j) = c.cold {
+                    add(r, j, -c.g * x);
+                }
+                add(r, self.controls[k].sensor, c.g * dxs * (th - tc));
+            }
+        }
+        for (l, g) in self.sample.iter().zip(&work.sample_g) {
+            if let Some(k) = l.control {
+                for (e, d) in [(l.a, *g), (l.b, -g)] {
+                    if let End::Node(j) = e {
+                        add(ROWS_PER_CONTROL * k, j, d);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Directional derivative of [`Self::control_rates`] along node rates `v` and boundary
+    /// rates `vb` into `out`.
+    pub fn control_rate_derivative(
+        &self,
+        temps: &[f64],
+        work: &NetworkWork,
+        v: Option<&[f64]>,
+        vb: Option<&[f64]>,
+        out: &mut [f64],
+    ) {
+        out.iter_mut().for_each(|x| *x = 0.0);
+        let dv = |e: End| match e {
+            End::Node(i) => v.map_or(0.0, |v| v[i]),
+            End::Boundary(j) => vb.map_or(0.0, |b| b[j]),
+        };
+        if let Some(v) = v {
+            self.control_rate_partials(temps, work, &mut |r, c, d| out[r] += d * v[c]);
+        }
+        if vb.is_none() {
+            return;
+        }
+        // The boundary ends' share (the node columns were added above only through `v`).
+        let bt = &work.boundary_t;
+        for c in &self.coolers {
+            if let (Some(k), End::Boundary(_)) = (c.control, c.cold) {
+                let th = temps[c.hot];
+                let tc = Self::temp(c.cold, temps, bt);
+                let x = c.opening_controlled(&self.controls, &work.mode, temps, th, tc).0;
+                out[ROWS_PER_CONTROL * k] -= c.g * x * dv(c.cold);
+            }
+        }
+        for (l, g) in self.sample.iter().zip(&work.sample_g) {
+            if let Some(k) = l.control {
+                let d = |e: End| if matches!(e, End::Boundary(_)) { dv(e) } else { 0.0 };
+                out[ROWS_PER_CONTROL * k] += g * (d(l.a) - d(l.b));
+            }
+        }
     }
 
     /// Conductances of the oil-state-dependent links (W/K) at the oil state `oil` into `g`, and
@@ -733,7 +1016,7 @@ impl ThermalScene {
         for c in &self.coolers {
             let th = temps[c.hot];
             let tc = Self::temp(c.cold, temps, bt);
-            let (x, dx) = c.opening(th, tc);
+            let (x, dx, dxs) = c.opening_controlled(&self.controls, &work.mode, temps, th, tc);
             Self::link_partials(
                 End::Node(c.hot),
                 c.cold,
@@ -741,6 +1024,13 @@ impl ThermalScene {
                 -c.g * x,
                 add,
             );
+            if let Some(k) = c.control {
+                // The controller's sensor column: the share follows its temperature.
+                let d = c.g * dxs * (th - tc);
+                let s = self.controls[k].sensor;
+                add(End::Node(c.hot), s, -d);
+                add(c.cold, s, d);
+            }
         }
     }
 
@@ -809,8 +1099,11 @@ impl ThermalScene {
         for c in &self.coolers {
             let th = temps[c.hot];
             let tc = Self::temp(c.cold, temps, bt);
-            let (x, dx) = c.opening(th, tc);
-            let dq = c.g * ((x + dx * (th - tc)) * dv(End::Node(c.hot)) - x * dv(c.cold));
+            let (x, dx, dxs) = c.opening_controlled(&self.controls, &work.mode, temps, th, tc);
+            let ds = c
+                .control
+                .map_or(0.0, |k| dxs * dv(End::Node(self.controls[k].sensor)));
+            let dq = c.g * ((x + dx * (th - tc)) * dv(End::Node(c.hot)) - x * dv(c.cold) + ds * (th - tc));
             Self::flow(End::Node(c.hot), c.cold, dq, out, &mut to_b);
         }
         to_b

@@ -15,6 +15,10 @@ pub(crate) struct Driver<'s> {
     pub(crate) segments: &'s [Segment],
     pub(crate) opts: &'s TransientOptions,
     pub(crate) atol: &'s [f64],
+    /// Controller events located so far (diffsol path).
+    pub(crate) events: std::cell::Cell<usize>,
+    /// Every switch located: (time, controller).
+    pub(crate) event_log: RefCell<Vec<(f64, usize)>>,
 }
 
 impl Driver<'_> {
@@ -64,6 +68,20 @@ impl Driver<'_> {
             .set_inputs(self.segments[k].inputs, &mut self.work.borrow_mut());
     }
 
+    /// Count a switch of switching function `idx` at time `t`.
+    pub(crate) fn log_event(&self, t: f64, idx: usize) {
+        let k = idx / crate::scene::controls::EVENTS_PER_CONTROL;
+        if k < self.scene.thermal.controls.len() {
+            self.events.set(self.events.get() + 1);
+            self.event_log.borrow_mut().push((t, k));
+        }
+    }
+
+    /// Settle the controllers at state `y` (the switches due there); true when one switched.
+    pub(crate) fn settle_controls(&self, y: &[f64]) -> bool {
+        self.scene.settle_controls(y, &mut self.work.borrow_mut())
+    }
+
     /// Forget a non-finite trial the integrator recovered from.
     pub(crate) fn clear_failure(&self) {
         self.work.borrow_mut().failure = None;
@@ -77,6 +95,23 @@ impl Driver<'_> {
         traj.times.push(t);
         traj.states.push(y);
         traj.segment.push(seg);
+        self.record_controls(traj, y);
+    }
+
+    /// The controllers' shares at state `y` into the row.
+    fn record_controls(&self, traj: &mut Trajectory, y: &[f64]) {
+        let th = &self.scene.thermal;
+        if th.controls.is_empty() {
+            return;
+        }
+        let w = self.work.borrow();
+        let row: Vec<f64> = th
+            .controls
+            .iter()
+            .zip(&w.net.mode)
+            .map(|(c, &m)| c.share(m, y[c.sensor]).0)
+            .collect();
+        traj.controls.push(&row);
     }
 
     /// The step budget is spent.
@@ -103,6 +138,7 @@ impl Driver<'_> {
         traj.times.push(t);
         traj.states.push(y);
         traj.segment.push(seg);
+        self.record_controls(traj, y);
     }
 
     /// Failure at the solver's current state: names the node with the largest weighted rate and

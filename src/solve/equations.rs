@@ -88,7 +88,7 @@ impl JacobianMatrix for FaerSparseMat<f64> {
 }
 
 /// The scene's ODE `dy/dt = f(t, y)`, `y(t0) = y0` as diffsol equations (no mass matrix, no
-/// roots, no outputs).
+/// outputs; the controllers' switching functions as roots).
 pub struct SceneEquations<'s, M: JacobianMatrix> {
     scene: &'s Scene,
     work: &'s RefCell<Work>,
@@ -215,6 +215,37 @@ pub struct SceneInit<'a, 's, M: JacobianMatrix>(&'a SceneEquations<'s, M>);
 impl_op!(SceneRhs);
 impl_op!(SceneInit);
 
+/// The controllers' switching functions (diffsol's root function): one root per function
+/// turning positive ([`Scene::switching_functions`]).
+pub struct SceneRoot<'a, 's, M: JacobianMatrix>(&'a SceneEquations<'s, M>);
+
+impl<M: JacobianMatrix> Op for SceneRoot<'_, '_, M> {
+    type T = f64;
+    type V = M::V;
+    type M = M;
+    type C = M::C;
+    fn context(&self) -> &Self::C {
+        &self.0.ctx
+    }
+    fn nstates(&self) -> usize {
+        self.0.n
+    }
+    fn nout(&self) -> usize {
+        self.0.scene.switching_count()
+    }
+    fn nparams(&self) -> usize {
+        0
+    }
+}
+
+impl<M: JacobianMatrix> NonLinearOp for SceneRoot<'_, '_, M> {
+    fn call_inplace(&self, x: &M::V, _t: f64, y: &mut M::V) {
+        let e = self.0;
+        e.scene
+            .switching_functions(x.host(), &e.work.borrow(), y.host_mut());
+    }
+}
+
 impl<M: JacobianMatrix> ConstantOp for SceneInit<'_, '_, M> {
     fn call_inplace(&self, _t: f64, y: &mut M::V) {
         y.host_mut().copy_from_slice(&self.0.y0);
@@ -263,7 +294,7 @@ impl<'a, M: JacobianMatrix> OdeEquationsRef<'a> for SceneEquations<'_, M> {
     type Mass = Unit<'a, M>;
     type Init = SceneInit<'a, 'a, M>;
     type Out = Unit<'a, M>;
-    type Root = Unit<'a, M>;
+    type Root = SceneRoot<'a, 'a, M>;
     type Reset = Unit<'a, M>;
 }
 
@@ -276,6 +307,9 @@ impl<M: JacobianMatrix> OdeEquations for SceneEquations<'_, M> {
     }
     fn init(&self) -> SceneInit<'_, '_, M> {
         SceneInit(self)
+    }
+    fn root(&self) -> Option<SceneRoot<'_, '_, M>> {
+        (self.scene.switching_count() > 0).then_some(SceneRoot(self))
     }
     fn set_params(&mut self, _p: &M::V) {}
     fn get_params(&self, _p: &mut M::V) {}

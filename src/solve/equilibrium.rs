@@ -115,6 +115,9 @@ pub struct Equilibrium {
     pub power: f64,
     /// Efficiency P / (P + losses) (None without power).
     pub efficiency: Option<f64>,
+    /// With controllers that find no equilibrium: the cycle they keep (then `solution` holds its
+    /// mean temperatures and the losses are those at the mean).
+    pub limit_cycle: Option<super::limit_cycle::LimitCycle>,
 }
 
 /// Solve the equilibrium of `scene` at `inputs` from `start` (K per node; None: the ambient or
@@ -138,16 +141,10 @@ pub fn equilibrium(
             }
         }
     };
-    let solution = match solve_steady(&sys, &t0, opts) {
-        Ok(s) => s,
-        // Newton and PTC gave up: follow the physical transient (the real ODE with the driver of
-        // the transient runs) until it either settles, giving Newton a start next to the
-        // equilibrium, or carries a node past its limit, which proves there is none in range.
-        Err(SteadyError::NotConverged { .. }) => {
-            let settled = transient_fallback(scene, &sys, inputs, &t0)?;
-            solve_steady(&sys, &settled, opts)?
-        }
-        Err(e) => return Err(e),
+    let (solution, limit_cycle) = if scene.thermal.controls.is_empty() {
+        (settle_steady(scene, &sys, inputs, &t0, opts)?, None)
+    } else {
+        controlled(scene, inputs, &t0, opts)?
     };
     let mut y = vec![0.0; scene.n_states()];
     y[..scene.nodes()].copy_from_slice(&solution.temperatures);
@@ -162,6 +159,107 @@ pub fn equilibrium(
         by_source: by,
         power,
         efficiency: crate::physics::efficiency::efficiency(power, total),
+        limit_cycle,
+    })
+}
+
+/// With controllers: the first mode combination of the two-point controllers (the start's
+/// first) whose equilibrium no controller would leave; the valves' regions follow the solution.
+/// None: the limit cycle ([`super::limit_cycle`]).
+fn controlled(
+    scene: &Scene,
+    inputs: Inputs,
+    t0: &[f64],
+    opts: &SteadyOptions,
+) -> Result<(SteadySolution, Option<super::limit_cycle::LimitCycle>), SteadyError> {
+    use super::limit_cycle::{find_limit_cycle, mean_solution, MAX_TWO_POINT};
+    let two: Vec<usize> = (0..scene.thermal.controls.len())
+        .filter(|&k| scene.thermal.controls[k].is_two_point())
+        .collect();
+    if two.len() > MAX_TWO_POINT {
+        return Err(SteadyError::InvalidInput(format!(
+            "{} two-point controllers: at most {MAX_TWO_POINT} in a steady state",
+            two.len()
+        )));
+    }
+    let nc = scene.thermal.controls.len() * crate::scene::controls::EVENTS_PER_CONTROL;
+    let mut y0 = vec![0.0; scene.n_states()];
+    y0[..t0.len()].copy_from_slice(t0);
+    let start = scene.work(inputs);
+    let first: usize = two
+        .iter()
+        .enumerate()
+        .map(|(b, &k)| usize::from(start.net.mode[k]) << b)
+        .sum();
+    for c in (0..1usize << two.len()).map(|c| c ^ first) {
+        let sys = SceneBalance::new(scene, inputs);
+        {
+            let mut w = sys.work.borrow_mut();
+            scene.initial_control_modes(&y0, &mut w);
+            for (b, &k) in two.iter().enumerate() {
+                w.net.mode[k] = u8::from(c >> b & 1 == 1);
+            }
+            let m = w.net.mode.clone();
+            for (k, x) in m.into_iter().enumerate() {
+                w.net.mode[k] = 255;
+                scene.set_control_mode(k, x, &mut w);
+            }
+        }
+        let mut t = t0.to_vec();
+        let mut g = vec![0.0; scene.switching_count()];
+        for _ in 0..4 {
+            let Ok(sol) = settle_steady(scene, &sys, inputs, &t, opts) else {
+                break;
+            };
+            let mut y = y0.clone();
+            y[..sol.temperatures.len()].copy_from_slice(&sol.temperatures);
+            let mut w = sys.work.borrow_mut();
+            scene.switching_functions(&y, &w, &mut g);
+            if g[..nc].iter().all(|v| *v <= 0.0) {
+                return Ok((sol, None));
+            }
+            // A valve in the wrong region: take the solution's and solve again; a two-point
+            // controller that would switch: this combination has no equilibrium.
+            let valves_only = scene
+                .thermal
+                .controls
+                .iter()
+                .enumerate()
+                .all(|(k, ct)| !ct.is_two_point() || g[2 * k..2 * k + 2].iter().all(|v| *v <= 0.0));
+            if !valves_only {
+                break;
+            }
+            for (k, ct) in scene.thermal.controls.iter().enumerate() {
+                if !ct.is_two_point() {
+                    let m = ct.settle(w.net.mode[k], y[ct.sensor]);
+                    scene.set_control_mode(k, m, &mut w);
+                }
+            }
+            t = sol.temperatures;
+        }
+    }
+    let cycle = find_limit_cycle(scene, inputs, t0)?;
+    Ok((mean_solution(&cycle), Some(cycle)))
+}
+
+/// [`solve_steady`], falling back on the transient when Newton and PTC give up.
+fn settle_steady(
+    scene: &Scene,
+    sys: &SceneBalance<'_>,
+    inputs: Inputs,
+    t0: &[f64],
+    opts: &SteadyOptions,
+) -> Result<SteadySolution, SteadyError> {
+    Ok(match solve_steady(sys, t0, opts) {
+        Ok(s) => s,
+        // Newton and PTC gave up: follow the physical transient (the real ODE with the driver of
+        // the transient runs) until it either settles, giving Newton a start next to the
+        // equilibrium, or carries a node past its limit, which proves there is none in range.
+        Err(SteadyError::NotConverged { .. }) => {
+            let settled = transient_fallback(scene, sys, inputs, t0)?;
+            solve_steady(sys, &settled, opts)?
+        }
+        Err(e) => return Err(e),
     })
 }
 

@@ -4,6 +4,8 @@ pub mod drive;
 pub(crate) mod driver;
 pub mod equations;
 pub mod equilibrium;
+pub(crate) mod events;
+pub mod limit_cycle;
 pub mod rosenbrock;
 pub mod rows;
 pub mod sensitivity;

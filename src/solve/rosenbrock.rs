@@ -214,7 +214,16 @@ pub(crate) struct RosStats {
     pub steps: usize,
     pub rejected: usize,
     pub lu: usize,
+    /// Trial steps spent locating them.
+    pub event_trials: usize,
 }
+
+/// Width of the bracket on a switching instant, relative to max(1, |t|): the event is located to
+/// this in time (well below the 1e-6 s the analytic check asks).
+const EVENT_TIME_TOL: f64 = 1e-13;
+
+/// Regula-falsi iterations per event at most (Illinois: superlinear; a dozen is typical).
+const EVENT_MAX_ITER: usize = 100;
 
 /// The integrator's state over a run.
 struct Ros<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> {
@@ -237,6 +246,8 @@ struct Ros<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> {
     ls: LS,
     slopes: Slopes,
     stats: RosStats,
+    /// Switching functions (controllers), scratch.
+    g: Vec<f64>,
 }
 
 impl<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> Ros<'a, 'd, M, LS> {
@@ -288,7 +299,90 @@ impl<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> Ros<'a, 'd, M, LS> {
                 t_oil: [0.0; 2],
             },
             stats: RosStats::default(),
+            g: vec![0.0; d.scene.switching_count()],
         }
+    }
+
+    /// Switch every controller whose switching function is positive at (t, y), logging each.
+    fn log_switches(&mut self, t: f64) {
+        self.switch_margin(false);
+        for (i, g) in self.g.iter().enumerate() {
+            if *g > 0.0 {
+                self.d.log_event(t, i);
+            }
+        }
+        self.d.settle_controls(self.y.host());
+    }
+
+    /// The largest switching function at state `y` in the current modes: positive once some
+    /// controller's switch is due (−∞ without controllers).
+    fn switch_margin(&mut self, y_is_trial: bool) -> f64 {
+        if self.g.is_empty() {
+            return f64::NEG_INFINITY;
+        }
+        let y = if y_is_trial {
+            self.tmp.host()
+        } else {
+            self.y.host()
+        };
+        self.d
+            .scene
+            .switching_functions(y, &self.d.work.borrow(), &mut self.g);
+        self.g.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b))
+    }
+
+    /// After an accepted trial step of size `h` from (t, y) whose end (in `tmp`) lies past a
+    /// switching surface: the step size at which the first switch is due, found by regula falsi
+    /// (Illinois) on the largest switching function of the ROS3 step as a function of its size;
+    /// `tmp` then holds the step to that instant (just past the surface). None when no switch is
+    /// due within the step.
+    fn locate_event(&mut self, t: f64, h: f64) -> Option<f64> {
+        let fb0 = self.switch_margin(true);
+        if fb0 <= 0.0 {
+            return None;
+        }
+        let (mut a, mut fa) = (0.0, self.switch_margin(false).min(0.0));
+        let (mut b, mut fb) = (h, fb0);
+        let tol = EVENT_TIME_TOL * t.abs().max(1.0);
+        let mut side = 0i8;
+        let mut last = h;
+        for _ in 0..EVENT_MAX_ITER {
+            if b - a <= tol {
+                break;
+            }
+            let mut c = if fb != fa {
+                b - fb * (b - a) / (fb - fa)
+            } else {
+                0.5 * (a + b)
+            };
+            if !(c > a && c < b) {
+                c = 0.5 * (a + b);
+            }
+            self.factorise(t, c);
+            self.step(t, c);
+            self.stats.event_trials += 1;
+            last = c;
+            let fc = self.switch_margin(true);
+            if fc > 0.0 {
+                (b, fb) = (c, fc);
+                if side == -1 {
+                    fa *= 0.5;
+                }
+                side = -1;
+            } else {
+                (a, fa) = (c, fc);
+                if side == 1 {
+                    fb *= 0.5;
+                }
+                side = 1;
+            }
+        }
+        if last != b {
+            self.factorise(t, b);
+            self.step(t, b);
+            self.stats.event_trials += 1;
+        }
+        Some(b)
     }
 
     /// f at (t, y) with the current inputs, and the losses of stage 1 (they are also the output
@@ -460,6 +554,7 @@ where
     let mut r = Ros::<M, LS>::new(d, eqn, y0);
     let segs = d.segments;
     let mut t = segs[0].t0;
+    d.settle_controls(r.y.host());
     r.eval_f(t)?;
     d.record_evaluated(traj, t, r.y.host(), 0);
     let len0 = segs[0].t1 - segs[0].t0;
@@ -505,14 +600,27 @@ fn integrate_segment<M: JacobianMatrix, LS: IterationLu<M>>(
         let expo = -1.0 / r.tab.elo;
         if err <= 1.0 {
             r.stats.steps += 1;
+            h = h_try * (SAFETY * err.max(1e-10).powf(expo)).min(GROW_MAX);
+            let event = r.locate_event(*t, h_try);
             r.learn_slopes();
-            *t = if h_try == rest { t1 } else { *t + h_try };
+            *t = match event {
+                Some(he) if he < rest => *t + he,
+                _ if h_try == rest => t1,
+                _ => *t + h_try,
+            };
             std::mem::swap(&mut r.y, &mut r.tmp);
             d.clear_failure();
-            h = h_try * (SAFETY * err.max(1e-10).powf(expo)).min(GROW_MAX);
+            if event.is_some() {
+                // The switch: the modes after it, and f with them at the next step's start.
+                r.log_switches(*t);
+            }
             retry = false;
             if *t < t1 {
                 r.eval_f(*t)?;
+                if event.is_some() {
+                    // f has jumped: a starting step for the new mode, at most the proposal.
+                    h = d.restart_step(r.y.host(), r.f.host(), h, t1 - *t);
+                }
             }
         } else {
             r.stats.rejected += 1;

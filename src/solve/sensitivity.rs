@@ -446,6 +446,20 @@ fn drive(
         item: None,
         message: "empty input: no segment to integrate".into(),
     })?;
+    if !scene.thermal.controls.is_empty() {
+        // The tangent integrator has no event location: across a switch its sensitivities
+        // would miss the jump (the saltation term). Refused rather than wrong.
+        return Err(NumericalFailure {
+            time: first.t0,
+            node: scene.thermal.names[scene.thermal.controls[0].sensor].clone(),
+            item: None,
+            message: format!(
+                "sensitivities across the switches of controller {} are not implemented: \
+                 calibrate a model without [[thermal.controls]]",
+                scene.thermal.controls[0].name
+            ),
+        });
+    }
     let mut r = Tangent::new(scene, dirs, first, opts.initial.as_deref());
     let mut out = SensitivityTrajectory {
         times: Vec::with_capacity(segments.len() + 1),

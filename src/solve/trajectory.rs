@@ -38,6 +38,8 @@ pub struct Stats {
     pub restarts: usize,
     /// Cycle samples whose loss terms were prepared (once per distinct input sample).
     pub samples_prepared: usize,
+    /// Controller switches located as events (switching-function roots).
+    pub events: usize,
     /// True when the Newton iterations used the sparse LU.
     pub sparse: bool,
     /// The method that integrated (`auto` resolved).
@@ -56,6 +58,13 @@ pub struct Trajectory {
     pub losses: Rows,
     /// Segment index whose inputs each row shows.
     pub segment: Vec<usize>,
+    /// Each controller's share at each row (a two-point controller: 1 on, its off fraction off;
+    /// a valve: the cooler's share), after the switches due at that instant.
+    pub controls: Rows,
+    /// Switches of each controller over the run.
+    pub switches: Vec<usize>,
+    /// Every located switch: (time, s; controller index).
+    pub events: Vec<(f64, usize)>,
     /// Counters.
     pub stats: Stats,
     /// Wall time of the integration, s.

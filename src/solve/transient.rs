@@ -8,14 +8,16 @@
 //!    runaway runs are stopped by our own step budget instead.
 //! 2. `TstopReached` may leave `t` one ulp short of the stop time: the segment index is kept here,
 //!    never derived from `t`; the time is reset to the exact segment start at a restart.
-//! 3. Roots are not used (samples and shifts are known times: stop times).
+//! 3. Samples and shifts are known times (stop times); roots are the controllers' switching
+//!    functions only. A root found in the step that lands on the stop time hides `TstopReached`:
+//!    after the switch the state is set back to the root's time and the stop time set again.
 //! 4. After a restart the step size is re-estimated (Hairer–Nørsett–Wanner II.4 starting step with
 //!    the new derivative), not kept from before the jump.
 //! 5. Restarts only where the inputs jump ([`Restart::AtJumps`], default); `EveryInterval` exists
 //!    for the benchmark.
 //! 6. After changing the inputs the state's `dy` is set to `f(t⁺, y)`.
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::time::Instant;
 
 use diffsol::{FaerSparseMat, NalgebraMat, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason};
@@ -23,6 +25,7 @@ use diffsol::{FaerSparseMat, NalgebraMat, OdeBuilder, OdeEquations, OdeSolverMet
 use super::dense_lu::SmallDenseLu;
 use super::driver::Driver;
 use super::equations::{HostVector, SceneEquations};
+use super::events::Events;
 use super::rosenbrock;
 use super::rows::Rows;
 use super::sparse_lu::NetworkSparseLu;
@@ -62,6 +65,12 @@ pub fn integrate(
         *a = opts.atol * mean_c;
     }
     let work = RefCell::new(scene.work(first.inputs));
+    {
+        let mut w = work.borrow_mut();
+        scene.initial_control_modes(&y0, &mut w);
+        scene.settle_controls(&y0, &mut w);
+        w.net.switches.iter_mut().for_each(|x| *x = 0);
+    }
     let fail_build = |e: diffsol::error::DiffsolError| NumericalFailure {
         time: first.t0,
         node: scene.thermal.names[scene.thermal.oil].clone(),
@@ -74,6 +83,8 @@ pub fn integrate(
         segments,
         opts,
         atol: &atol,
+        events: Cell::new(0),
+        event_log: RefCell::new(Vec::new()),
     };
     let mut traj = Trajectory {
         times: Vec::with_capacity(segments.len() + 1),
@@ -83,6 +94,9 @@ pub fn integrate(
             if opts.record_losses { segments.len() + 1 } else { 0 },
         ),
         segment: Vec::with_capacity(segments.len() + 1),
+        controls: Rows::with_capacity(scene.thermal.controls.len(), segments.len() + 1),
+        switches: Vec::new(),
+        events: Vec::new(),
         stats: Stats::default(),
         wall_time_s: 0.0,
     };
@@ -141,6 +155,9 @@ pub fn integrate(
     traj.stats.rhs_evals = w.rhs_evals;
     traj.stats.jac_evals = w.jac_evals;
     traj.stats.samples_prepared = w.terms.prepared;
+    traj.stats.events = ctx.events.get();
+    traj.events = ctx.event_log.take();
+    traj.switches = w.net.switches.clone();
     traj.wall_time_s = start.elapsed().as_secs_f64();
     Ok(traj)
 }
@@ -164,6 +181,7 @@ impl Driver<'_> {
             self.record(traj, segs[0].t0, st.y.host(), 0);
         }
         let mut restarts = 0;
+        let mut events = Events::new(self.scene);
         for (k, seg) in segs.iter().enumerate() {
             if k > 0 {
                 // The inputs were switched to this segment's when the previous row was recorded.
@@ -219,15 +237,24 @@ impl Driver<'_> {
                     let why = format!("step size {h}: the right-hand side is not finite");
                     return Err(self.failure(t, &y, why));
                 }
+                events.step_start(solver);
                 let stepped = solver.step();
                 if stepped.is_ok() {
                     // A non-finite trial the solver recovered from is not this run's failure.
                     self.work.borrow_mut().failure = None;
                 }
                 match stepped {
-                    Ok(OdeSolverStopReason::TstopReached) => break,
+                    Ok(OdeSolverStopReason::TstopReached) => {
+                        if events.at_stop(self, solver, seg.t1)? {
+                            break;
+                        }
+                    }
                     Ok(OdeSolverStopReason::InternalTimestep) => {}
-                    Ok(OdeSolverStopReason::RootFound(..)) => {}
+                    Ok(OdeSolverStopReason::RootFound(tr, idx)) => {
+                        if events.at_root(self, solver, tr, idx, seg.t1)? {
+                            break;
+                        }
+                    }
                     Err(e) => {
                         let st = solver.state();
                         return Err(self.failure(st.t, st.y.host(), format!("solver error: {e}")));

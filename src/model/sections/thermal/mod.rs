@@ -1,7 +1,7 @@
 //! `[thermal]`: the lumped thermal network in the model file and its checks into a checked
 //! [`ThermalNetwork`] in SI units (temperatures in K). One file per sub-table, each with its
 //! serde struct, its checks and its checked type: [`nodes`], [`boundaries`], [`links`],
-//! [`coolers`], [`heat`], [`wall_mesh`]; [`common`] holds what they share (node references and
+//! [`coolers`], [`controls`], [`heat`], [`wall_mesh`]; [`common`] holds what they share (node references and
 //! names, gears, loss items), [`network`] the checked network they make up.
 //!
 //! Validation reports every problem with its key path: unknown node names, duplicate names,
@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 
 pub mod boundaries;
 pub mod common;
+pub mod controls;
 pub mod coolers;
 pub mod heat;
 pub mod links;
@@ -21,6 +22,7 @@ pub mod wall_mesh;
 
 pub use boundaries::{Boundary, BoundarySpec, BoundaryTemp};
 pub use common::{GearInfo, LossItemNames, NodeRef};
+pub use controls::{Control, ControlKind, ControlLaw, ControlSpec, ControlTarget};
 pub use coolers::{Cooler, CoolerSpec, ThermostatSpec};
 pub use heat::{HeatRule, HeatSpec, HeatTarget};
 pub use links::{Fluid, HLawSpec, HTableSpec, Link, LinkLaw, LinkSpec, RotatingSpec};
@@ -54,6 +56,9 @@ pub struct ThermalSpec {
     /// `[[thermal.coolers]]`: heat exchangers with an optional thermostat.
     #[serde(default)]
     pub coolers: Vec<CoolerSpec>,
+    /// `[[thermal.controls]]`: two-point controllers and bypass valves.
+    #[serde(default)]
+    pub controls: Vec<ControlSpec>,
     /// `[[thermal.heat]]`: where loss heat goes (overrides of the defaults).
     #[serde(default)]
     pub heat: Vec<HeatSpec>,
@@ -83,6 +88,7 @@ pub fn validate_thermal(
     let boundaries = boundaries::check_boundaries(&spec.boundaries, problems);
     let links = links::check_links(&spec.links, &names, gears, problems);
     let coolers = coolers::check_coolers(&spec.coolers, &names, problems);
+    let controls = controls::check_controls(&spec.controls, &names, &coolers, &links, problems);
     let oil_node = oil_node(&spec.oil_node, &names, problems);
     let heat = heat::check_heat(&spec.heat, &names, items, problems);
     if problems.len() == start {
@@ -96,6 +102,7 @@ pub fn validate_thermal(
         boundaries,
         links,
         coolers,
+        controls,
         heat,
         oil_node: oil_node?,
         initial_temp: initial + KELVIN_OFFSET,

@@ -4,6 +4,7 @@
 
 use super::boundaries::Boundary;
 use super::common::NodeRef;
+use super::controls::Control;
 use super::coolers::Cooler;
 use super::heat::HeatRule;
 use super::links::Link;
@@ -20,6 +21,8 @@ pub struct ThermalNetwork {
     pub links: Vec<Link>,
     /// Coolers.
     pub coolers: Vec<Cooler>,
+    /// Controllers.
+    pub controls: Vec<Control>,
     /// Heat rules (item rules override source rules, which override the defaults).
     pub heat: Vec<HeatRule>,
     /// Oil node index.

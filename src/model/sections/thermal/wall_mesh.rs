@@ -131,6 +131,16 @@ pub fn patch_name(node: &str, i: usize, j: usize) -> String {
     format!("{node}_{i}_{j}")
 }
 
+/// True when controller `c` switches a link with an end at node `h`.
+fn switches_link_of(net: &ThermalNetwork, c: &super::controls::Control, h: usize) -> bool {
+    let super::controls::ControlTarget::Link { link, .. } = &c.target else {
+        return false;
+    };
+    net.links
+        .iter()
+        .any(|l| &l.name == link && (l.a == NodeRef::Node(h) || l.b == NodeRef::Node(h)))
+}
+
 /// Replace the node `spec.node` of `net` by the patches of `spec`. Problems (unknown node, the oil
 /// node, a node lumping gears or feeding a cooler, out-of-range sizes) go to `problems` with the
 /// key path; the network is returned unchanged then.
@@ -154,6 +164,13 @@ pub fn mesh_wall(mut net: ThermalNetwork, spec: &WallMeshSpec, problems: &mut Pr
                 .any(|c| c.hot == NodeRef::Node(h) || c.cold == NodeRef::Node(h)) =>
         {
             problems.push(path, &spec.node, "a cooler side cannot be meshed as a wall")
+        }
+        Some(h) if net.controls.iter().any(|c| c.reads_or_heats(h) || switches_link_of(&net, c, h)) => {
+            problems.push(
+                path,
+                &spec.node,
+                "a controller's sensor or heater node, or an end of a link a controller switches, cannot be meshed as a wall",
+            )
         }
         Some(_) => {}
     }

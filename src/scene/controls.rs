@@ -1,0 +1,230 @@
+//! The controllers of a compiled network (`[[thermal.controls]]`): each has a discrete mode (a
+//! two-point controller on or off; a valve below its lower limit, proportional, or at its upper
+//! limit) that the integrators hold constant within a step and change only at located events,
+//! so the right-hand side is smooth between events.
+//!
+//! Switching functions: two per controller, `g ≤ 0` while the mode holds; an event is the
+//! first time some `g` turns positive. A cooling two-point controller (on above `on`, off below
+//! `off`, `on > off`) has `g = T − on` while off and `g = off − T` while on; a heating one the
+//! mirror; a valve has `T − lo` (below the lower limit), `T − hi` and `lo − T` (proportional),
+//! `hi − T` (at the upper limit), where the share `(T − closed)/(open − closed)` meets its limits,
+//! each shifted by [`EDGE_BAND`] to the far side.
+//! An unused function is −1.
+
+use crate::model::thermal::{Control, ControlLaw, ControlTarget};
+
+/// Half-width of the band around a valve's (or thermostat's) limit in which either region
+/// holds, K: the share is continuous across the limit, and this band keeps a state that sits on
+/// it (within rounding) from switching back and forth. The share's error for it is at most
+/// this over the proportional band.
+pub const EDGE_BAND: f64 = 1e-8;
+
+/// Switching functions per controller.
+pub const EVENTS_PER_CONTROL: usize = 2;
+
+/// State rows per controller after the boundary-energy quadrature: the energy it moved (J) and
+/// the time integral of its share (s; a two-point controller's time on).
+pub const ROWS_PER_CONTROL: usize = 2;
+
+/// A controller's law, temperatures in K.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Law {
+    /// On at `on`, off at `off`; cooling when `on > off`.
+    TwoPoint {
+        /// Switch-on temperature, K.
+        on: f64,
+        /// Switch-off temperature, K.
+        off: f64,
+        /// State at the start, when given.
+        initial_on: Option<bool>,
+    },
+    /// Share `(T − closed)/(open − closed)` between `lo` and `hi` (the temperatures where it
+    /// meets `min` and `max`).
+    Valve {
+        /// Share 0 at this temperature, K.
+        closed: f64,
+        /// Share 1 at this temperature, K.
+        open: f64,
+        /// Lowest share.
+        min: f64,
+        /// Highest share.
+        max: f64,
+        /// Temperature where the share meets `min`, K.
+        lo: f64,
+        /// Temperature where it meets `max`, K.
+        hi: f64,
+    },
+}
+
+/// What a controller acts on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Action {
+    /// The cooler (index among the compiled coolers) whose conductance it scales.
+    Cooler(usize),
+    /// The links (operating-point links carrying this controller's index) it scales.
+    Link,
+    /// A heater of `power` W into `node` while on.
+    Heater {
+        /// Node heated.
+        node: usize,
+        /// Power while on, W.
+        power: f64,
+    },
+}
+
+/// A compiled controller.
+#[derive(Debug, Clone)]
+pub struct ControlTerm {
+    /// Name.
+    pub name: String,
+    /// Sensor node.
+    pub sensor: usize,
+    /// Law.
+    pub law: Law,
+    /// Target.
+    pub action: Action,
+    /// Share of the target's conductance while a two-point controller is off.
+    pub off_fraction: f64,
+}
+
+impl ControlTerm {
+    /// Compile a checked controller; `cooler_index` maps a model cooler to its compiled index.
+    pub fn compile(c: &Control, cooler_index: impl Fn(usize) -> usize) -> ControlTerm {
+        let law = match c.law {
+            ControlLaw::TwoPoint { on, off, initial_on } => Law::TwoPoint { on, off, initial_on },
+            ControlLaw::Valve {
+                closed,
+                open,
+                min,
+                max,
+            } => Law::Valve {
+                closed,
+                open,
+                min,
+                max,
+                lo: closed + min * (open - closed),
+                hi: closed + max * (open - closed),
+            },
+        };
+        let (action, off_fraction) = match &c.target {
+            ControlTarget::Cooler { cooler, off_fraction } => {
+                (Action::Cooler(cooler_index(*cooler)), *off_fraction)
+            }
+            ControlTarget::Link { off_fraction, .. } => (Action::Link, *off_fraction),
+            ControlTarget::Heater { node, power } => (
+                Action::Heater {
+                    node: *node,
+                    power: *power,
+                },
+                0.0,
+            ),
+        };
+        ControlTerm {
+            name: c.name.clone(),
+            sensor: c.sensor,
+            law,
+            action,
+            off_fraction,
+        }
+    }
+
+    /// True for a two-point controller (its mode is on/off).
+    pub fn is_two_point(&self) -> bool {
+        matches!(self.law, Law::TwoPoint { .. })
+    }
+
+    /// The share x the controller applies in `mode` at sensor temperature `t` (K) and dx/dT:
+    /// a two-point controller 1 on, `off_fraction` off; a valve its limited share.
+    #[inline]
+    pub fn share(&self, mode: u8, t: f64) -> (f64, f64) {
+        match self.law {
+            Law::TwoPoint { .. } => (if mode == 1 { 1.0 } else { self.off_fraction }, 0.0),
+            Law::Valve {
+                closed,
+                open,
+                min,
+                max,
+                ..
+            } => match mode {
+                0 => (min, 0.0),
+                2 => (max, 0.0),
+                _ => {
+                    let w = 1.0 / (open - closed);
+                    ((t - closed) * w, w)
+                }
+            },
+        }
+    }
+
+    /// The switching functions in `mode` at sensor temperature `t` (K) into `g`.
+    #[inline]
+    pub fn events(&self, mode: u8, t: f64, g: &mut [f64]) {
+        let (a, b) = match self.law {
+            Law::TwoPoint { on, off, .. } => {
+                let cooling = on > off;
+                let g = match (cooling, mode == 1) {
+                    (true, false) => t - on,
+                    (true, true) => off - t,
+                    (false, false) => on - t,
+                    (false, true) => t - off,
+                };
+                (g, -1.0)
+            }
+            Law::Valve { lo, hi, .. } => match mode {
+                0 => (t - (lo + EDGE_BAND), -1.0),
+                1 => (t - (hi + EDGE_BAND), (lo - EDGE_BAND) - t),
+                _ => (-1.0, (hi - EDGE_BAND) - t),
+            },
+        };
+        g[0] = a;
+        g[1] = b;
+    }
+
+    /// The mode after switching function `slot` fired in `mode`.
+    pub fn flip(&self, mode: u8, slot: usize) -> u8 {
+        match self.law {
+            Law::TwoPoint { .. } => 1 - mode.min(1),
+            Law::Valve { .. } => {
+                if slot == 0 {
+                    (mode + 1).min(2)
+                } else {
+                    mode.saturating_sub(1)
+                }
+            }
+        }
+    }
+
+    /// The mode at the start at sensor temperature `t` (K): a two-point controller as given,
+    /// else on when `t` lies beyond the switch-on temperature; a valve by where `t` lies.
+    pub fn initial_mode(&self, t: f64) -> u8 {
+        match self.law {
+            Law::TwoPoint { on, off, initial_on } => {
+                let beyond = if on > off { t >= on } else { t <= on };
+                u8::from(initial_on.unwrap_or(beyond))
+            }
+            Law::Valve { lo, hi, .. } => {
+                if t < lo {
+                    0
+                } else if t > hi {
+                    2
+                } else {
+                    1
+                }
+            }
+        }
+    }
+
+    /// A mode in which no switching function is positive at `t` (the mode after the events
+    /// that are due at this point; unchanged when none is): flips while one is.
+    pub fn settle(&self, mut mode: u8, t: f64) -> u8 {
+        let mut g = [0.0; EVENTS_PER_CONTROL];
+        for _ in 0..3 {
+            self.events(mode, t, &mut g);
+            match g.iter().position(|v| *v > 0.0) {
+                Some(slot) => mode = self.flip(mode, slot),
+                None => break,
+            }
+        }
+        mode
+    }
+}

@@ -1,0 +1,196 @@
+//! Hostile controllers (`[[thermal.controls]]`): set points reversed, equal, NaN, outside the
+//! oil's range; a controller on a node that does not exist; two controllers on one cooler; keys
+//! of the wrong kind. Each is refused by the release binary with exit 1, the key path and the
+//! reason, and nothing is written.
+
+use std::path::Path;
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_geartherm"))
+}
+
+/// The FZG C model with a cooler without thermostat (`fan_cooler`) and `controls` appended.
+fn model_with(dir: &Path, controls: &str) -> std::path::PathBuf {
+    let text = std::fs::read_to_string("models/fzg_c.toml").unwrap();
+    let extra = r#"
+[[thermal.coolers]]
+name = "fan_cooler"
+hot = "oil"
+cold = "ambient"
+effectiveness = 0.5
+capacity_rate_w_per_k = 40.0
+"#;
+    let p = dir.join("m.toml");
+    std::fs::write(&p, format!("{text}\n{extra}\n{controls}")).unwrap();
+    p
+}
+
+const CYCLE: &str = "time_s,input_speed_rpm,input_torque_nm,gear\n0,3000,150,1\n600,3000,150,1\n";
+
+/// `run` on the model with `controls`: exit code, stderr, whether the output exists.
+fn run(controls: &str) -> (i32, String, bool) {
+    let d = tempfile::tempdir().unwrap();
+    let m = model_with(d.path(), controls);
+    let c = d.path().join("c.csv");
+    std::fs::write(&c, CYCLE).unwrap();
+    let out = d.path().join("out");
+    let o = bin()
+        .args(["run", m.to_str().unwrap(), "--cycle", c.to_str().unwrap()])
+        .args(["--out", out.to_str().unwrap(), "--quiet"])
+        .output()
+        .unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+        out.exists(),
+    )
+}
+
+fn two_point(on: &str, off: &str, sensor: &str, target: &str) -> String {
+    format!(
+        "[[thermal.controls]]\nname = \"fan\"\nkind = \"two_point\"\nsensor = \"{sensor}\"\n\
+         on_c = {on}\noff_c = {off}\n{target}\n"
+    )
+}
+
+fn refused(controls: &str, path: &str, reason: &str) {
+    let (code, err, written) = run(controls);
+    assert_eq!(code, 1, "{controls}\n{err}");
+    assert!(err.contains(path), "key path {path} missing: {err}");
+    assert!(err.contains(reason), "reason {reason:?} missing: {err}");
+    assert!(!written, "nothing is written: {controls}");
+}
+
+const COOLER: &str = "cooler = \"fan_cooler\"";
+
+#[test]
+fn a_valid_controller_runs() {
+    let (code, err, written) = run(&two_point("60.0", "55.0", "oil", COOLER));
+    assert_eq!(code, 0, "{err}");
+    assert!(written);
+}
+
+#[test]
+fn equal_set_points_are_refused_with_the_reason() {
+    refused(
+        &two_point("60.0", "60.0", "oil", COOLER),
+        "thermal.controls[0].off_c",
+        "chatter",
+    );
+}
+
+#[test]
+fn nan_and_out_of_range_set_points_are_refused() {
+    refused(
+        &two_point("nan", "55.0", "oil", COOLER),
+        "thermal.controls[0].on_c",
+        "must lie in",
+    );
+    refused(
+        &two_point("60.0", "250.0", "oil", COOLER),
+        "thermal.controls[0].off_c",
+        "200",
+    );
+    refused(
+        &two_point("-80.0", "55.0", "oil", COOLER),
+        "thermal.controls[0].on_c",
+        "must lie in",
+    );
+}
+
+#[test]
+fn reversed_valve_set_points_are_refused() {
+    let v = "[[thermal.controls]]\nname = \"valve\"\nkind = \"valve\"\nsensor = \"oil\"\n\
+             closed_c = 80.0\nopen_c = 70.0\ncooler = \"fan_cooler\"\n";
+    refused(v, "thermal.controls[0].open_c", "must be above closed_c");
+    let limits = "[[thermal.controls]]\nname = \"valve\"\nkind = \"valve\"\nsensor = \"oil\"\n\
+                  closed_c = 70.0\nopen_c = 80.0\nmin_share = 0.8\nmax_share = 0.2\n\
+                  cooler = \"fan_cooler\"\n";
+    refused(limits, "thermal.controls[0].max_share", "must be above min_share");
+}
+
+#[test]
+fn an_unknown_sensor_node_is_refused() {
+    refused(
+        &two_point("60.0", "55.0", "sump", COOLER),
+        "thermal.controls[0].sensor",
+        "unknown node",
+    );
+    refused(
+        &two_point("60.0", "55.0", "ambient", COOLER),
+        "thermal.controls[0].sensor",
+        "not a boundary",
+    );
+}
+
+#[test]
+fn two_controllers_on_one_cooler_are_refused() {
+    let a = two_point("60.0", "55.0", "oil", COOLER);
+    let b = a.replace("name = \"fan\"", "name = \"fan2\"");
+    refused(
+        &format!("{a}{b}"),
+        "thermal.controls[1].cooler",
+        "one controller per cooler",
+    );
+}
+
+#[test]
+fn targets_are_checked() {
+    refused(
+        &two_point("60.0", "55.0", "oil", "cooler = \"nope\""),
+        "thermal.controls[0].cooler",
+        "unknown cooler",
+    );
+    refused(
+        &two_point("60.0", "55.0", "oil", "cooler = \"oil_temperature_control\""),
+        "thermal.controls[0].cooler",
+        "its own thermostat",
+    );
+    refused(
+        &two_point("60.0", "55.0", "oil", "cooler = \"fan_cooler\"\nheater_w = 100.0"),
+        "thermal.controls[0]",
+        "exactly one target",
+    );
+    refused(
+        &two_point("40.0", "45.0", "oil", "heater_w = -5.0"),
+        "thermal.controls[0].heater_w",
+        "must lie in",
+    );
+    refused(
+        &two_point("60.0", "55.0", "oil", "cooler = \"fan_cooler\"\nclosed_c = 50.0"),
+        "thermal.controls[0].closed_c",
+        "not a key of a two_point controller",
+    );
+}
+
+/// `steady` on a network whose fan cycles: exit 0, `method` = `limit_cycle`, the oil's band
+/// between the set points, a period; the text names the controller.
+#[test]
+fn steady_reports_a_cycling_fan() {
+    let d = tempfile::tempdir().unwrap();
+    let m = model_with(d.path(), &two_point("60.0", "55.0", "oil", COOLER));
+    let args = [
+        m.to_str().unwrap(),
+        "--gear",
+        "1",
+        "--speed-rpm",
+        "3000",
+        "--torque-nm",
+        "150",
+    ];
+    let o = bin().arg("steady").args(args).arg("--json").output().unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["method"], "limit_cycle");
+    let c = &v["limit_cycle"];
+    let (lo, hi) = (
+        c["min_c"]["oil"].as_f64().unwrap(),
+        c["max_c"]["oil"].as_f64().unwrap(),
+    );
+    assert!((lo - 55.0).abs() < 1e-6 && (hi - 60.0).abs() < 1e-6, "{lo} {hi}");
+    assert!(c["period_s"].as_f64().unwrap() > 0.0);
+    let o = bin().arg("steady").args(args).output().unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("no equilibrium, controller fan cycles"), "{text}");
+}
