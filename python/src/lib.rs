@@ -713,7 +713,7 @@ fn study_case(spec: &str, text: String, file: &str, index: usize) -> PyResult<(V
     let s = load_study(spec, text, file)?;
     let c = pick_cases(&s, Some(vec![index]), None)?[0];
     let (ovs, _) = s.overrides(c.sample).map_err(input_error)?;
-    let job = match &s.jobs[c.job] {
+    let job = match &s.case_job(&c, s.spec.outputs.per_case) {
         geartherm::study::Job::Run(o) => serde_json::json!({"kind": "run", "options": o}),
         geartherm::study::Job::Steady(o) => serde_json::json!({"kind": "steady", "options": o}),
     };

@@ -36,7 +36,7 @@ def test_override_changes_the_model_and_keeps_the_original(at6):
     assert at6.overrides == []
     a = at6.losses("3", 2500, 150, 80)
     b = low.losses("3", 2500, 150, 80)
-    assert a != b
+    assert not a.equals(b)
 
 
 def test_invalid_override_raises_with_the_key_path(at6):

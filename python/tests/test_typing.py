@@ -24,7 +24,9 @@ def test_the_docs_examples_pass_mypy_strict(tmp_path):
         files.append(str(f))
     assert len(files) >= 5, files
     p = subprocess.run(
-        [sys.executable, "-m", "mypy", "--strict", "--no-incremental", "--cache-dir", str(tmp_path / ".mypy"), *files],
+        [sys.executable, "-m", "mypy", "--strict",
+         # distributed's own LocalCluster and Client have no annotations (not geartherm's).
+         "--untyped-calls-exclude", "distributed", "--no-incremental", "--cache-dir", str(tmp_path / ".mypy"), *files],
         capture_output=True,
         text=True,
         cwd=tmp_path,

@@ -24,8 +24,8 @@ TomlValue = Union[bool, int, float, str, Sequence["TomlValue"], Mapping[str, "To
 Json = Union[None, bool, int, float, str, List["Json"], Dict[str, "Json"]]
 
 #: A study parameter's specification (``{"range": [lo, hi]}``, ``{"values": [...]}``,
-#: ``{"scale": [lo, hi]}``, ``"levels"``, ``"path"``).
-ParameterSpec = Mapping[str, Union[str, int, float, Sequence[Union[str, int, float]]]]
+#: ``{"scale": [lo, hi]}``, ``"levels"``, ``"path"``; checked when the study is built).
+ParameterSpec = Mapping[str, object]
 
 #: A study's job (``{"kind": "run", "cycles": [...], "options": {...}}``, ...) or sampling plan.
 JobSpec = Mapping[str, object]

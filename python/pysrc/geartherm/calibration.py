@@ -7,7 +7,7 @@ import json
 import math
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING, Dict, List, Literal, Optional, Sequence, Tuple, Union
+from typing import TYPE_CHECKING, Dict, List, Literal, Optional, Sequence, Tuple, TypedDict, Union
 
 from . import _native
 from ._tables import frame, html_table
@@ -124,6 +124,31 @@ class CalibrationResult:
         return f"CalibrationResult({len(self.parameters)} parameter(s), σ = {self._sigma:.3g} K)"
 
 
+class SegmentSummary(TypedDict):
+    """One segment of a trace file: its first and last line, rows, the time of its first row
+    in the file and its duration, s."""
+
+    first_line: int
+    last_line: int
+    rows: int
+    start_s: float
+    duration_s: float
+
+
+class TraceSummary(TypedDict):
+    """``geartherm trace --json``: rows read, kept and dropped, empty cells per column, the
+    segments, the node and boundary columns."""
+
+    source: str
+    rows: int
+    kept_rows: int
+    dropped_rows: int
+    missing_cells: Dict[str, int]
+    segments: List[SegmentSummary]
+    nodes: List[str]
+    boundaries: List[str]
+
+
 class TraceFile:
     """A measured trace file read as ``geartherm trace`` and ``geartherm calibrate`` read it.
 
@@ -144,8 +169,8 @@ class TraceFile:
     """
 
     def __init__(self, summary_json: str, segments: Sequence[Tuple[float, str]]):
-        self.summary: Dict[str, Json] = json.loads(summary_json)
-        s = json.loads(summary_json)
+        self.summary: TraceSummary = json.loads(summary_json)
+        s = self.summary
         self.offsets_s: List[float] = [float(o) for o, _ in segments]
         self.segments: List["pandas.DataFrame"] = [frame(csv) for _, csv in segments]
         self.dropped_rows: int = int(s["dropped_rows"])

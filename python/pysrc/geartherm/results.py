@@ -34,7 +34,8 @@ class TemperatureStats(TypedDict):
 
 
 class RunSummary(TypedDict, total=False):
-    """The ``summary.json`` of a run (docs/outputs.md lists every key)."""
+    """The ``summary.json`` of a run: energies per source, efficiencies, temperatures per node,
+    warnings, the solver's figures (docs/outputs.md lists every key)."""
 
     model: str
     cycle: str

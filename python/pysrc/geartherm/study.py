@@ -25,7 +25,9 @@ if TYPE_CHECKING:
     from . import Model
 
 Progress = Union[bool, Callable[[int, int], None], None]
-Parameters = Union[Mapping[str, ParameterSpec], Sequence[ParameterSpec]]
+# A mapping {key path: its specification} or a list of specifications with a "path" (checked
+# when the study is built: a wrong shape is a TypeError naming what is expected).
+Parameters = Union[Mapping[str, object], Sequence[ParameterSpec]]
 Backend = Literal["pandas", "polars"]
 
 __all__ = ["Study", "study", "study_commands", "read_study"]
