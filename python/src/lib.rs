@@ -116,6 +116,10 @@ struct State {
     overrides: Vec<String>,
 }
 
+/// A calibration for Python: (`calibration.json`, `fit.csv`, `calibrated.toml`, `cycle.csv`
+/// texts, the CLI's files as (name, bytes)).
+type Calibration = (String, String, String, String, Vec<(String, Vec<u8>)>);
+
 /// A checked gearbox model.
 #[pyclass(module = "geartherm._native", frozen)]
 struct Model {
@@ -300,15 +304,14 @@ impl Model {
 
     // --- calibrate -----------------------------------------------------------------------
     /// Calibrate against a trace given as CSV text (`trace_name` names it in messages; a
-    /// mapping of `job::CalibrateOptions` in): (`calibration.json`, `fit.csv`,
-    /// `calibrated.toml`, `cycle.csv`) texts.
+    /// mapping of `job::CalibrateOptions` in): a [`Calibration`].
     fn calibrate(
         &self,
         py: Python<'_>,
         trace_csv: &str,
         trace_name: &str,
         options: &Bound<'_, PyAny>,
-    ) -> PyResult<(String, String, String, String, Vec<(String, Vec<u8>)>)> {
+    ) -> PyResult<Calibration> {
         let mut o: job::CalibrateOptions = self::options("calibrate", options)?;
         o.trace = trace_name.to_string();
         let file = job::calibrate::trace_file::read(trace_csv, trace_name, o.missing())

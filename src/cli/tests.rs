@@ -188,6 +188,8 @@ fn calibrate_options_round_trip() {
             max_steps: 1234,
             max_iterations: 7,
             initial_from_trace: false,
+            segment: Some(2),
+            refuse_missing: true,
         },
     ];
     for o in all {

@@ -204,8 +204,9 @@ fn time_of(row: &Row<'_>, col: Option<usize>) -> Option<f64> {
 /// a new one. Without readable times (the segment reader then names the bad cell) one segment.
 fn split(rows: &[Row<'_>], col: Option<usize>) -> Vec<std::ops::Range<usize>> {
     let times: Option<Vec<f64>> = rows.iter().map(|r| time_of(r, col)).collect();
+    let whole = 0..rows.len();
     let Some(times) = times.filter(|t| t.len() > 1) else {
-        return vec![0..rows.len()];
+        return vec![whole];
     };
     let mut steps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
     steps.sort_by(f64::total_cmp);
