@@ -109,6 +109,25 @@ fn classify(source: &str, line: usize, col: &str) -> Result<Kind, TraceError> {
     )))
 }
 
+/// What each header column is (a column named twice or unknown is an error naming it).
+fn header_kinds(source: &str, line: usize, header: &[&str]) -> Result<Vec<Kind>, TraceError> {
+    let mut kinds = Vec::with_capacity(header.len());
+    for (i, col) in header.iter().enumerate() {
+        if header[..i].iter().any(|c| c.eq_ignore_ascii_case(col)) {
+            return Err(TraceError(format!(
+                "{source}, line {line}: column \"{col}\": appears twice"
+            )));
+        }
+        kinds.push(classify(source, line, col)?);
+    }
+    Ok(kinds)
+}
+
+/// The header's columns checked (each known, none twice) before any row is read.
+pub(super) fn check_header(source: &str, line: usize, header: &[&str]) -> Result<(), TraceError> {
+    header_kinds(source, line, header).map(|_| ())
+}
+
 impl Trace {
     /// Parse and check trace text of one segment; `source` names it in messages. An empty cell
     /// or a gap in time is an error here ([`super::trace_file::read`] cuts a file with them into
@@ -128,16 +147,7 @@ impl Trace {
             .position(|l| is_record(l))
             .ok_or_else(|| TraceError(format!("{source}: empty trace: no header line")))?;
         let header: Vec<&str> = lines[head].split(',').map(str::trim).collect();
-        let mut kinds = Vec::with_capacity(header.len());
-        for (i, col) in header.iter().enumerate() {
-            if header[..i].iter().any(|c| c.eq_ignore_ascii_case(col)) {
-                return Err(TraceError(format!(
-                    "{source}, line {}: column \"{col}\": appears twice",
-                    head + 1
-                )));
-            }
-            kinds.push(classify(source, head + 1, col)?);
-        }
+        let kinds = header_kinds(source, head + 1, &header)?;
         // The cycle columns, on the same line numbers, for the cycle reader.
         let cycle_cols: Vec<usize> = (0..header.len())
             .filter(|&i| matches!(kinds[i], Kind::Cycle))

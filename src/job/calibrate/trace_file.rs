@@ -16,7 +16,7 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use super::trace::{Trace, TraceError, MAX_GAP_FACTOR};
+use super::trace::{check_header, Trace, TraceError, MAX_GAP_FACTOR};
 
 /// What an empty cell does.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -112,6 +112,7 @@ pub fn read(text: &str, source: &str, missing: Missing) -> Result<TraceFile, Tra
         .position(|l| is_record(l))
         .ok_or_else(|| TraceError(format!("{source}: empty trace: no header line")))?;
     let header: Vec<&str> = lines[head].split(',').map(str::trim).collect();
+    check_header(source, head + 1, &header)?;
     let mut counts = vec![0usize; header.len()];
     let mut kept = Vec::new();
     let mut rows = 0;
