@@ -169,6 +169,10 @@ def test_input_errors_carry_their_fields():
     with pytest.raises(geartherm.InputError) as e:
         at6.steady(gear="6", speed_rpm=60000, torque_nm=10)
     assert e.value.path == "speed_rpm" and e.value.value == 60000.0 and "50000" in e.value.allowed.replace(" ", "")
+    assert isinstance(e.value.value, float)
+    with pytest.raises(geartherm.InputError) as e:
+        at6.steady(gear="9", speed_rpm=1000, torque_nm=10)
+    assert (e.value.path, e.value.value) == ("gear", "9") and "R" in e.value.allowed
     bad = _rig()
     bad.loc[3, "node:oil"] = 900.0
     with pytest.raises(geartherm.InputError) as e:

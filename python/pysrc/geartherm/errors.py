@@ -187,5 +187,23 @@ def _from_native(
             kw[k] = f[k]
     if f.get("value") is not None:
         kw["value"] = typed(str(f["value"]))
+    if cls is InputError and not m and problems:
+        kw["value"] = _option_value(str(kw.get("path") or problems[0][0]), problems[0][1])
     err: BaseException = cls(message, problems=problems, **kw)  # type: ignore[arg-type]
     return err
+
+
+# Options whose values are names (kept as text) and those that are counts (int); every other
+# option is a quantity (float).
+_NAME_OPTIONS = {"gear", "cycle", "solver", "trace", "fit", "holdout", "backend"}
+_COUNT_OPTIONS = {"max_steps", "max_iterations", "threads", "threads_per_task", "batch_size", "cases", "segment"}
+
+
+def _option_value(option: str, text: str) -> Value:
+    """An option's value as the Python type the API takes for it."""
+    if option in _NAME_OPTIONS:
+        return text
+    v = typed(text)
+    if isinstance(v, int) and not isinstance(v, bool) and option not in _COUNT_OPTIONS:
+        return float(v)
+    return v
