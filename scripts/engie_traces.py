@@ -13,6 +13,12 @@
 
     python3 scripts/engie_traces.py EXTRACT_DIR OUT_DIR
 
+Reads the extracts and the full records (R80711_2013-2020.csv, …, in
+../shared/data/engie_la_haute_borne/ from the repository root). A source cell that is empty
+stays empty in the trace (a missing value: `geartherm calibrate` and `geartherm trace` drop
+such rows and count them, or refuse them with --refuse-missing); the record's gaps in time stay
+gaps (the trace reader cuts the trace into segments there).
+
 Also prints the overall ratio Ds_avg / Rs_avg (median over rows with the rotor above 8 rpm).
 """
 import csv
@@ -29,24 +35,41 @@ def rows(path):
         return list(csv.DictReader(line for line in fh if not line.startswith("#")))
 
 
+def number(x, key):
+    """The cell as a float, None when it is empty."""
+    v = (x.get(key) or "").strip()
+    return float(v) if v else None
+
+
+def inputs(x):
+    """(speed rpm, torque N·m) as text, empty where a source cell is."""
+    ds, p = number(x, "Ds_avg"), number(x, "P_avg")
+    if ds is None or p is None:
+        return "", ""
+    n = max(ds, 0.0)
+    w = n * math.pi / 30.0
+    torque = -p * 1e3 / w if n > 50.0 else 0.0
+    return f"{n}", f"{torque:.1f}"
+
+
 def main(src, out):
     os.makedirs(out, exist_ok=True)
     for path in sorted(glob.glob(os.path.join(src, "R807*_*.csv"))):
         r = rows(path)
         t0 = datetime.fromisoformat(r[0]["Date_time"]).timestamp()
-        ratio = statistics.median(
-            float(x["Ds_avg"]) / float(x["Rs_avg"]) for x in r if float(x["Rs_avg"]) > 8.0
-        )
+        pairs = [(number(x, "Ds_avg"), number(x, "Rs_avg")) for x in r]
+        ratio = statistics.median(ds / rs for ds, rs in pairs if ds is not None and rs is not None and rs > 8.0)
         dest = os.path.join(out, os.path.basename(path))
+        empty = 0
         with open(dest, "w") as fh:
             fh.write("time_s,input_speed_rpm,input_torque_nm,gear,boundary:nacelle,boundary:outdoor,node:sump\n")
             for x in r:
                 t = datetime.fromisoformat(x["Date_time"]).timestamp() - t0
-                n = max(float(x["Ds_avg"]), 0.0)
-                w = n * math.pi / 30.0
-                torque = -float(x["P_avg"]) * 1e3 / w if n > 50.0 else 0.0
-                fh.write(f"{t:.0f},{n},{torque:.1f},run,{x['Yt_avg']},{x['Ot_avg']},{x['Gost_avg']}\n")
-        print(f"{dest}: {len(r)} rows, ratio Ds/Rs {ratio:.3f}")
+                n, torque = inputs(x)
+                cells = [n, torque, (x["Yt_avg"] or "").strip(), (x["Ot_avg"] or "").strip(), (x["Gost_avg"] or "").strip()]
+                empty += any(c == "" for c in cells)
+                fh.write(f"{t:.0f},{cells[0]},{cells[1]},run,{cells[2]},{cells[3]},{cells[4]}\n")
+        print(f"{dest}: {len(r)} rows ({empty} with an empty cell), ratio Ds/Rs {ratio:.3f}")
 
 
 if __name__ == "__main__":

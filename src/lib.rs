@@ -14,12 +14,14 @@
 //! | [`model`] | the model file: serde schema, key-path overrides, every check with its key path |
 //! | [`physics`] | pure physics in SI units: oil, geometry, kinematics, losses, thermal links |
 //!
-//! The command-line front end lives in `src/main.rs` and `src/cli/`, the Python binding in
-//! `python/`; both only convert arguments into [`job`] options, call the same functions and
+//! The command-line front end lives in `src/cli/` (its entry point is [`cli_main`], which
+//! `src/main.rs` and the Python package's `geartherm` console script call), the Python binding
+//! in `python/`; both only convert arguments into [`job`] options, call the same functions and
 //! print.
 
 #![warn(missing_docs)]
 
+mod cli;
 pub mod cycle;
 pub mod job;
 pub mod model;
@@ -29,3 +31,5 @@ pub mod report;
 pub mod scene;
 pub mod solve;
 pub mod study;
+
+pub use cli::main as cli_main;

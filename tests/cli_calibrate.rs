@@ -42,7 +42,11 @@ const GOOD: [&str; 6] = [
 #[test]
 fn bad_traces_exit_1_and_write_nothing() {
     let d = tempfile::tempdir().unwrap();
-    let fit = ["--fit", "thermal.links[\"oil-housing\"].h_w_per_m2k"];
+    let fit = [
+        "--fit",
+        "thermal.links[\"oil-housing\"].h_w_per_m2k",
+        "--refuse-missing",
+    ];
     let cases: [(String, &[&str]); 5] = [
         (
             trace(&GOOD).replace("1200,3000,200,1,20,68", "1200,3000,200,1,20,nan"),
@@ -59,7 +63,7 @@ fn bad_traces_exit_1_and_write_nothing() {
         ),
         (
             trace(&GOOD).replace("1800,1500,100,1,20,70", "1800,1500,100,1,,70"),
-            &["line 5", "boundary:ambient", "gap"],
+            &["line 5", "boundary:ambient", "empty", "refused"],
         ),
     ];
     for (k, (text, wanted)) in cases.iter().enumerate() {
@@ -74,6 +78,54 @@ fn bad_traces_exit_1_and_write_nothing() {
         }
         assert!(!out.exists(), "case {k}: {} was written", out.display());
     }
+}
+
+#[test]
+fn empty_cells_are_dropped_and_counted_and_gaps_cut_segments() {
+    let d = tempfile::tempdir().unwrap();
+    let fit = ["--fit", "thermal.links[\"oil-housing\"].h_w_per_m2k", "--json"];
+    // Row 3 has an empty cell; a gap of 30 000 s starts a second segment.
+    let mut rows: Vec<String> = GOOD.iter().map(|r| r.to_string()).collect();
+    rows[2] = "1200,3000,200,1,20,".into();
+    rows.extend(
+        [
+            "33000,1500,100,1,20,50",
+            "33600,1500,100,1,20,49",
+            "34200,1500,100,1,20,48",
+        ]
+        .map(String::from),
+    );
+    let refs: Vec<&str> = rows.iter().map(String::as_str).collect();
+    let t = d.path().join("scada.csv");
+    std::fs::write(&t, trace(&refs)).unwrap();
+    let o = calibrate(&t, &d.path().join("none"), &fit);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("2 segments") && err.contains("--segment"), "{err}");
+    let mut args = fit.to_vec();
+    args.extend(["--segment", "0"]);
+    let o = calibrate(&t, &d.path().join("seg0"), &args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(s["rows"], 5, "{s}");
+    let warnings = s["warnings"].to_string();
+    assert!(
+        warnings.contains("1 row(s) with empty cells dropped") && warnings.contains("node:oil 1"),
+        "{warnings}"
+    );
+    assert!(warnings.contains("segment 0 of 2"), "{warnings}");
+    let listed = Command::new(env!("CARGO_BIN_EXE_geartherm"))
+        .args(["trace", "--json"])
+        .arg(&t)
+        .output()
+        .unwrap();
+    let l: serde_json::Value = serde_json::from_slice(&listed.stdout).unwrap();
+    assert_eq!(
+        (l["rows"].as_u64(), l["dropped_rows"].as_u64()),
+        (Some(9), Some(1))
+    );
+    assert_eq!(l["segments"][1]["start_s"], 33000.0);
+    assert_eq!(l["segments"][1]["first_line"], 8);
 }
 
 #[test]

@@ -46,6 +46,11 @@ fn py_error(
 /// `.value`, `.allowed` and `.problems`), a numerical failure a `SolveError`, a missing file
 /// `FileNotFoundError`, other I/O `OSError`.
 fn job_error(e: JobError) -> PyErr {
+    job_error_in(e, None)
+}
+
+/// [`job_error`] for a model's own file: an invalid model names it (`.file`).
+fn job_error_in(e: JobError, file: Option<String>) -> PyErr {
     let problems: Vec<(String, String, String)> = e
         .problems
         .iter()
@@ -58,11 +63,18 @@ fn job_error(e: JobError) -> PyErr {
         ErrorKind::Model => "model",
         ErrorKind::Option | ErrorKind::Invalid => "input",
     };
-    py_error(kind, e.message, problems, None)
+    let file = if kind == "model" { file } else { None };
+    py_error(kind, e.message, problems, file)
 }
 
 fn input_error(message: String) -> PyErr {
     py_error("input", message, Vec::new(), None)
+}
+
+/// A trace's problem: an `InputError` whose fields come from its message (`FILE, line N: column
+/// C = "V": what`).
+fn trace_error(message: &str) -> PyErr {
+    py_error("input", message.to_string(), Vec::new(), None)
 }
 
 fn study_error(e: StudyError) -> PyErr {
@@ -104,6 +116,10 @@ struct State {
     overrides: Vec<String>,
 }
 
+/// A calibration for Python: (`calibration.json`, `fit.csv`, `calibrated.toml`, `cycle.csv`
+/// texts, the CLI's files as (name, bytes)).
+type Calibration = (String, String, String, String, Vec<(String, Vec<u8>)>);
+
 /// A checked gearbox model.
 #[pyclass(module = "geartherm._native", frozen)]
 struct Model {
@@ -129,7 +145,8 @@ fn build(state: State) -> PyResult<Model> {
         })?;
         ovs.push(o);
     }
-    let m = job::Model::from_text(&state.text, &file, &ovs).map_err(job_error)?;
+    let m = job::Model::from_text(&state.text, &file, &ovs)
+        .map_err(|e| job_error_in(e, Some(state.file.clone())))?;
     Ok(Model {
         state,
         m: Arc::new(m),
@@ -198,6 +215,22 @@ impl Model {
     #[getter]
     fn name(&self) -> &str {
         &self.m.gearbox.name
+    }
+
+    /// The model's text with every override written in at its key path (comments and layout
+    /// kept), which `Model.from_text` checks into an equal model.
+    fn to_toml(&self) -> PyResult<String> {
+        geartherm::job::calibrate::model_file::calibrated_text(&self.state.text, &self.m.overrides, &[])
+            .map_err(|e| py_error("model", format!("{}: {e}", self.state.file), Vec::new(), None))
+    }
+
+    /// Two models are equal when their checked gearboxes are (every value, bit for bit),
+    /// whatever text, file name and overrides made them.
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        match other.cast::<Model>() {
+            Ok(o) => format!("{:?}", self.m.gearbox) == format!("{:?}", o.get().m.gearbox),
+            Err(_) => false,
+        }
     }
 
     /// Counts of the checked model (JSON).
@@ -271,24 +304,36 @@ impl Model {
 
     // --- calibrate -----------------------------------------------------------------------
     /// Calibrate against a trace given as CSV text (`trace_name` names it in messages; a
-    /// mapping of `job::CalibrateOptions` in): (`calibration.json`, `fit.csv`,
-    /// `calibrated.toml`, `cycle.csv`) texts.
+    /// mapping of `job::CalibrateOptions` in): a [`Calibration`].
     fn calibrate(
         &self,
         py: Python<'_>,
         trace_csv: &str,
         trace_name: &str,
         options: &Bound<'_, PyAny>,
-    ) -> PyResult<(String, String, String, String)> {
+    ) -> PyResult<Calibration> {
         let mut o: job::CalibrateOptions = self::options("calibrate", options)?;
         o.trace = trace_name.to_string();
-        let trace = job::calibrate::Trace::parse(trace_csv, trace_name)
-            .map_err(|e| job_error(JobError::invalid(e.to_string())))?;
+        let file = job::calibrate::trace_file::read(trace_csv, trace_name, o.missing())
+            .map_err(|e| trace_error(&e.to_string()))?;
+        let trace = file.select(o.segment).map_err(|e| trace_error(&e.to_string()))?;
         let (m, text) = (self.m.clone(), self.state.text.clone());
         let r = py
-            .detach(|| in_process_pool(|| job::calibrate::calibrate(&m, &text, &trace, &o)))
+            .detach(|| in_process_pool(|| job::calibrate::calibrate(&m, &text, trace, &o)))
             .map_err(job_error)?;
-        Ok((to_json(&r.summary)?, r.fit_csv, r.calibrated_model, r.cycle_csv))
+        let files = r
+            .files()
+            .map_err(job_error)?
+            .into_iter()
+            .map(|(n, b)| (n.to_string(), b))
+            .collect();
+        Ok((
+            to_json(&r.summary)?,
+            r.fit_csv,
+            r.calibrated_model,
+            r.cycle_csv,
+            files,
+        ))
     }
     // --- end calibrate -------------------------------------------------------------------
 
@@ -642,6 +687,50 @@ fn sources() -> Vec<&'static str> {
         .collect()
 }
 
+/// Read trace text as `geartherm trace` does (`refuse`: empty cells are errors): (the summary
+/// JSON, each segment's (offset s, CSV text)).
+#[pyfunction]
+fn read_trace(text: &str, name: &str, refuse: bool) -> PyResult<(String, Vec<(f64, String)>)> {
+    let missing = if refuse {
+        job::calibrate::Missing::Refuse
+    } else {
+        job::calibrate::Missing::Drop
+    };
+    let f = job::calibrate::trace_file::read(text, name, missing).map_err(|e| trace_error(&e.to_string()))?;
+    let segs = f.segments.iter().map(|s| (s.offset_s, s.csv.clone())).collect();
+    Ok((to_json(&f.summary())?, segs))
+}
+
+/// Draw `calibration.png` into a directory holding a calibration's `fit.csv` (as the CLI does).
+#[pyfunction]
+fn render_calibration(py: Python<'_>, dir: PathBuf) -> PyResult<()> {
+    py.detach(|| geartherm::report::plots::calibration::render_calibration(&dir))
+        .map(|_| ())
+        .map_err(|e| py_error("io", format!("calibration.png: {e}"), Vec::new(), None))
+}
+
+/// Case `index` of a study: (its overrides as `"path = toml value"` lines, its job as JSON:
+/// `{"kind": "run", "options": RunOptions}` or `{"kind": "steady", "options": SteadyOptions}`).
+#[pyfunction]
+fn study_case(spec: &str, text: String, file: &str, index: usize) -> PyResult<(Vec<String>, String)> {
+    let s = load_study(spec, text, file)?;
+    let c = pick_cases(&s, Some(vec![index]), None)?[0];
+    let (ovs, _) = s.overrides(c.sample).map_err(input_error)?;
+    let job = match &s.case_job(&c, s.spec.outputs.per_case) {
+        geartherm::study::Job::Run(o) => serde_json::json!({"kind": "run", "options": o}),
+        geartherm::study::Job::Steady(o) => serde_json::json!({"kind": "steady", "options": o}),
+    };
+    Ok((ovs.iter().map(|o| o.to_string()).collect(), to_json(&job)?))
+}
+
+/// The `geartherm` command line (the program's name first), run in this process exactly as the
+/// binary runs it, with the GIL released; returns the exit code (the console script exits with
+/// it).
+#[pyfunction]
+fn cli(py: Python<'_>, argv: Vec<std::ffi::OsString>) -> i32 {
+    py.detach(|| geartherm::cli_main(argv))
+}
+
 /// Version of the geartherm library this binding was built with.
 #[pyfunction]
 fn version() -> &'static str {
@@ -663,6 +752,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(oils, m)?)?;
     m.add_function(wrap_pyfunction!(cycles, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
+    m.add_function(wrap_pyfunction!(cli, m)?)?;
+    m.add_function(wrap_pyfunction!(read_trace, m)?)?;
+    m.add_function(wrap_pyfunction!(render_calibration, m)?)?;
+    m.add_function(wrap_pyfunction!(study_case, m)?)?;
     m.add_function(wrap_pyfunction!(sources, m)?)?;
     Ok(())
 }

@@ -46,9 +46,14 @@ def test_bad_traces_are_refused_like_the_cli():
     bad = rig().rename(columns={"node:housing": "node:case"})
     with pytest.raises(geartherm.GearthermError, match="node:case"):
         base.calibrate(bad, fit=[H])
+    # A NaN is an empty cell in the CSV text: its row is dropped and counted (a warning), or,
+    # with missing="refuse", refused naming the line and the column.
     nan = rig()
     nan.loc[3, "node:oil"] = float("nan")
-    with pytest.raises(geartherm.GearthermError, match="node:oil"):
-        base.calibrate(nan, fit=[H])
+    r = base.calibrate(nan, fit=[H])
+    assert len(r.fit) == 30 and any("1 row(s) with empty cells dropped" in w and "node:oil 1" in w for w in r.warnings)
+    with pytest.raises(geartherm.InputError, match="node:oil") as e:
+        base.calibrate(nan, fit=[H], missing="refuse")
+    assert e.value.line == 5 and e.value.path == "node:oil"
     with pytest.raises(geartherm.GearthermError, match="max_iterations"):
         base.calibrate(rig(), fit=[H], max_iterations=0)

@@ -2,9 +2,9 @@
 
 use std::path::PathBuf;
 
-use geartherm::job::bench::BenchRow;
-use geartherm::job::bench::{bench as run_bench, BenchOptions};
-use geartherm::report::files::OutputDir;
+use crate::job::bench::BenchRow;
+use crate::job::bench::{bench as run_bench, BenchOptions};
+use crate::report::files::OutputDir;
 
 use super::output::{emit, io_failure, warn};
 use super::{Failure, ModelSource};
@@ -98,7 +98,7 @@ pub fn bench(args: &BenchArgs) -> Result<(), Failure> {
     for (name, bytes) in r.files()? {
         out.write(name, &bytes)?;
     }
-    geartherm::report::plots::render_bench(out.path()).map_err(|e| io_failure(format!("plot: {e}")))?;
+    crate::report::plots::render_bench(out.path()).map_err(|e| io_failure(format!("plot: {e}")))?;
     emit(&format!(
         "{}\n{}\n",
         out.target().join("bench.csv").display(),

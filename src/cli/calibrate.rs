@@ -3,9 +3,9 @@
 
 use std::path::PathBuf;
 
-use geartherm::job::calibrate::{self, CalibrateOptions, Trace};
-use geartherm::report::calibration::to_text;
-use geartherm::report::files::OutputDir;
+use crate::job::calibrate::{self, CalibrateOptions, Missing, TraceFile};
+use crate::report::calibration::to_text;
+use crate::report::files::OutputDir;
 
 use super::output::{emit, emit_json, invalid, io_failure, warn};
 use super::{Failure, ModelSource};
@@ -33,10 +33,10 @@ pub struct CalibrateArgs {
     #[arg(long, default_value_t = calibrate::DEFAULT_RTOL)]
     pub rtol: f64,
     /// Absolute tolerance, K (1e-14 … 1).
-    #[arg(long, default_value_t = geartherm::job::run::DEFAULT_ATOL)]
+    #[arg(long, default_value_t = crate::job::run::DEFAULT_ATOL)]
     pub atol: f64,
     /// Step budget of one integration.
-    #[arg(long, default_value_t = geartherm::job::run::DEFAULT_MAX_STEPS)]
+    #[arg(long, default_value_t = crate::job::run::DEFAULT_MAX_STEPS)]
     pub max_steps: usize,
     /// Most evaluations with sensitivities (1 … 1000).
     #[arg(long, default_value_t = calibrate::DEFAULT_MAX_ITERATIONS)]
@@ -44,6 +44,13 @@ pub struct CalibrateArgs {
     /// Start from the model's initial temperatures instead of the trace's first row.
     #[arg(long)]
     pub keep_initial: bool,
+    /// The segment of the trace fitted, 0-based (gaps in time cut a trace file into
+    /// segments; `geartherm trace FILE` lists them).
+    #[arg(long, value_name = "K")]
+    pub segment: Option<usize>,
+    /// Refuse a trace with empty cells (by default their rows are dropped and counted).
+    #[arg(long)]
+    pub refuse_missing: bool,
     /// Print calibration.json on stdout.
     #[arg(long)]
     pub json: bool,
@@ -61,6 +68,8 @@ impl CalibrateArgs {
             max_steps: self.max_steps,
             max_iterations: self.max_iterations,
             initial_from_trace: !self.keep_initial,
+            segment: self.segment,
+            refuse_missing: self.refuse_missing,
         }
     }
 }
@@ -71,11 +80,12 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
     let m = args.source.load()?;
     let text = std::fs::read_to_string(&args.source.model)
         .map_err(|e| io_failure(format!("{}: {e}", args.source.model.display())))?;
-    let trace = Trace::load(&args.trace)
+    let o = args.options();
+    let file = TraceFile::load(&args.trace, o.missing())
         .map_err(|e| io_failure(format!("{}: {e}", args.trace.display())))?
         .map_err(|e| invalid(e.to_string()))?;
-    let o = args.options();
-    let prepared = calibrate::prepare(&m, &text, &trace, &o)?;
+    let trace = file.select(o.segment).map_err(|e| invalid(e.to_string()))?;
+    let prepared = calibrate::prepare(&m, &text, trace, &o)?;
     let dir = args
         .out
         .clone()
@@ -85,7 +95,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
     for (name, bytes) in result.files()? {
         out.write(name, &bytes)?;
     }
-    geartherm::report::plots::calibration::render_calibration(out.path())
+    crate::report::plots::calibration::render_calibration(out.path())
         .map_err(|e| io_failure(format!("calibration.png: {e}")))?;
     for w in &result.summary.warnings {
         warn(w);
@@ -101,4 +111,57 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
     }
     out.commit()?;
     Ok(())
+}
+
+/// Arguments of `trace`.
+#[derive(clap::Args, Debug)]
+pub struct TraceArgs {
+    /// Trace CSV (the columns of `calibrate --trace`).
+    pub trace: PathBuf,
+    /// Refuse empty cells (by default their rows are dropped and counted).
+    #[arg(long)]
+    pub refuse_missing: bool,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Read a trace file as `calibrate` reads it and print what it holds: rows, rows dropped for
+/// empty cells (per column), the segments its gaps cut it into.
+pub fn trace(args: &TraceArgs) -> Result<(), Failure> {
+    let missing = if args.refuse_missing {
+        Missing::Refuse
+    } else {
+        Missing::Drop
+    };
+    let file = TraceFile::load(&args.trace, missing)
+        .map_err(|e| io_failure(format!("{}: {e}", args.trace.display())))?
+        .map_err(|e| invalid(e.to_string()))?;
+    let s = file.summary();
+    if args.json {
+        return emit_json(&s);
+    }
+    let mut out = format!(
+        "{}: {} rows, {} kept in {} segment(s), {} dropped for empty cells\n",
+        s.source,
+        s.rows,
+        s.kept_rows,
+        s.segments.len(),
+        s.dropped_rows
+    );
+    for (c, n) in &s.missing_cells {
+        out.push_str(&format!("  empty cells in {c}: {n}\n"));
+    }
+    out.push_str(&format!(
+        "  nodes: {}; boundaries: {}\n",
+        s.nodes.join(", "),
+        s.boundaries.join(", ")
+    ));
+    for (k, g) in s.segments.iter().enumerate() {
+        out.push_str(&format!(
+            "  segment {k}: lines {}…{}, {} rows, from {} s for {} s\n",
+            g.first_line, g.last_line, g.rows, g.start_s, g.duration_s
+        ));
+    }
+    emit(&out)
 }

@@ -1,7 +1,7 @@
 //! `check`, `info` and `losses`: the commands that read a model and print, writing no files.
 
-use geartherm::job::{self, LossesOptions};
-use geartherm::report::{info, losses};
+use crate::job::{self, LossesOptions};
+use crate::report::{info, losses};
 
 use super::output::{emit, emit_json, warnings};
 use super::{Failure, ModelSource};

@@ -1,8 +1,10 @@
 //! Command-line interface: argument definitions, their conversion into the use-case layer's
-//! options ([`geartherm::job`]), and dispatch. A command converts its arguments once, calls the
+//! options ([`crate::job`]), and dispatch. A command converts its arguments once, calls the
 //! job, writes the output directory, prints; the exit code comes from the job's error kind (0
 //! ok, 1 invalid input, 2 numerical failure, 3 I/O, 141 closed standard output).
 
+use std::ffi::OsString;
+use std::io::Write;
 use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
@@ -22,8 +24,38 @@ mod validate;
 
 pub use output::Failure;
 
-use geartherm::job;
-use geartherm::model::Override;
+/// The `geartherm` command line `args` (the program's name first), run as the binary runs it:
+/// parse (a usage error exits 1 like any other bad input; clap's own 2 is this tool's code for a
+/// numerical failure; `--help` and `--version` exit 0), run, print a failure's message on
+/// standard error, flush standard output. Returns the exit code. The binary (`src/main.rs`) and
+/// the Python package's `geartherm` console script both call it.
+pub fn main<I, T>(args: I) -> i32
+where
+    I: IntoIterator<Item = T>,
+    T: Into<OsString> + Clone,
+{
+    let code = match Cli::try_parse_from(args) {
+        Err(e) => {
+            let _ = e.print();
+            i32::from(e.use_stderr())
+        }
+        Ok(cli) => match run(cli) {
+            Ok(()) => 0,
+            Err(f) => {
+                if !f.message.is_empty() {
+                    let newline = if f.message.ends_with('\n') { "" } else { "\n" };
+                    let _ = write!(std::io::stderr(), "{}{newline}", f.message);
+                }
+                f.code
+            }
+        },
+    };
+    let _ = std::io::stdout().flush();
+    code
+}
+
+use crate::job;
+use crate::model::Override;
 
 /// geartherm: gearbox power losses and temperatures over drive cycles.
 #[derive(Parser, Debug)]
@@ -67,6 +99,9 @@ pub enum Command {
     /// Fit model parameters (key paths with bounds) to a measured temperature trace: values with
     /// 95 % intervals, correlations, errors on fitted and held-out rows, calibrated.toml.
     Calibrate(calibrate::CalibrateArgs),
+    /// Read a measured trace as `calibrate` does: rows, rows dropped for empty cells, the
+    /// segments its gaps in time cut it into.
+    Trace(calibrate::TraceArgs),
 }
 
 /// The model file and `--set PATH=VALUE` overrides, shared by every command that reads a model.
@@ -107,5 +142,6 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         Command::Validate(a) => validate::validate(&a),
         Command::Report(a) => report::report(&a),
         Command::Calibrate(a) => calibrate::calibrate(&a),
+        Command::Trace(a) => calibrate::trace(&a),
     }
 }

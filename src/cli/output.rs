@@ -8,7 +8,7 @@
 
 use std::io::{ErrorKind, IsTerminal, Write};
 
-use geartherm::job::JobError;
+use crate::job::JobError;
 
 /// Exit code: invalid input (nothing written).
 pub const EXIT_INVALID: i32 = 1;
@@ -35,8 +35,8 @@ impl From<JobError> for Failure {
     }
 }
 
-impl From<geartherm::report::files::OutputError> for Failure {
-    fn from(e: geartherm::report::files::OutputError) -> Self {
+impl From<crate::report::files::OutputError> for Failure {
+    fn from(e: crate::report::files::OutputError) -> Self {
         Failure {
             code: EXIT_IO,
             message: format!("cannot write outputs: {e}"),
@@ -93,7 +93,7 @@ pub fn warn(line: &str) {
 }
 
 /// Each out-of-range warning as one stderr line (the scene only collects them).
-pub fn warnings(w: &[geartherm::job::RangeWarning]) {
+pub fn warnings(w: &[crate::job::RangeWarning]) {
     for x in w {
         warn(&x.to_string());
     }

@@ -4,9 +4,9 @@
 
 use std::path::PathBuf;
 
-use geartherm::job::rating::{self, RatingOptions, RatingPoint, RatingResult, Status};
-use geartherm::job::JobError;
-use geartherm::report::files::OutputDir;
+use crate::job::rating::{self, RatingOptions, RatingPoint, RatingResult, Status};
+use crate::job::JobError;
+use crate::report::files::OutputDir;
 
 use super::output::{emit, emit_json, io_failure, progress_bar, warn, warnings};
 use super::steady::{steady_text, values, PointArgs};
@@ -99,7 +99,7 @@ pub fn rating(a: &RatingArgs) -> Result<(), Failure> {
             out.write(name, &bytes)?;
         }
         if !a.no_plots {
-            geartherm::report::plots::rating::render(out.path(), &r.curve())
+            crate::report::plots::rating::render(out.path(), &r.curve())
                 .map_err(|e| io_failure(format!("plot: {e}")))?;
         }
     }

@@ -4,8 +4,8 @@
 
 use std::path::PathBuf;
 
-use geartherm::report::files::OutputDir;
-use geartherm::report::plots::{self, PlotError};
+use crate::report::files::OutputDir;
+use crate::report::plots::{self, PlotError};
 
 use super::output::{emit, invalid, EXIT_INVALID, EXIT_IO};
 use super::Failure;

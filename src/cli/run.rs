@@ -2,9 +2,9 @@
 
 use std::path::PathBuf;
 
-use geartherm::job::run::{prepare, solve, RunOptions, DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL};
-use geartherm::job::{self, RunResult};
-use geartherm::report::files::OutputDir;
+use crate::job::run::{prepare, solve, RunOptions, DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL};
+use crate::job::{self, RunResult};
+use crate::report::files::OutputDir;
 
 use super::output::{emit, emit_json, io_failure, progress_bar, warnings};
 use super::{Failure, ModelSource};
@@ -117,7 +117,7 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
         out.write(name, &bytes)?;
     }
     if args.report {
-        geartherm::report::plots::render_run(out.path()).map_err(|e| io_failure(format!("report: {e}")))?;
+        crate::report::plots::render_run(out.path()).map_err(|e| io_failure(format!("report: {e}")))?;
     }
     warnings(&result.summary.warnings);
     if args.json {

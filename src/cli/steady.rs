@@ -3,10 +3,10 @@
 
 use std::path::PathBuf;
 
-use geartherm::job::map::{self, axis, MapOptions};
-use geartherm::job::steady::{self, SteadyOptions, SteadyResult};
-use geartherm::job::JobError;
-use geartherm::report::files::OutputDir;
+use crate::job::map::{self, axis, MapOptions};
+use crate::job::steady::{self, SteadyOptions, SteadyResult};
+use crate::job::JobError;
+use crate::report::files::OutputDir;
 
 use super::output::{emit, emit_json, io_failure, progress_bar, warnings};
 use super::{Failure, ModelSource};
@@ -197,7 +197,7 @@ pub fn map(a: &MapArgs) -> Result<(), Failure> {
         out.write(name, &bytes)?;
     }
     if !a.no_plots {
-        geartherm::report::plots::render_map(out.path()).map_err(|e| io_failure(format!("plot: {e}")))?;
+        crate::report::plots::render_map(out.path()).map_err(|e| io_failure(format!("plot: {e}")))?;
     }
     emit(&format!(
         "{n} points ({} converged, {:.1} iterations on average) in {:.3} s on {} threads; outputs in {}\n",

@@ -1,13 +1,13 @@
 //! `geartherm study STUDY.toml --out DIR [--shard I/N] [--list]`: parses, runs the study with
-//! the library's runner (`geartherm::study::runner`: journal, resume, compaction) under a
+//! the library's runner (`crate::study::runner`: journal, resume, compaction) under a
 //! progress bar, stops cleanly on Ctrl-C (exit 130, resumable), prints the tally.
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use geartherm::report::study::CaseRow;
-use geartherm::study::runner::{self, Output, RunnerError};
-use geartherm::study::{Case, Study, StudyError};
+use crate::report::study::CaseRow;
+use crate::study::runner::{self, Output, RunnerError};
+use crate::study::{Case, Study, StudyError};
 
 use super::output::{emit, invalid, progress_bar, warn, Failure, EXIT_IO};
 

@@ -3,12 +3,12 @@
 
 use std::path::Path;
 
-use clap::Parser;
-use geartherm::job::command::{command_line, split, validate_line, ToArgs};
-use geartherm::job::{
+use crate::job::command::{command_line, split, validate_line, ToArgs};
+use crate::job::{
     BenchOptions, LossesOptions, MapOptions, RatingOptions, RunOptions, SteadyOptions, ValidateOptions,
 };
-use geartherm::model::Override;
+use crate::model::Override;
+use clap::Parser;
 
 use super::{Cli, Command};
 
@@ -170,7 +170,7 @@ fn validate_options_round_trip() {
 
 #[test]
 fn calibrate_options_round_trip() {
-    use geartherm::job::CalibrateOptions;
+    use crate::job::CalibrateOptions;
     let all = [
         CalibrateOptions {
             trace: "traces/rig 1.csv".into(),
@@ -188,6 +188,8 @@ fn calibrate_options_round_trip() {
             max_steps: 1234,
             max_iterations: 7,
             initial_from_trace: false,
+            segment: Some(2),
+            refuse_missing: true,
         },
     ];
     for o in all {

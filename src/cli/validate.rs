@@ -4,9 +4,9 @@
 
 use std::path::PathBuf;
 
-use geartherm::job::validate::{validate as run_validate, ValidateOptions};
-use geartherm::report::files::{write_all_atomic, OutputDir};
-use geartherm::report::validation::{
+use crate::job::validate::{validate as run_validate, ValidateOptions};
+use crate::report::files::{write_all_atomic, OutputDir};
+use crate::report::validation::{
     doc_block, rows_csv, splice_doc, summary_csv, summary_markdown, ValidationReport,
 };
 
@@ -76,7 +76,7 @@ pub fn validate(a: &ValidateArgs) -> Result<(), Failure> {
         ("validation_summary.csv", summary_csv(&r.summary)),
         ("validation.md", summary_markdown(&r.summary)),
     ];
-    geartherm::report::plots::render_validation(out.path(), &r.rows, &texts)
+    crate::report::plots::render_validation(out.path(), &r.rows, &texts)
         .map_err(|e| io_failure(format!("validate: {e}")))?;
     if let Some(doc) = &a.doc {
         write_doc(doc, &doc_block(&r.rows, &r.summary))?;

@@ -146,9 +146,20 @@ impl From<crate::cycle::CycleError> for JobError {
     fn from(e: crate::cycle::CycleError) -> JobError {
         let message = format!("cycle: {e}");
         if e.kind == crate::cycle::CycleErrorKind::Io {
-            JobError::io(message, std::io::ErrorKind::Other)
-        } else {
-            JobError::invalid(message)
+            return JobError::io(message, std::io::ErrorKind::Other);
+        }
+        // The problem: the column and its cell, or the cycle option and the name given.
+        let (path, value) = match (&e.column, &e.value) {
+            (Some(c), v) => (c.clone(), v.clone().unwrap_or_default()),
+            (None, v) => ("cycle".to_string(), v.clone().unwrap_or_else(|| e.source.clone())),
+        };
+        JobError {
+            problems: vec![Problem {
+                path,
+                value,
+                allowed: e.allowed.clone(),
+            }],
+            ..JobError::invalid(message)
         }
     }
 }

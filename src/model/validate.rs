@@ -69,9 +69,14 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
             .map(|g| (g.name.clone(), g.ratio()))
             .collect(),
     );
+    // A train that failed (a gear, mesh, set or shift element in error) has no gear states:
+    // the sections that name gear states are not checked against an empty list (one mistake,
+    // one problem; they are checked once the train is right).
+    let train_failed = s.train.is_none() && !file.gear_states.is_empty();
     let launch = file
         .launch
         .as_ref()
+        .filter(|_| !train_failed)
         .and_then(|spec| launch::validate_launch(spec, &ratios, problems));
     let items = ItemNames {
         gears: &s.gears,
@@ -89,9 +94,11 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         .and_then(|spec| check_thermal(spec, &items, problems));
     let circuit = file.circuit.as_ref().and_then(|spec| {
         let names = circuit::CircuitNames {
-            gears: s.gears.iter().map(|g| g.name.as_str()).collect(),
+            // Names as the file writes them: an entry in error is reported where it is
+            // defined, not again where the circuit names it.
+            gears: file.gears.iter().map(|g| g.name.as_str()).collect(),
             meshes: s.meshes.iter().map(|m| m.name.as_str()).collect(),
-            sets: s.sets.iter().map(|x| x.name.as_str()).collect(),
+            sets: file.planetary_sets.iter().map(|x| x.name.as_str()).collect(),
             packs: clutch_packs.iter().map(|c| c.name.as_str()).collect(),
             bearings: bearings.iter().map(|b| b.name.as_str()).collect(),
             nodes: &nodes,
@@ -105,6 +112,7 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
     let vehicle = file
         .vehicle
         .as_ref()
+        .filter(|_| !train_failed)
         .and_then(|spec| vehicle::validate_vehicle(spec, &ratios, problems));
 
     if problems.len() > start {

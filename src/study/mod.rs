@@ -488,7 +488,7 @@ impl Study {
     }
 
     /// The job a case runs: a run job is summary-only unless per-case files are asked for.
-    fn case_job(&self, c: &Case, per_case: bool) -> Job {
+    pub fn case_job(&self, c: &Case, per_case: bool) -> Job {
         match &self.jobs[c.job] {
             Job::Run(o) => Job::Run(RunOptions {
                 summary_only: !per_case,

@@ -25,20 +25,30 @@ from __future__ import annotations
 import json
 import math
 import os
-from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Dict, Iterable, List, Literal, Mapping, Optional, Sequence, Tuple, Union, overload
 
 from . import _native
 from ._tables import frame as _frame
 from ._tables import html_table as _html_table
 from ._tables import warn_ranges as _warn_ranges
+from ._types import CycleLike, Json, PathLike, TomlValue
+from .calibration import CalibrationResult, TraceFile, read_trace
+from .calibration import _trace_text
 from .errors import GearthermError, InputError, ModelError, RangeWarning, SolveError
-from .results import RunResult, read_run
+from .results import RunResult, RunSummary, read_run
 from .study import Study, read_study, study, study_commands
+
+if TYPE_CHECKING:
+    import pandas
+    import polars
 
 __all__ = [
     "CalibrationResult",
     "Model",
     "RunResult",
+    "RunSummary",
+    "TraceFile",
+    "read_trace",
     "Study",
     "study",
     "study_commands",
@@ -64,7 +74,7 @@ SOURCES = tuple(_native.sources())
 SOLVERS = ("auto", "ros3", "tr-bdf2", "esdirk34", "bdf", "tsit45")
 
 
-def toml_value(v: Any) -> str:
+def toml_value(v: TomlValue) -> str:
     """A Python value as TOML value text.
 
     Parameters
@@ -98,11 +108,11 @@ def toml_value(v: Any) -> str:
     if isinstance(v, Iterable):
         return "[" + ", ".join(toml_value(x) for x in v) + "]"
     if hasattr(v, "item"):  # numpy scalars
-        return toml_value(v.item())
+        return toml_value(v.item())  # type: ignore[union-attr]
     raise TypeError(f"{v!r}: cannot be written as a TOML value")
 
 
-def oils():
+def oils() -> "pandas.DataFrame":
     """The oil catalogue (``models/oils.toml``, compiled in) as a DataFrame.
 
     Returns
@@ -118,7 +128,7 @@ def oils():
     return pd.DataFrame.from_records(json.loads(_native.oils()))
 
 
-def cycles():
+def cycles() -> "pandas.DataFrame":
     """The bundled drive cycles as a DataFrame.
 
     Returns
@@ -132,61 +142,17 @@ def cycles():
     return pd.DataFrame.from_records(json.loads(_native.cycles()))
 
 
-def _cycle_options(cycle: Any) -> Dict[str, Any]:
+def _cycle_options(cycle: CycleLike) -> Dict[str, object]:
     """A cycle name or CSV path as ``cycle``; a DataFrame (pandas or polars, its columns as they
     are: ``time_s`` and ``speed_kmh``, or a rig cycle's columns) as CSV text in ``cycle_text``,
     named ``DataFrame`` in messages and the summary."""
+    if isinstance(cycle, (str, os.PathLike)):
+        return {"cycle": os.fspath(cycle)}
     if hasattr(cycle, "to_csv"):
         return {"cycle": "DataFrame", "cycle_text": cycle.to_csv(index=False)}
-    if hasattr(cycle, "write_csv"):  # polars
-        return {"cycle": "DataFrame", "cycle_text": cycle.write_csv()}
-    return {"cycle": os.fspath(cycle)}
+    return {"cycle": "DataFrame", "cycle_text": cycle.write_csv()}  # polars
 
 
-# --- calibrate -------------------------------------------------------------------------------
-class CalibrationResult:
-    """A calibration (``Model.calibrate``): ``summary`` (dict, ``calibration.json``),
-    ``parameters`` (DataFrame: key path, start, fitted value, bounds, 95 % interval),
-    ``correlation`` (DataFrame, parameters × parameters), ``errors`` (DataFrame: per measured
-    channel RMSE, largest error and bias on the fitted and the held-out rows, K), ``fit``
-    (DataFrame, ``fit.csv``: measured, simulated, residual at every row), ``warnings`` (list),
-    ``calibrated_text`` (the model text with the fitted values written in) and ``calibrated``
-    (that text as a :class:`Model`)."""
-
-    def __init__(self, summary_json: str, fit_csv: str, calibrated_text: str, cycle_csv: str):
-        import pandas as pd
-
-        self._args = (summary_json, fit_csv, calibrated_text, cycle_csv)
-        self.summary: Dict[str, Any] = json.loads(summary_json)
-        self.parameters = pd.DataFrame(self.summary["parameters"])
-        c = self.summary["correlation"]
-        self.correlation = pd.DataFrame(
-            [[math.nan if x is None else x for x in row] for row in c["matrix"]],
-            index=c["parameters"],
-            columns=c["parameters"],
-        )
-        rows = []
-        for ch in self.summary["channels"]:
-            for part in ("fitted", "holdout"):
-                e = ch[part]
-                if e is not None:
-                    rows.append({"node": ch["node"], "rows_of": part, **e})
-        self.errors = pd.DataFrame(rows)
-        self.fit = _frame(fit_csv)
-        self.warnings: List[str] = list(self.summary["warnings"])
-        self.calibrated_text = calibrated_text
-        self.cycle_csv = cycle_csv
-
-    @property
-    def calibrated(self) -> "Model":
-        return Model.from_text(self.calibrated_text, "calibrated.toml")
-
-    def __reduce__(self):
-        return (CalibrationResult, self._args)
-
-    def __repr__(self) -> str:
-        return f"CalibrationResult({len(self.summary['parameters'])} parameter(s), σ = {self.summary['fit']['sigma_k']:.3g} K)"
-# --- end calibrate ---------------------------------------------------------------------------
 
 
 class Model:
@@ -229,7 +195,7 @@ class Model:
         """
         return cls(_native.Model.from_text(text, name))
 
-    def override(self, values: Mapping[str, Any]) -> "Model":
+    def override(self, values: Mapping[str, TomlValue]) -> "Model":
         """A new model with values overridden by key path, checked exactly like the file.
 
         Parameters
@@ -268,7 +234,22 @@ class Model:
         """The overrides applied, as ``"path = toml value"`` lines."""
         return list(self._m.overrides)
 
-    def check(self) -> Dict[str, Any]:
+    def to_toml(self) -> str:
+        """The model as TOML text with every override written in at its key path (the base
+        file's comments and layout kept): ``Model.from_text(m.to_toml())`` is equal to ``m``,
+        and ``geartherm check`` accepts the text as a model file."""
+        return self._m.to_toml()
+
+    def __eq__(self, other: object) -> bool:
+        """Equal when the checked models are: every value bit for bit, whatever text, file name
+        and overrides made them."""
+        if not isinstance(other, Model):
+            return NotImplemented
+        return bool(self._m == other._m)
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def check(self) -> Dict[str, Json]:
         """Counts of the checked model.
 
         Returns
@@ -279,11 +260,27 @@ class Model:
         """
         return json.loads(self._m.check())
 
-    def info(self) -> Dict[str, Any]:
+    def info(self) -> Dict[str, Json]:
         """Gear states, ratios, member speeds, meshes and immersion (``geartherm info --json``)."""
         return json.loads(self._m.info())
 
-    def losses(self, gear: str, speed_rpm: float, torque_nm: float, oil_temp_c: float) -> Dict[str, Any]:
+    @overload
+    def losses(
+        self, gear: str, speed_rpm: float, torque_nm: float, oil_temp_c: float, *, output: Literal["frame"] = ...
+    ) -> "pandas.DataFrame": ...
+    @overload
+    def losses(
+        self, gear: str, speed_rpm: float, torque_nm: float, oil_temp_c: float, *, output: Literal["dict"]
+    ) -> Dict[str, Json]: ...
+    def losses(
+        self,
+        gear: str,
+        speed_rpm: float,
+        torque_nm: float,
+        oil_temp_c: float,
+        *,
+        output: Literal["frame", "dict"] = "frame",
+    ) -> Union["pandas.DataFrame", Dict[str, Json]]:
         """Every loss item at one operating point and oil temperature (``geartherm losses``).
 
         Parameters
@@ -296,14 +293,14 @@ class Model:
             Input torque, N·m.
         oil_temp_c : float
             Oil temperature, °C.
+        output : {"frame", "dict"}, default "frame"
+            ``"frame"``: a DataFrame with one row per loss item (``source``, ``name``, ``w``);
+            its ``attrs`` hold the rest of the report. ``"dict"``: the ``geartherm losses
+            --json`` report: ``loss_<source>_w`` per source and ``loss_total_w`` (W),
+            ``items``, ``efficiency``, the oil's viscosity and density at that temperature,
+            ``skipped``, ``warnings``.
 
-        Returns
-        -------
-        dict
-            ``loss_<source>_w`` per source and ``loss_total_w`` (W), ``items`` (one per loss
-            item: ``source``, ``name``, ``w``), ``efficiency``, the oil's viscosity and density
-            at that temperature, ``skipped``, ``warnings`` (each also raised as a
-            :class:`RangeWarning`).
+        Range warnings are raised as one :class:`RangeWarning` (a one-line summary).
 
         Raises
         ------
@@ -313,8 +310,30 @@ class Model:
         o = {"gear": str(gear), "speed_rpm": float(speed_rpm), "torque_nm": float(torque_nm), "oil_temp_c": float(oil_temp_c)}
         r = json.loads(self._m.losses(o))
         _warn_ranges(r.get("warnings"))
-        return r
+        return _as_frame(r, r.get("items", []), output)
 
+    @overload
+    def steady(
+        self,
+        gear: str,
+        speed_rpm: float,
+        torque_nm: float,
+        vehicle_speed_kmh: float = ...,
+        ambient_c: Optional[float] = ...,
+        *,
+        output: Literal["frame"] = ...,
+    ) -> "pandas.DataFrame": ...
+    @overload
+    def steady(
+        self,
+        gear: str,
+        speed_rpm: float,
+        torque_nm: float,
+        vehicle_speed_kmh: float = ...,
+        ambient_c: Optional[float] = ...,
+        *,
+        output: Literal["dict"],
+    ) -> Dict[str, Json]: ...
     def steady(
         self,
         gear: str,
@@ -322,7 +341,9 @@ class Model:
         torque_nm: float,
         vehicle_speed_kmh: float = 0.0,
         ambient_c: Optional[float] = None,
-    ) -> Dict[str, Any]:
+        *,
+        output: Literal["frame", "dict"] = "frame",
+    ) -> Union["pandas.DataFrame", Dict[str, Json]]:
         """The thermal equilibrium at one operating point (``geartherm steady``).
 
         Parameters
@@ -335,13 +356,13 @@ class Model:
             Vehicle speed for the speed-dependent heat transfer h(v), km/h.
         ambient_c : float, optional
             Ambient temperature, °C (default: the model's).
-
-        Returns
-        -------
-        dict
-            ``temperatures_c`` (per node, °C), ``loss_<source>_w`` per source and
-            ``loss_total_w`` (W), ``losses_w`` per item, ``efficiency``, the Newton
-            iterations, ``warnings`` (each also raised as a :class:`RangeWarning`).
+        output : {"frame", "dict"}, default "frame"
+            ``"frame"``: a one-row DataFrame with every number of the report
+            (``loss_<source>_w``, ``loss_total_w``, ``efficiency``, ``iterations``, …) and
+            ``temp_<node>_c`` per node (the columns of a map row); its ``attrs`` hold the
+            whole report. ``"dict"``: the report: ``temperatures_c`` (per node, °C),
+            ``loss_<source>_w`` per source and ``loss_total_w`` (W), ``losses_w`` per item,
+            ``efficiency``, the Newton iterations, ``warnings``.
 
         Raises
         ------
@@ -353,8 +374,30 @@ class Model:
         p = _point(gear, speed_rpm, torque_nm, vehicle_speed_kmh, ambient_c)
         r = json.loads(self._m.steady(p))
         _warn_ranges(r.get("warnings"))
-        return r
+        return _as_frame(r, [_steady_row(r)], output)
 
+    @overload
+    def map(
+        self,
+        gear: str,
+        speed_rpm: Sequence[float],
+        torque_nm: Sequence[float],
+        vehicle_speed_kmh: float = ...,
+        ambient_c: Optional[float] = ...,
+        *,
+        backend: Literal["pandas"] = ...,
+    ) -> "pandas.DataFrame": ...
+    @overload
+    def map(
+        self,
+        gear: str,
+        speed_rpm: Sequence[float],
+        torque_nm: Sequence[float],
+        vehicle_speed_kmh: float = ...,
+        ambient_c: Optional[float] = ...,
+        *,
+        backend: Literal["polars"],
+    ) -> "polars.DataFrame": ...
     def map(
         self,
         gear: str,
@@ -363,8 +406,8 @@ class Model:
         vehicle_speed_kmh: float = 0.0,
         ambient_c: Optional[float] = None,
         *,
-        backend: str = "pandas",
-    ):
+        backend: Literal["pandas", "polars"] = "pandas",
+    ) -> Union["pandas.DataFrame", "polars.DataFrame"]:
         """Equilibria over a speed × torque grid (``geartherm map``).
 
         Parameters
@@ -398,6 +441,32 @@ class Model:
         }
         return _frame(self._m.map(o), backend=backend)
 
+    @overload
+    def rating(
+        self,
+        gear: str,
+        speed_rpm: Union[float, Sequence[float]],
+        oil_limit_c: float,
+        vehicle_speed_kmh: float = ...,
+        ambient_c: Optional[float] = ...,
+        torque_min_nm: float = ...,
+        torque_max_nm: Optional[float] = ...,
+        *,
+        output: Literal["frame"] = ...,
+    ) -> "pandas.DataFrame": ...
+    @overload
+    def rating(
+        self,
+        gear: str,
+        speed_rpm: Union[float, Sequence[float]],
+        oil_limit_c: float,
+        vehicle_speed_kmh: float = ...,
+        ambient_c: Optional[float] = ...,
+        torque_min_nm: float = ...,
+        torque_max_nm: Optional[float] = ...,
+        *,
+        output: Literal["dict"],
+    ) -> Dict[str, Json]: ...
     def rating(
         self,
         gear: str,
@@ -407,7 +476,9 @@ class Model:
         ambient_c: Optional[float] = None,
         torque_min_nm: float = 0.0,
         torque_max_nm: Optional[float] = None,
-    ) -> Dict[str, Any]:
+        *,
+        output: Literal["frame", "dict"] = "frame",
+    ) -> Union["pandas.DataFrame", Dict[str, Json]]:
         """Thermal rating, as ``geartherm rating``: at each input speed the highest input torque
         whose equilibrium oil temperature stays at or below ``oil_limit_c``.
 
@@ -426,10 +497,11 @@ class Model:
         torque_max_nm : float, optional
             The ceiling, N·m (default 1e6: a model states no torque capacity).
 
-        Returns
-        -------
-        dict
-            The ``rating.json`` document: ``points`` with ``speed_rpm``, ``rated_torque_nm``,
+        output : {"frame", "dict"}, default "frame"
+            ``"frame"``: one row per speed with the numbers and flags of each point
+            (``speed_rpm``, ``rated_torque_nm``, ``rated_power_w``, ``oil_temp_c``,
+            ``loss_total_w``, ``efficiency``, ``status``, ``non_monotonic``); its ``attrs``
+            hold the whole document. ``"dict"``: the ``rating.json`` document: ``points`` with ``speed_rpm``, ``rated_torque_nm``,
             ``rated_power_w``, ``oil_temp_c``, ``loss_total_w``, ``efficiency``, ``status``,
             ``non_monotonic`` and the ``equilibrium`` at that torque (the :meth:`steady` dict);
             ``warnings`` (each also raised as a :class:`RangeWarning`).
@@ -453,11 +525,11 @@ class Model:
         }
         r = json.loads(self._m.rating(o))
         _warn_ranges(r.get("warnings"))
-        return r
+        return _as_frame(r, [_scalars(p) for p in r.get("points", [])], output)
 
     def run(
         self,
-        cycle: Any = "wltc",
+        cycle: CycleLike = "wltc",
         *,
         solver: str = "auto",
         rtol: Optional[float] = None,
@@ -509,7 +581,7 @@ class Model:
         SolveError
             A numerical failure (the message names the time, node or loss item).
         """
-        o: Dict[str, Any] = {
+        o: Dict[str, object] = {
             **_cycle_options(cycle),
             "solver": solver,
             "summary_only": bool(summary_only),
@@ -526,51 +598,72 @@ class Model:
         _warn_ranges(r.summary.get("warnings"))
         return r
 
-    # --- calibrate ---------------------------------------------------------------------------
     def calibrate(
         self,
-        trace,
+        trace: Union[PathLike, "pandas.DataFrame"],
         fit: Sequence[str] = (),
-        holdout: Optional[Sequence[Any]] = None,
+        holdout: Optional[Sequence[Union[str, Tuple[float, float]]]] = None,
         *,
         rtol: Optional[float] = None,
         atol: Optional[float] = None,
         max_steps: Optional[int] = None,
         max_iterations: Optional[int] = None,
         initial_from_trace: bool = True,
-        name: str = "trace",
-    ) -> "CalibrationResult":
+        segment: Optional[int] = None,
+        missing: Literal["drop", "refuse"] = "drop",
+        name: Optional[str] = None,
+    ) -> CalibrationResult:
         """Fit parameters (``fit``: key paths, ``"KEYPATH=LO:HI"`` with bounds) to a measured
-        trace, as ``geartherm calibrate``. ``trace``: a DataFrame (or a CSV file path) with the
-        cycle's columns (``time_s`` and ``speed_kmh`` or ``input_speed_rpm``,
-        ``input_torque_nm``, ``gear``), ``boundary:NAME`` and ``node:NAME`` temperature columns
-        in °C; ``holdout``: time windows ``(t0, t1)`` in s (or ``"t0:t1"``) predicted, not
-        fitted."""
-        if isinstance(trace, (str, os.PathLike)):
-            name = os.fspath(trace)
-            with open(name, encoding="utf-8") as fh:
-                text = fh.read()
-        else:
-            text = trace.to_csv(index=False)
+        trace, as ``geartherm calibrate``.
+
+        Parameters
+        ----------
+        trace : DataFrame or path
+            A DataFrame (or a CSV file) with the cycle's columns (``time_s`` and ``speed_kmh``
+            or ``input_speed_rpm``, ``input_torque_nm``, ``gear``), ``boundary:NAME`` and
+            ``node:NAME`` temperature columns in °C (docs/calibration.md). Rows with an empty
+            cell are dropped and counted (listed in the warnings); gaps in time cut it into
+            segments (:func:`read_trace` lists them).
+        fit : sequence of str
+            Key paths, each optionally ``=LO:HI``.
+        holdout : sequence of (t0, t1) or "t0:t1"
+            Time windows, s, predicted, not fitted.
+        segment : int, optional
+            The segment fitted (needed when gaps cut the trace into several).
+        missing : {"drop", "refuse"}
+            ``"refuse"``: an empty cell is an :class:`InputError`.
+        rtol, atol, max_steps, max_iterations, initial_from_trace
+            As ``geartherm calibrate``'s options.
+        name : str, optional
+            The trace's name in messages (default: its path, or ``trace``).
+        """
+        text, label = _trace_text(trace, name)
         windows = []
         for h in holdout or ():
             windows.append(h if isinstance(h, str) else f"{float(h[0])!r}:{float(h[1])!r}")
-        o: Dict[str, Any] = {"fit": [str(f) for f in fit], "holdout": windows, "initial_from_trace": bool(initial_from_trace)}
+        o: Dict[str, object] = {
+            "fit": [str(f) for f in fit],
+            "holdout": windows,
+            "initial_from_trace": bool(initial_from_trace),
+            "refuse_missing": missing == "refuse",
+        }
+        if segment is not None:
+            o["segment"] = segment
         for k, v in (("rtol", rtol), ("atol", atol), ("max_steps", max_steps), ("max_iterations", max_iterations)):
             if v is not None:
                 o[k] = v
-        return CalibrationResult(*self._m.calibrate(text, name, o))
-    # --- end calibrate -----------------------------------------------------------------------
+        return CalibrationResult(*self._m.calibrate(text, label, o))
 
-    def __reduce__(self):
+
+    def __reduce__(self) -> Tuple[type, Tuple["_native.Model"]]:
         return (Model, (self._m,))
 
     def _repr_html_(self) -> str:
         c = self.check()
-        rows = [
+        rows: List[Tuple[str, object]] = [
             ("file", self.file),
             ("gears / meshes", f"{c['gears']} / {c['meshes']}"),
-            ("gear states", ", ".join(c["gear_states"])),
+            ("gear states", ", ".join(str(g) for g in c["gear_states"] or [])),  # type: ignore[union-attr]
             ("thermal nodes", c["thermal_nodes"]),
             ("vehicle", c["vehicle"]),
             ("overrides", "; ".join(self.overrides) or "none"),
@@ -581,7 +674,9 @@ class Model:
         return repr(self._m)
 
 
-def _point(gear, speed_rpm, torque_nm, vehicle_speed_kmh, ambient_c) -> Dict[str, Any]:
+def _point(
+    gear: str, speed_rpm: float, torque_nm: float, vehicle_speed_kmh: float, ambient_c: Optional[float]
+) -> Dict[str, object]:
     return {
         "gear": str(gear),
         "speed_rpm": float(speed_rpm),
@@ -589,3 +684,31 @@ def _point(gear, speed_rpm, torque_nm, vehicle_speed_kmh, ambient_c) -> Dict[str
         "vehicle_speed_kmh": float(vehicle_speed_kmh),
         "ambient_c": None if ambient_c is None else float(ambient_c),
     }
+
+
+def _scalars(d: Mapping[str, Json]) -> Dict[str, Json]:
+    return {k: v for k, v in d.items() if not isinstance(v, (dict, list))}
+
+
+def _steady_row(r: Mapping[str, Json]) -> Dict[str, Json]:
+    row = _scalars(r)
+    temps = r.get("temperatures_c")
+    if isinstance(temps, dict):
+        row.update({f"temp_{n}_c": t for n, t in temps.items()})
+    return row
+
+
+def _as_frame(
+    report: Dict[str, Json], rows: Sequence[Mapping[str, Json]], output: str
+) -> Union["pandas.DataFrame", Dict[str, Json]]:
+    """The report as it is (``output="dict"``) or its rows as a DataFrame whose ``attrs`` hold
+    the report."""
+    if output == "dict":
+        return report
+    if output != "frame":
+        raise ValueError(f"output={output!r}: 'frame' or 'dict'")
+    import pandas as pd
+
+    df = pd.DataFrame.from_records(list(rows))
+    df.attrs.update(report)
+    return df

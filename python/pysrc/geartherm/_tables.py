@@ -56,9 +56,18 @@ def frame(csv_text: str, text: Iterable[str] = (), backend: str = "pandas") -> A
 
 
 def warn_ranges(items: Optional[Sequence[Mapping[str, Any]]], stacklevel: int = 3) -> None:
-    """Each range warning of a result as a :class:`RangeWarning`."""
-    for w in items or ():
-        warnings.warn(RangeWarning(f"{w.get('item')}: {w.get('range')} ({w.get('seen')})"), stacklevel=stacklevel)
+    """The range warnings of one result as one :class:`RangeWarning` on one line: how many, the
+    first in full, the items of the others (every one stays in the result's ``warnings``)."""
+    items = list(items or ())
+    if not items:
+        return
+    first = items[0]
+    text = f"{first.get('item')}: {first.get('range')} ({first.get('seen')})"
+    if len(items) > 1:
+        others = list(dict.fromkeys(str(w.get("item")) for w in items[1:]))
+        text += f"; also {', '.join(others)}"
+    line = " ".join(f"{len(items)} range warning(s): {text} (all in the result's warnings)".split())
+    warnings.warn(RangeWarning(line), stacklevel=stacklevel)
 
 
 def html_table(title: str, rows: Iterable[Sequence[Any]]) -> str:

@@ -176,3 +176,30 @@ def main_effects(df, outputs: Sequence[str], parameters: Optional[Sequence[str]]
                 ax.legend(title=color_by, fontsize=6)
     fig.tight_layout()
     return fig
+
+
+def calibration_figure(fit: Any) -> Any:
+    """Measured (points) and simulated (lines) temperature of every channel of a calibration's
+    ``fit.csv`` over time, held-out rows shaded, and the residuals (K) below."""
+    plt = _plt()
+    import numpy as np
+
+    nodes = [c[: -len("_measured_c")] for c in fit.columns if c.endswith("_measured_c")]
+    t = np.asarray(fit["time_s"], dtype=float)
+    scale, unit = (3600.0, "h") if t.size and t[-1] - t[0] > 7200 else (1.0, "s")
+    fig, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(9, 6), height_ratios=[3, 1])
+    held = np.asarray(fit["held_out"], dtype=float) > 0 if "held_out" in fit.columns else np.zeros(t.size, bool)
+    for ax in (top, bottom):
+        if held.any():
+            ax.fill_between(t / scale, 0, 1, where=held, color="0.9", transform=ax.get_xaxis_transform(), label=None)
+    for n in nodes:
+        line = top.plot(t / scale, fit[f"{n}_simulated_c"], label=f"{n} simulated")[0]
+        top.plot(t / scale, fit[f"{n}_measured_c"], ".", ms=3, color=line.get_color(), label=f"{n} measured")
+        bottom.plot(t / scale, fit[f"{n}_residual_k"], color=line.get_color(), label=n)
+    top.set_ylabel("temperature (°C)")
+    top.legend(fontsize="small")
+    bottom.set_ylabel("residual (K)")
+    bottom.set_xlabel(f"time ({unit})")
+    top.set_title("Calibration: measured and simulated" + (" (held-out rows shaded)" if held.any() else ""))
+    fig.tight_layout()
+    return fig

@@ -3,13 +3,61 @@
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
-from typing import Any, Dict, Optional, Union
+from typing import TYPE_CHECKING, Dict, List, Literal, Optional, Tuple, TypedDict, Union
 
 from ._tables import frame, html_table
+from ._types import PathLike
 
-__all__ = ["RunResult", "read_run"]
+if TYPE_CHECKING:
+    import matplotlib.figure
+    import pandas
+    import polars
+
+__all__ = ["RunResult", "RunSummary", "read_run"]
+
+
+class RangeWarningEntry(TypedDict):
+    """One range warning: the loss ``item``, the ``range`` its model holds in, what was ``seen``."""
+
+    item: str
+    range: str
+    seen: str
+
+
+class TemperatureStats(TypedDict):
+    """Temperatures of one node over a run, °C."""
+
+    min: float
+    max: float
+    final: float
+
+
+class RunSummary(TypedDict, total=False):
+    """The ``summary.json`` of a run: energies per source, efficiencies, temperatures per node,
+    warnings, the solver's figures (docs/outputs.md lists every key)."""
+
+    model: str
+    cycle: str
+    solver: str
+    rtol: float
+    atol: float
+    wall_time_s: float
+    steps: int
+    duration_s: float
+    energy_lost_j: Dict[str, float]
+    energy_by_item_j: List[Dict[str, Union[str, float]]]
+    energy_stored_j: float
+    energy_to_boundaries_j: float
+    energy_balance_relative: float
+    output_energy_j: float
+    cycle_efficiency: Optional[float]
+    energy_efficiency: Optional[float]
+    temperatures_c: Dict[str, TemperatureStats]
+    oil_node: str
+    skipped: List[Dict[str, str]]
+    frozen_viscosity: bool
+    warnings: List[RangeWarningEntry]
 
 
 class RunResult:
@@ -31,32 +79,43 @@ class RunResult:
     def __init__(self, summary_json: str, timeseries_csv: Optional[str]):
         self._summary_json = summary_json
         self._csv = timeseries_csv
-        self.summary: Dict[str, Any] = json.loads(summary_json)
-        self._frame = None
+        self.summary: RunSummary = json.loads(summary_json)
+        self._frame: Optional["pandas.DataFrame"] = None
 
     @property
-    def timeseries(self):
+    def timeseries(self) -> Optional["pandas.DataFrame"]:
         if self._csv is None:
             return None
         if self._frame is None:
             self._frame = frame(self._csv)
         return self._frame
 
-    def to_polars(self):
+    def to_polars(self) -> Optional["polars.DataFrame"]:
         """The time series as a polars DataFrame (needs ``polars``); None without one."""
         return None if self._csv is None else frame(self._csv, backend="polars")
 
-    def write(self, directory: Union[str, "os.PathLike[str]"]) -> Path:
+    def write(self, directory: PathLike, *, parquet: bool = False) -> Path:
         """Write ``summary.json`` and ``timeseries.csv`` (when present) into ``directory``, the
-        files ``geartherm run --out`` writes; :func:`read_run` reads them back."""
+        files ``geartherm run --out`` writes; with ``parquet=True`` also ``timeseries.parquet``
+        (the same columns and dtypes as the CSV read back). :func:`read_run` reads them back."""
         d = Path(directory)
         d.mkdir(parents=True, exist_ok=True)
         (d / "summary.json").write_text(json.dumps(self.summary, indent=2) + "\n")
         if self._csv is not None:
             (d / "timeseries.csv").write_text(self._csv)
+            if parquet:
+                self.to_parquet(d / "timeseries.parquet")
         return d
 
-    def plot(self, kind: str = "all"):
+    def to_parquet(self, path: PathLike) -> None:
+        """Write the time series as Parquet (pyarrow): the columns and dtypes of
+        :attr:`timeseries`, which ``pandas.read_parquet`` gives back equal."""
+        ts = self.timeseries
+        if ts is None:
+            raise ValueError("a summary-only run has no time series")
+        ts.to_parquet(path, index=False)
+
+    def plot(self, kind: Literal["all", "temperatures", "losses", "energy"] = "all") -> "matplotlib.figure.Figure":
         """Draw the run report's figures with matplotlib (``pip install "geartherm[plot]"``).
 
         Parameters
@@ -82,17 +141,20 @@ class RunResult:
         b.pop("wall_time_s", None)
         return a == b and self._csv == other._csv
 
-    def __reduce__(self):
+    __hash__ = None  # type: ignore[assignment]
+
+    def __reduce__(self) -> "Tuple[type, Tuple[str, Optional[str]]]":
         return (RunResult, (self._summary_json, self._csv))
 
     def _repr_html_(self) -> str:
         s = self.summary
         e = s.get("energy_lost_j", {})
-        rows = [("cycle", s.get("cycle")), ("duration", f"{s.get('duration_s', 0):.0f} s")]
+        rows: List[Tuple[str, object]] = [("cycle", s.get("cycle")), ("duration", f"{s.get('duration_s', 0):.0f} s")]
         rows += [(k, f"{v / 1e3:.2f} kJ") for k, v in e.items() if v]
         for k in ("cycle_efficiency", "energy_efficiency"):
-            if s.get(k) is not None:
-                rows.append((k, f"{s[k]:.4f}"))
+            v = s.get(k)
+            if isinstance(v, float):
+                rows.append((k, f"{v:.4f}"))
         rows += [(f"{n} (max / final)", f"{t['max']:.1f} / {t['final']:.1f} °C") for n, t in s.get("temperatures_c", {}).items()]
         rows.append(("warnings", len(s.get("warnings", []))))
         return html_table(f"Run of {s.get('model')!r}", rows)
@@ -102,7 +164,7 @@ class RunResult:
         return f"RunResult({s.get('model')!r} over {s.get('cycle')!r}: {s['energy_lost_j']['total'] / 1e3:.1f} kJ lost)"
 
 
-def read_run(directory: Union[str, "os.PathLike[str]"]) -> RunResult:
+def read_run(directory: PathLike) -> RunResult:
     """A run directory (``geartherm run --out DIR`` or :meth:`RunResult.write`) as the
     :class:`RunResult` the run returned.
 
@@ -110,4 +172,5 @@ def read_run(directory: Union[str, "os.PathLike[str]"]) -> RunResult:
     d = Path(directory)
     summary = (d / "summary.json").read_text()
     ts = d / "timeseries.csv"
-    return RunResult(json.dumps(json.loads(summary)), ts.read_text() if ts.exists() else None)
+    csv: Optional[str] = ts.read_text() if ts.exists() else None
+    return RunResult(json.dumps(json.loads(summary)), csv)

@@ -10,14 +10,25 @@ import math
 import os
 import sys
 from pathlib import Path
-from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import TYPE_CHECKING, Any, Callable, Dict, List, Literal, Mapping, Optional, Sequence, Tuple, Union, overload
 
 from . import _native
 from ._tables import frame, html_table
+from ._types import Json, JobSpec, ParameterSpec, PathLike
 from .errors import InputError
 
-PathLike = Union[str, "os.PathLike[str]"]
+if TYPE_CHECKING:
+    import distributed
+    import pandas
+    import polars
+
+    from . import Model
+
 Progress = Union[bool, Callable[[int, int], None], None]
+# A mapping {key path: its specification} or a list of specifications with a "path" (checked
+# when the study is built: a wrong shape is a TypeError naming what is expected).
+Parameters = Union[Mapping[str, object], Sequence[ParameterSpec]]
+Backend = Literal["pandas", "polars"]
 
 __all__ = ["Study", "study", "study_commands", "read_study"]
 
@@ -133,13 +144,13 @@ class Study:
 
     def __init__(
         self,
-        model: Any,
-        parameters: Union[Mapping[str, Mapping[str, Any]], Sequence[Mapping[str, Any]]],
-        job: Optional[Mapping[str, Any]] = None,
-        sampling: Optional[Mapping[str, Any]] = None,
+        model: Union["Model", PathLike],
+        parameters: Parameters,
+        job: Optional[JobSpec] = None,
+        sampling: Optional[JobSpec] = None,
         *,
         name: str = "study",
-        outputs: Optional[Mapping[str, Any]] = None,
+        outputs: Optional[JobSpec] = None,
     ):
         from . import Model
 
@@ -169,24 +180,69 @@ class Study:
     def name(self) -> str:
         return self.spec["study"]["name"]
 
+    def model(self, case: int) -> "Model":
+        """The model of case ``case`` (its position in :attr:`cases`): the base model with the
+        case's parameter values as overrides (``.overrides`` lists them, :meth:`Model.to_toml`
+        writes them in). Running it with :meth:`job`'s options gives the case's row."""
+        from . import Model
+
+        overrides, _ = _native.study_case(self._spec_json, self._text, self._file, _case_indices([case], len(self.cases))[0])
+        return Model(_native.Model.from_text(self._text, self._file).with_overrides(overrides))
+
+    def job(self, case: int) -> Dict[str, Json]:
+        """The job of case ``case``: ``{"kind": "run", "options": {...}}`` (the options of
+        :meth:`Model.run`: ``cycle``, ``solver``, ``rtol``, ``atol``, ``summary_only``, …) or
+        ``{"kind": "steady", "options": {...}}`` (those of :meth:`Model.steady`)."""
+        _, job = _native.study_case(self._spec_json, self._text, self._file, _case_indices([case], len(self.cases))[0])
+        out: Dict[str, Json] = json.loads(job)
+        return out
+
     def commands(self) -> List[str]:
         """The stand-alone ``geartherm run``/``steady`` command line of every case (for Slurm
         arrays or HyperQueue without Python)."""
         return _native.study_commands(self._spec_json, self._text, self._file)
 
+    @overload
     def run(
         self,
         out: Optional[PathLike] = None,
         *,
-        client: Any = None,
+        client: Optional["distributed.Client"] = None,
         progress: Progress = True,
         threads: Optional[int] = None,
         cases: Optional[Sequence[int]] = None,
         shard: Optional[Tuple[int, int]] = None,
         batch_size: Optional[int] = None,
         threads_per_task: Optional[int] = None,
-        backend: str = "pandas",
-    ):
+        backend: Literal["pandas"] = ...,
+    ) -> "pandas.DataFrame": ...
+    @overload
+    def run(
+        self,
+        out: Optional[PathLike] = None,
+        *,
+        client: Optional["distributed.Client"] = None,
+        progress: Progress = True,
+        threads: Optional[int] = None,
+        cases: Optional[Sequence[int]] = None,
+        shard: Optional[Tuple[int, int]] = None,
+        batch_size: Optional[int] = None,
+        threads_per_task: Optional[int] = None,
+        backend: Literal["polars"],
+    ) -> "polars.DataFrame": ...
+    def run(
+        self,
+        out: Optional[PathLike] = None,
+        *,
+        client: Optional["distributed.Client"] = None,
+        progress: Progress = True,
+        threads: Optional[int] = None,
+        cases: Optional[Sequence[int]] = None,
+        shard: Optional[Tuple[int, int]] = None,
+        batch_size: Optional[int] = None,
+        threads_per_task: Optional[int] = None,
+        backend: Backend = "pandas",
+    ) -> Union["pandas.DataFrame", "polars.DataFrame"]:
         """Solve the study; one DataFrame row per case, in case order.
 
         Parameters
@@ -303,14 +359,15 @@ def _study_frame(csv: str, spec: Mapping[str, Any], backend: str = "pandas"):
     return frame(csv, _text_columns(spec), backend)
 
 
+@overload
 def study(
-    model: Any,
-    parameters: Optional[Union[Mapping[str, Mapping[str, Any]], Sequence[Mapping[str, Any]]]] = None,
-    job: Optional[Mapping[str, Any]] = None,
-    sampling: Optional[Mapping[str, Any]] = None,
+    model: Union["Study", "Model", PathLike],
+    parameters: Optional[Parameters] = None,
+    job: Optional[JobSpec] = None,
+    sampling: Optional[JobSpec] = None,
     *,
     out: Optional[PathLike] = None,
-    client: Any = None,
+    client: Optional["distributed.Client"] = None,
     progress: Progress = True,
     threads: Optional[int] = None,
     batch_size: Optional[int] = None,
@@ -318,9 +375,46 @@ def study(
     cases: Optional[Sequence[int]] = None,
     shard: Optional[Tuple[int, int]] = None,
     name: str = "study",
-    outputs: Optional[Mapping[str, Any]] = None,
-    backend: str = "pandas",
-):
+    outputs: Optional[JobSpec] = None,
+    backend: Literal["pandas"] = ...,
+) -> "pandas.DataFrame": ...
+@overload
+def study(
+    model: Union["Study", "Model", PathLike],
+    parameters: Optional[Parameters] = None,
+    job: Optional[JobSpec] = None,
+    sampling: Optional[JobSpec] = None,
+    *,
+    out: Optional[PathLike] = None,
+    client: Optional["distributed.Client"] = None,
+    progress: Progress = True,
+    threads: Optional[int] = None,
+    batch_size: Optional[int] = None,
+    threads_per_task: Optional[int] = None,
+    cases: Optional[Sequence[int]] = None,
+    shard: Optional[Tuple[int, int]] = None,
+    name: str = "study",
+    outputs: Optional[JobSpec] = None,
+    backend: Literal["polars"],
+) -> "polars.DataFrame": ...
+def study(
+    model: Union["Study", "Model", PathLike],
+    parameters: Optional[Parameters] = None,
+    job: Optional[JobSpec] = None,
+    sampling: Optional[JobSpec] = None,
+    *,
+    out: Optional[PathLike] = None,
+    client: Optional["distributed.Client"] = None,
+    progress: Progress = True,
+    threads: Optional[int] = None,
+    batch_size: Optional[int] = None,
+    threads_per_task: Optional[int] = None,
+    cases: Optional[Sequence[int]] = None,
+    shard: Optional[Tuple[int, int]] = None,
+    name: str = "study",
+    outputs: Optional[JobSpec] = None,
+    backend: Backend = "pandas",
+) -> Union["pandas.DataFrame", "polars.DataFrame"]:
     """Run a design study and return one DataFrame row per case.
 
     ``study("models/studies/at6_wltc_lhs.toml", out="studies/at6")`` runs a study file (a
@@ -333,10 +427,10 @@ def study(
     if isinstance(model, Study):
         s = model
     elif parameters is None:
-        s = Study.load(model)
+        s = Study.load(model)  # type: ignore[arg-type]
     else:
         s = Study(model, parameters, job, sampling, name=name, outputs=outputs)
-    return s.run(
+    return s.run(  # type: ignore[call-overload,no-any-return]
         out,
         client=client,
         progress=progress,
@@ -349,14 +443,23 @@ def study(
     )
 
 
-def study_commands(model: Any, parameters=None, job=None, sampling=None) -> List[str]:
+def study_commands(
+    model: Union["Study", "Model", PathLike],
+    parameters: Optional[Parameters] = None,
+    job: Optional[JobSpec] = None,
+    sampling: Optional[JobSpec] = None,
+) -> List[str]:
     """The stand-alone ``geartherm run``/``steady`` command line of every case (for Slurm arrays
     or HyperQueue without Python); arguments as :func:`study`."""
     s = model if isinstance(model, Study) else Study.load(model) if parameters is None else Study(model, parameters, job, sampling)
     return s.commands()
 
 
-def read_study(directory: PathLike, backend: str = "pandas"):
+@overload
+def read_study(directory: PathLike, backend: Literal["pandas"] = ...) -> "pandas.DataFrame": ...
+@overload
+def read_study(directory: PathLike, backend: Literal["polars"]) -> "polars.DataFrame": ...
+def read_study(directory: PathLike, backend: Backend = "pandas") -> Union["pandas.DataFrame", "polars.DataFrame"]:
     """The table of a study directory (``study.csv`` written by ``geartherm study`` or
     :func:`study` with ``out=``) as the DataFrame :func:`study` returned for it."""
     d = Path(directory)
@@ -368,7 +471,8 @@ def read_study(directory: PathLike, backend: str = "pandas"):
     header = list(raw.columns)
     params = header[3 : header.index("status")] if "status" in header else []
     text = [c for c in params if not _numeric(raw[c])]
-    return frame(csv, text, backend)
+    out: Union["pandas.DataFrame", "polars.DataFrame"] = frame(csv, text, backend)
+    return out
 
 
 def _numeric(col) -> bool:

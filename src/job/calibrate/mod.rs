@@ -17,6 +17,7 @@ pub mod params;
 pub mod problem;
 pub mod stats;
 pub mod trace;
+pub mod trace_file;
 
 use std::time::Instant;
 
@@ -37,6 +38,7 @@ use lm::{Evaluation, LmOptions};
 use params::{FitSpec, Parameter};
 use problem::{initial_overrides, Problem};
 pub use trace::Trace;
+pub use trace_file::{Missing, TraceFile};
 
 /// Default relative tolerance of a calibration's integrations (that of `run`: the fit and its
 /// sensitivities are those of the discrete solution `run` computes).
@@ -79,6 +81,21 @@ pub struct CalibrateOptions {
     /// Start every measured node at its first measured value and the others at their mean
     /// (else at the model's initial temperatures).
     pub initial_from_trace: bool,
+    /// The segment of the trace file fitted (0-based; needed when gaps cut it into several).
+    pub segment: Option<usize>,
+    /// Refuse empty cells (else their rows are dropped and counted).
+    pub refuse_missing: bool,
+}
+
+impl CalibrateOptions {
+    /// How the trace file's empty cells are read.
+    pub fn missing(&self) -> Missing {
+        if self.refuse_missing {
+            Missing::Refuse
+        } else {
+            Missing::Drop
+        }
+    }
 }
 
 impl Default for CalibrateOptions {
@@ -92,6 +109,8 @@ impl Default for CalibrateOptions {
             max_steps: super::run::DEFAULT_MAX_STEPS,
             max_iterations: DEFAULT_MAX_ITERATIONS,
             initial_from_trace: true,
+            segment: None,
+            refuse_missing: false,
         }
     }
 }
@@ -451,7 +470,7 @@ fn assemble(
     let ssr = res.at.r.norm_squared();
     let lin = stats::linearised(&res.at.j, ssr, &identifiable);
     let t = stats::t975(lin.dof);
-    let mut warnings = Vec::new();
+    let mut warnings = pr.trace.notes.clone();
     let parameters = parameters(pr, res, influence, &identifiable, &lin, t, &mut warnings);
     let correlation = correlation(pr, &lin, &mut warnings);
     if res.stop == lm::Stop::Budget {
@@ -572,6 +591,12 @@ impl super::command::ToArgs for CalibrateOptions {
         a.extend(["--max-iterations".into(), self.max_iterations.to_string()]);
         if !self.initial_from_trace {
             a.push("--keep-initial".into());
+        }
+        if let Some(k) = self.segment {
+            a.extend(["--segment".into(), k.to_string()]);
+        }
+        if self.refuse_missing {
+            a.push("--refuse-missing".into());
         }
         a
     }

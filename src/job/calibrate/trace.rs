@@ -9,8 +9,10 @@
 //! - `node:NAME`: the measured temperature of capacity node NAME, °C (at least one).
 //!
 //! Blank lines and lines starting with `#` are skipped. Every cell of a temperature column must
-//! hold a finite number in [−60, 400] °C: an empty cell (a gap in the record) is an error, as is
-//! a time step more than [`MAX_GAP_FACTOR`] times the median step (a gap in time).
+//! hold a finite number in [−60, 400] °C. [`Trace::parse`] reads one segment: an empty cell is an
+//! error, as is a time step more than [`MAX_GAP_FACTOR`] times the median step (a gap in time);
+//! [`super::trace_file::read`] reads a whole file, dropping rows with empty cells (counted) and
+//! cutting it at its gaps.
 
 use crate::cycle::{CycleError, DriveCycle};
 
@@ -55,6 +57,9 @@ pub struct Trace {
     pub boundaries: Vec<Channel>,
     /// Measured node temperature columns.
     pub measured: Vec<Channel>,
+    /// What reading the file did to it (rows dropped for empty cells, the segment it is of a
+    /// file cut at its gaps); a calibration lists them among its warnings.
+    pub notes: Vec<String>,
 }
 
 /// A problem with a trace: file, line, column, value, what is allowed.
@@ -104,9 +109,37 @@ fn classify(source: &str, line: usize, col: &str) -> Result<Kind, TraceError> {
     )))
 }
 
+/// What each header column is (a column named twice or unknown is an error naming it).
+fn header_kinds(source: &str, line: usize, header: &[&str]) -> Result<Vec<Kind>, TraceError> {
+    let mut kinds = Vec::with_capacity(header.len());
+    for (i, col) in header.iter().enumerate() {
+        if header[..i].iter().any(|c| c.eq_ignore_ascii_case(col)) {
+            return Err(TraceError(format!(
+                "{source}, line {line}: column \"{col}\": appears twice"
+            )));
+        }
+        kinds.push(classify(source, line, col)?);
+    }
+    Ok(kinds)
+}
+
+/// The header's columns checked (each known, none twice) before any row is read.
+pub(super) fn check_header(source: &str, line: usize, header: &[&str]) -> Result<(), TraceError> {
+    header_kinds(source, line, header).map(|_| ())
+}
+
 impl Trace {
-    /// Parse and check trace text; `source` names it in messages.
+    /// Parse and check trace text of one segment; `source` names it in messages. An empty cell
+    /// or a gap in time is an error here ([`super::trace_file::read`] cuts a file with them into
+    /// segments).
     pub fn parse(text: &str, source: &str) -> Result<Trace, TraceError> {
+        let t = Self::parse_segment(text, source)?;
+        check_gaps(source, &t.times, &t.lines)?;
+        Ok(t)
+    }
+
+    /// [`Trace::parse`] without the check for gaps in time (a segment cut at its gaps).
+    pub(super) fn parse_segment(text: &str, source: &str) -> Result<Trace, TraceError> {
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let lines: Vec<&str> = text.lines().collect();
         let head = lines
@@ -114,16 +147,7 @@ impl Trace {
             .position(|l| is_record(l))
             .ok_or_else(|| TraceError(format!("{source}: empty trace: no header line")))?;
         let header: Vec<&str> = lines[head].split(',').map(str::trim).collect();
-        let mut kinds = Vec::with_capacity(header.len());
-        for (i, col) in header.iter().enumerate() {
-            if header[..i].iter().any(|c| c.eq_ignore_ascii_case(col)) {
-                return Err(TraceError(format!(
-                    "{source}, line {}: column \"{col}\": appears twice",
-                    head + 1
-                )));
-            }
-            kinds.push(classify(source, head + 1, col)?);
-        }
+        let kinds = header_kinds(source, head + 1, &header)?;
         // The cycle columns, on the same line numbers, for the cycle reader.
         let cycle_cols: Vec<usize> = (0..header.len())
             .filter(|&i| matches!(kinds[i], Kind::Cycle))
@@ -172,7 +196,6 @@ impl Trace {
         }
         let times: Vec<f64> = cycle.rows.iter().map(|r| r.time).collect();
         let lines_of: Vec<usize> = cycle.rows.iter().map(|r| r.line).collect();
-        check_gaps(source, &times, &lines_of)?;
         Ok(Trace {
             source: source.to_string(),
             cycle,
@@ -180,6 +203,7 @@ impl Trace {
             times,
             boundaries,
             measured,
+            notes: Vec::new(),
         })
     }
 
