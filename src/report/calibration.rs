@@ -80,6 +80,28 @@ pub struct Correlation {
     pub matrix: Vec<Vec<Option<f64>>>,
 }
 
+/// One parameter's part in an eigen-direction.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Component {
+    /// Key path.
+    pub key_path: String,
+    /// Component in the fitted coordinate (ln p or p), the largest ±1.
+    pub component: f64,
+}
+
+/// An eigen-direction of the scaled Fisher information: how well the trace fixes a step along it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Direction {
+    /// `not determined` (null), `weakly determined` or `determined`.
+    pub status: &'static str,
+    /// λ/λ_max of the scaled information.
+    pub relative_eigenvalue: f64,
+    /// The direction (components above 0.05 only).
+    pub components: Vec<Component>,
+    /// 95 % half-width of the step along the direction (null: none).
+    pub ci95_half_width: Option<f64>,
+}
+
 /// How the fit went.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FitStats {
@@ -118,6 +140,8 @@ pub struct CalibrationSummary {
     pub parameters: Vec<FittedParameter>,
     /// Their correlations.
     pub correlation: Correlation,
+    /// The eigen-directions of the scaled Fisher information, least determined first.
+    pub identifiability: Vec<Direction>,
     /// Errors per measured channel.
     pub channels: Vec<ChannelErrors>,
     /// The fit.

@@ -11,6 +11,7 @@
 //! - [`stats`]: covariance, t quantile, correlations;
 //! - [`model_file`]: the calibrated model text.
 
+pub mod checks;
 pub mod lm;
 pub mod model_file;
 pub mod params;
@@ -27,7 +28,8 @@ use crate::model::overrides;
 use crate::model::parse::parse_document;
 use crate::model::Problems;
 use crate::report::calibration::{
-    fit_csv, CalibrationSummary, ChannelErrors, Correlation, Errors, FitStats, FittedParameter,
+    fit_csv, CalibrationSummary, ChannelErrors, Component, Correlation, Direction, Errors, FitStats,
+    FittedParameter,
 };
 use crate::solve::sensitivity::SensitivityOptions;
 
@@ -48,6 +50,10 @@ pub const DEFAULT_MAX_ITERATIONS: usize = 30;
 pub const MIN_INFLUENCE_K: f64 = 1e-6;
 /// Correlation above which two parameters are reported as not told apart by the trace.
 pub const CORRELATION_WARNING: f64 = 0.95;
+
+/// A direction of the scaled Fisher information whose relative eigenvalue lies below this is
+/// reported as weakly determined (for two parameters: a correlation above about 0.998).
+pub const WEAK_EIGENVALUE: f64 = 1e-3;
 
 /// Most evaluations with sensitivities.
 pub const MAX_ITERATIONS: Limit = Limit {
@@ -219,6 +225,7 @@ pub fn prepare<'a>(
                 .map_err(|e| JobError::option("fit", s.to_string(), "a number in the model", e))
         })
         .collect::<Result<Vec<_>, _>>()?;
+    checks::fitted_once(&specs, &doc)?;
     let opts = SensitivityOptions {
         rtol: o.rtol,
         atol: o.atol,
@@ -241,7 +248,9 @@ pub fn prepare<'a>(
         )));
     }
     // The model at the start point must check (bounds written into the file are checked there).
-    problem.gearbox_at(&start(&problem.params))?;
+    problem.gearbox_at(&problem.start())?;
+    checks::boundaries_in_model_range(m, &problem)?;
+    checks::measured_in_envelope(m, &problem)?;
     Ok(Prepared {
         problem,
         windows,
@@ -249,11 +258,27 @@ pub fn prepare<'a>(
     })
 }
 
-fn start(params: &[Parameter]) -> Vec<f64> {
-    params.iter().map(|p| p.theta(p.start)).collect()
+/// The error of a fitted model whose trajectory leaves the physics envelope (exit 2).
+fn breach_error(p: &Prepared<'_>, theta: &[f64], breach: &str) -> JobError {
+    let pr = &p.problem;
+    let values: Vec<String> = pr
+        .params
+        .iter()
+        .zip(theta)
+        .map(|(q, &t)| format!("{} = {}", q.name(), q.written(t)))
+        .collect();
+    JobError::numerical(format!(
+        "{} on {}: with {} the trajectory leaves the range where the models hold {breach}: no calibrated \
+         model is written (narrow the bounds or check the trace)",
+        pr.file.display(),
+        pr.trace.source,
+        values.join(", ")
+    ))
 }
 
-/// Residuals (simulated − measured, K) and their Jacobian over the fitted rows.
+/// Residuals (simulated − measured, K) and their Jacobian over the fitted rows. The points the
+/// fit passes through may leave the physics envelope (a start far from the data); the fitted
+/// point may not ([`fit`]).
 fn evaluate(p: &Prepared<'_>, theta: &[f64]) -> Result<Evaluation, JobError> {
     let pr = &p.problem;
     let sim = pr.simulate(theta, true)?;
@@ -290,7 +315,7 @@ pub fn calibrate(
 pub fn fit(m: &Model, p: &Prepared<'_>, o: &CalibrateOptions) -> Result<CalibrateResult, JobError> {
     let clock = Instant::now();
     let pr = &p.problem;
-    let theta0 = start(&pr.params);
+    let theta0 = pr.start();
     let at0 = evaluate(p, &theta0)?;
     let influence: Vec<f64> = (0..pr.params.len())
         .map(|k| at0.j.column(k).iter().fold(0.0, |a: f64, x| a.max(x.abs())))
@@ -336,14 +361,14 @@ fn parameters(
             warnings.push(format!(
                 "{}: at its bound ({}): no interval; widen the bounds or fix the parameter",
                 par.name(),
-                par.value(th)
+                par.written(th)
             ));
         }
         let se = lin.std_err[k];
         out.push(FittedParameter {
             key_path: par.name(),
             start: par.start,
-            value: par.value(th),
+            value: par.written(th),
             lower_bound: par.lo,
             upper_bound: par.hi,
             scale: if par.log { "log" } else { "linear" },
@@ -380,6 +405,72 @@ fn correlation(pr: &Problem<'_>, lin: &stats::Linearised, warnings: &mut Vec<Str
         parameters: names,
         matrix,
     }
+}
+
+/// The eigen-directions as reported, with a warning for each the trace does not or only weakly
+/// determines.
+fn identifiability(
+    pr: &Problem<'_>,
+    lin: &stats::Linearised,
+    t: f64,
+    warnings: &mut Vec<String>,
+) -> Vec<Direction> {
+    let mut out = Vec::new();
+    for d in &lin.directions {
+        let components: Vec<Component> = pr
+            .params
+            .iter()
+            .zip(&d.direction)
+            .filter(|(_, c)| c.abs() > stats::INVOLVED)
+            .map(|(q, &c)| Component {
+                key_path: q.name(),
+                component: c,
+            })
+            .collect();
+        let label = |c: &Component| {
+            let log = pr.params.iter().any(|q| q.name() == c.key_path && q.log);
+            if log {
+                format!("{:+.3}·ln {}", c.component, c.key_path)
+            } else {
+                format!("{:+.3}·{}", c.component, c.key_path)
+            }
+        };
+        let along: Vec<String> = components.iter().map(label).collect();
+        let names: Vec<&str> = components.iter().map(|c| c.key_path.as_str()).collect();
+        let half = d.std_error.map(|s| t * s);
+        let status = match half {
+            None => "not determined",
+            Some(_) if d.relative_eigenvalue < WEAK_EIGENVALUE => "weakly determined",
+            Some(_) => "determined",
+        };
+        match half {
+            None => warnings.push(format!(
+                "{} are not identifiable: a step along ({}) leaves the fitted temperatures unchanged (relative \
+                 eigenvalue {:.1e} of the scaled Fisher information): the trace fixes only the combinations \
+                 across it; fix all but one of them, give a prior, or add a trace that separates them",
+                names.join(" and "),
+                along.join(", "),
+                d.relative_eigenvalue
+            )),
+            Some(h) if d.relative_eigenvalue < WEAK_EIGENVALUE && components.len() > 1 => {
+                warnings.push(format!(
+                    "{} move together: the trace fixes a step along ({}) only to ±{h:.3} (95 %; relative \
+                     eigenvalue {:.1e})",
+                    names.join(" and "),
+                    along.join(", "),
+                    d.relative_eigenvalue
+                ))
+            }
+            _ => {}
+        }
+        out.push(Direction {
+            status,
+            relative_eigenvalue: d.relative_eigenvalue,
+            components,
+            ci95_half_width: half,
+        });
+    }
+    out
 }
 
 /// Errors per channel on the fitted and the held-out rows.
@@ -454,6 +545,7 @@ fn assemble(
     let mut warnings = Vec::new();
     let parameters = parameters(pr, res, influence, &identifiable, &lin, t, &mut warnings);
     let correlation = correlation(pr, &lin, &mut warnings);
+    let identifiability = identifiability(pr, &lin, t, &mut warnings);
     if res.stop == lm::Stop::Budget {
         warnings.push(format!(
             "the fit stopped after {} evaluations (max_iterations) before converging",
@@ -461,26 +553,14 @@ fn assemble(
         ));
     }
     let sim = pr.simulate(&res.theta, false)?;
+    if let Some(b) = &sim.breach {
+        return Err(breach_error(p, &res.theta, b));
+    }
     let channels = channel_errors(p, &sim.temps_c);
     let nodes: Vec<String> = pr.trace.measured.iter().map(|c| c.name.clone()).collect();
     let measured: Vec<Vec<f64>> = pr.trace.measured.iter().map(|c| c.values_c.clone()).collect();
     let csv = fit_csv(&pr.trace.times, &p.held, &nodes, &measured, &sim.temps_c);
-    let series: Vec<(String, Vec<(f64, f64)>)> = pr
-        .trace
-        .boundaries
-        .iter()
-        .map(|c| {
-            (
-                c.name.clone(),
-                pr.trace
-                    .times
-                    .iter()
-                    .copied()
-                    .zip(c.values_c.iter().copied())
-                    .collect(),
-            )
-        })
-        .collect();
+    let series = pr.boundary_series();
     let calibrated = model_file::calibrated_text(pr.text, &pr.overrides_at(&res.theta), &series)
         .map_err(|e| JobError::invalid(format!("{}: {e}", m.label())))?;
     let summary = CalibrationSummary {
@@ -490,6 +570,7 @@ fn assemble(
         holdout_s: p.windows.clone(),
         parameters,
         correlation,
+        identifiability,
         channels,
         fit: FitStats {
             evaluations: res.evaluations,
@@ -541,6 +622,14 @@ fn check_finite(s: &CalibrationSummary) -> Result<(), JobError> {
             if !(e.rmse_k.is_finite() && e.max_abs_k.is_finite() && e.bias_k.is_finite()) {
                 return Err(bad(&c.column));
             }
+        }
+    }
+    for d in &s.identifiability {
+        let vals = [Some(d.relative_eigenvalue), d.ci95_half_width];
+        if vals.iter().flatten().any(|v| !v.is_finite())
+            || d.components.iter().any(|c| !c.component.is_finite())
+        {
+            return Err(bad("an eigen-direction of the Fisher information"));
         }
     }
     if !s.fit.sigma_k.is_finite() {
