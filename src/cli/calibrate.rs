@@ -44,6 +44,10 @@ pub struct CalibrateArgs {
     /// Start from the model's initial temperatures instead of the trace's first row.
     #[arg(long)]
     pub keep_initial: bool,
+    /// Residual model: ar1 (per channel AR(1) errors, generalised least squares; the intervals
+    /// of independent errors are reported beside) or independent (ordinary least squares).
+    #[arg(long, default_value = "ar1", value_name = "ar1|independent")]
+    pub residuals: String,
     /// Print calibration.json on stdout.
     #[arg(long)]
     pub json: bool,
@@ -61,6 +65,7 @@ impl CalibrateArgs {
             max_steps: self.max_steps,
             max_iterations: self.max_iterations,
             initial_from_trace: !self.keep_initial,
+            residuals: self.residuals.clone(),
         }
     }
 }

@@ -188,6 +188,7 @@ fn calibrate_options_round_trip() {
             max_steps: 1234,
             max_iterations: 7,
             initial_from_trace: false,
+            residuals: "independent".into(),
         },
     ];
     for o in all {

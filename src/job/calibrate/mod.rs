@@ -11,11 +11,13 @@
 //! - [`stats`]: covariance, t quantile, correlations;
 //! - [`model_file`]: the calibrated model text.
 
+pub mod bands;
 pub mod checks;
 pub mod lm;
 pub mod model_file;
 pub mod params;
 pub mod problem;
+pub mod residuals;
 pub mod stats;
 pub mod trace;
 
@@ -29,7 +31,7 @@ use crate::model::parse::parse_document;
 use crate::model::Problems;
 use crate::report::calibration::{
     fit_csv, CalibrationSummary, ChannelErrors, Component, Correlation, Direction, Errors, FitStats,
-    FittedParameter,
+    FittedParameter, Noise,
 };
 use crate::solve::sensitivity::SensitivityOptions;
 
@@ -85,6 +87,9 @@ pub struct CalibrateOptions {
     /// Start every measured node at its first measured value and the others at their mean
     /// (else at the model's initial temperatures).
     pub initial_from_trace: bool,
+    /// Residual model: `ar1` (per channel AR(1) errors, generalised least squares) or
+    /// `independent` (ordinary least squares).
+    pub residuals: String,
 }
 
 impl Default for CalibrateOptions {
@@ -98,6 +103,7 @@ impl Default for CalibrateOptions {
             max_steps: super::run::DEFAULT_MAX_STEPS,
             max_iterations: DEFAULT_MAX_ITERATIONS,
             initial_from_trace: true,
+            residuals: "ar1".into(),
         }
     }
 }
@@ -134,6 +140,18 @@ impl CalibrateOptions {
         limits::ATOL.check(self.atol)?;
         limits::MAX_STEPS.check(self.max_steps as f64)?;
         MAX_ITERATIONS.check(self.max_iterations as f64)?;
+        if !["ar1", "independent"].contains(&self.residuals.as_str()) {
+            let msg = format!(
+                "residuals (--residuals) = {}: must be ar1 or independent",
+                self.residuals
+            );
+            return Err(JobError::option(
+                "residuals",
+                &self.residuals,
+                "ar1 or independent",
+                msg,
+            ));
+        }
         let mut specs: Vec<FitSpec> = Vec::with_capacity(self.fit.len());
         for f in &self.fit {
             let s: FitSpec = f
@@ -326,9 +344,54 @@ pub fn fit(m: &Model, p: &Prepared<'_>, o: &CalibrateOptions) -> Result<Calibrat
         max_iterations: o.max_iterations,
         ..LmOptions::default()
     };
-    let res = lm::minimise(|th| evaluate(p, th), &theta0, at0, &bounds, &free, &lmo)?;
-    let wall = clock.elapsed().as_secs_f64();
-    assemble(m, p, o, &res, &influence, &free, wall)
+    let ols = lm::minimise(|th| evaluate(p, th), &theta0, at0, &bounds, &free, &lmo)?;
+    let id_ols = identifiable(&ols.theta, &bounds, &free);
+    let independent = Independent {
+        lin: stats::linearised(&ols.at.j, ols.at.r.norm_squared(), &id_ols, 0),
+        theta: ols.theta.clone(),
+    };
+    let layout = residuals::Layout::of(&p.held, pr.channels.len());
+    let (res, noise) = if o.residuals == "ar1" {
+        let (res, models) = residuals::refit(|th| evaluate(p, th), ols, &layout, &bounds, &free, &lmo)?;
+        (res, Some(models))
+    } else {
+        (ols, None)
+    };
+    let fitted = Fitted {
+        res,
+        noise,
+        layout,
+        independent,
+        influence,
+        free,
+    };
+    assemble(m, p, o, &fitted, clock)
+}
+
+/// The ordinary least-squares fit's statistics (the residual model `independent`), reported
+/// beside those of the AR(1) model.
+struct Independent {
+    lin: stats::Linearised,
+    theta: Vec<f64>,
+}
+
+/// A finished fit.
+struct Fitted {
+    /// The last fit (its evaluation whitened with `noise`).
+    res: lm::LmResult,
+    /// The channels' AR(1) errors (None: independent).
+    noise: Option<Vec<residuals::Ar1>>,
+    layout: residuals::Layout,
+    independent: Independent,
+    influence: Vec<f64>,
+    free: Vec<bool>,
+}
+
+/// Free and not at a bound.
+fn identifiable(theta: &[f64], bounds: &[(f64, f64)], free: &[bool]) -> Vec<bool> {
+    (0..free.len())
+        .map(|k| free[k] && !at_bound(theta[k], bounds[k]))
+        .collect()
 }
 
 /// A fitted coordinate within 1e-6 of the bounds' width of a bound.
@@ -340,16 +403,19 @@ fn at_bound(theta: f64, (lo, hi): (f64, f64)) -> bool {
 /// The parameters with their intervals, and the warnings about them.
 fn parameters(
     pr: &Problem<'_>,
-    res: &lm::LmResult,
-    influence: &[f64],
+    f: &Fitted,
     identifiable: &[bool],
     lin: &stats::Linearised,
     t: f64,
     warnings: &mut Vec<String>,
 ) -> Vec<FittedParameter> {
+    let (res, influence) = (&f.res, &f.influence);
+    let ind = &f.independent;
+    let t_ind = stats::t975(ind.lin.dof);
     let mut out = Vec::with_capacity(pr.params.len());
     for (k, par) in pr.params.iter().enumerate() {
         let th = res.theta[k];
+        let (ith, ise) = (ind.theta[k], ind.lin.std_err[k].filter(|_| f.noise.is_some()));
         if influence[k] <= MIN_INFLUENCE_K {
             warnings.push(format!(
                 "{}: the trace does not influence this parameter (no fitted temperature moves by more than \
@@ -375,6 +441,8 @@ fn parameters(
             std_error: se,
             ci95_low: se.map(|s| par.value(th - t * s)),
             ci95_high: se.map(|s| par.value(th + t * s)),
+            ci95_independent_low: ise.map(|s| par.value(ith - t_ind * s)),
+            ci95_independent_high: ise.map(|s| par.value(ith + t_ind * s)),
             influence_k: influence[k],
         });
     }
@@ -473,25 +541,38 @@ fn identifiability(
     out
 }
 
-/// Errors per channel on the fitted and the held-out rows.
-fn channel_errors(p: &Prepared<'_>, temps_c: &[Vec<f64>]) -> Vec<ChannelErrors> {
+/// Errors per channel on the fitted and the held-out rows (with the fraction inside the band),
+/// and the residual process (its autocorrelation at lags 1, 2 and 6 rows on the fitted rows).
+fn channel_errors(
+    p: &Prepared<'_>,
+    f: &Fitted,
+    temps_c: &[Vec<f64>],
+    band: &[Vec<f64>],
+    noise: &[residuals::Ar1],
+) -> Vec<ChannelErrors> {
     let pr = &p.problem;
     pr.trace
         .measured
         .iter()
         .enumerate()
         .map(|(c, ch)| {
-            let res = |held: bool| -> Vec<f64> {
-                (0..p.held.len())
-                    .filter(|&r| p.held[r] == held)
-                    .map(|r| temps_c[r][c] - ch.values_c[r])
-                    .collect()
-            };
+            let rows = |held: bool| (0..p.held.len()).filter(move |&r| p.held[r] == held);
+            let res =
+                |held: bool| -> Vec<f64> { rows(held).map(|r| temps_c[r][c] - ch.values_c[r]).collect() };
+            let half = |held: bool| -> Vec<f64> { rows(held).map(|r| band[r][c]).collect() };
+            let fitted = res(false);
+            let acf = [1, 2, 6].map(|lag| f.layout.autocorrelation(&fitted, lag));
             ChannelErrors {
                 column: ch.column.clone(),
                 node: ch.name.clone(),
-                fitted: Errors::of(&res(false)),
-                holdout: Errors::of(&res(true)),
+                fitted: Errors::of(&fitted, &half(false)),
+                holdout: Errors::of(&res(true), &half(true)),
+                noise: Noise {
+                    phi: noise[c].phi,
+                    innovation_sd_k: noise[c].sigma,
+                    marginal_sd_k: noise[c].marginal_sd(),
+                    autocorrelation_lag_1_2_6: acf,
+                },
             }
         })
         .collect()
@@ -529,21 +610,22 @@ fn assemble(
     m: &Model,
     p: &Prepared<'_>,
     o: &CalibrateOptions,
-    res: &lm::LmResult,
-    influence: &[f64],
-    free: &[bool],
-    wall: f64,
+    f: &Fitted,
+    clock: Instant,
 ) -> Result<CalibrateResult, JobError> {
-    let pr = &p.problem;
+    let (pr, res) = (&p.problem, &f.res);
     let bounds: Vec<(f64, f64)> = pr.params.iter().map(Parameter::theta_bounds).collect();
-    let identifiable: Vec<bool> = (0..free.len())
-        .map(|k| free[k] && !at_bound(res.theta[k], bounds[k]))
-        .collect();
-    let ssr = res.at.r.norm_squared();
-    let lin = stats::linearised(&res.at.j, ssr, &identifiable);
+    let identifiable = identifiable(&res.theta, &bounds, &f.free);
+    let lost = f.noise.as_ref().map_or(0, Vec::len);
+    let mut lin = stats::linearised(&res.at.j, res.at.r.norm_squared(), &identifiable, lost);
+    if let Some(models) = &f.noise {
+        let used = identifiable.iter().filter(|&&k| k).count() as f64;
+        let eff = residuals::effective_rows(&f.layout, models) - used;
+        lin.dof = lin.dof.min(eff.floor().max(1.0) as usize);
+    }
     let t = stats::t975(lin.dof);
     let mut warnings = Vec::new();
-    let parameters = parameters(pr, res, influence, &identifiable, &lin, t, &mut warnings);
+    let parameters = parameters(pr, f, &identifiable, &lin, t, &mut warnings);
     let correlation = correlation(pr, &lin, &mut warnings);
     let identifiability = identifiability(pr, &lin, t, &mut warnings);
     if res.stop == lm::Stop::Budget {
@@ -552,23 +634,38 @@ fn assemble(
             res.evaluations
         ));
     }
-    let sim = pr.simulate(&res.theta, false)?;
+    let sim = pr.simulate(&res.theta, !pr.params.is_empty())?;
     if let Some(b) = &sim.breach {
         return Err(breach_error(p, &res.theta, b));
     }
-    let channels = channel_errors(p, &sim.temps_c);
+    let noise = f.noise.clone().unwrap_or_else(|| {
+        let a = residuals::Ar1 {
+            phi: 0.0,
+            sigma: lin.sigma2.sqrt(),
+        };
+        vec![a; pr.channels.len()]
+    });
+    let band = bands::half_widths(&sim, &lin.covariance, &noise, t);
+    let channels = channel_errors(p, f, &sim.temps_c, &band, &noise);
     let nodes: Vec<String> = pr.trace.measured.iter().map(|c| c.name.clone()).collect();
     let measured: Vec<Vec<f64>> = pr.trace.measured.iter().map(|c| c.values_c.clone()).collect();
-    let csv = fit_csv(&pr.trace.times, &p.held, &nodes, &measured, &sim.temps_c);
-    let series = pr.boundary_series();
-    let calibrated = model_file::calibrated_text(pr.text, &pr.overrides_at(&res.theta), &series)
-        .map_err(|e| JobError::invalid(format!("{}: {e}", m.label())))?;
+    let csv = fit_csv(&pr.trace.times, &p.held, &nodes, &measured, &sim.temps_c, &band);
+    let covariance: Vec<Vec<Option<f64>>> = lin
+        .covariance
+        .iter()
+        .map(|row| row.iter().map(|&x| x.is_finite().then_some(x)).collect())
+        .collect();
+    let mut calibrated =
+        model_file::calibrated_text(pr.text, &pr.overrides_at(&res.theta), &pr.boundary_series())
+            .map_err(|e| JobError::invalid(format!("{}: {e}", m.label())))?;
+    calibrated.push_str(&model_file::covariance_comment(&parameters, &covariance));
     let summary = CalibrationSummary {
         model: m.gearbox.name.clone(),
         trace: pr.trace.source.clone(),
         rows: pr.trace.len(),
         holdout_s: p.windows.clone(),
         parameters,
+        covariance,
         correlation,
         identifiability,
         channels,
@@ -579,12 +676,15 @@ fn assemble(
                 .ok()
                 .and_then(|v| v.as_str().map(String::from))
                 .unwrap_or_default(),
-            sigma_k: lin.sigma2.sqrt(),
+            residual_model: o.residuals.clone(),
+            sigma_k: (noise.iter().map(|a| a.marginal_sd().powi(2)).sum::<f64>() / noise.len().max(1) as f64)
+                .sqrt(),
+            scale: lin.sigma2.sqrt(),
             dof: lin.dof,
             t975: t,
             rtol: o.rtol,
             atol: o.atol,
-            wall_time_s: wall,
+            wall_time_s: clock.elapsed().as_secs_f64(),
         },
         warnings,
     };
@@ -611,6 +711,8 @@ fn check_finite(s: &CalibrationSummary) -> Result<(), JobError> {
             p.std_error,
             p.ci95_low,
             p.ci95_high,
+            p.ci95_independent_low,
+            p.ci95_independent_high,
             Some(p.influence_k),
         ];
         if vals.iter().flatten().any(|v| !v.is_finite()) {
@@ -619,7 +721,11 @@ fn check_finite(s: &CalibrationSummary) -> Result<(), JobError> {
     }
     for c in &s.channels {
         for e in [c.fitted, c.holdout].iter().flatten() {
-            if !(e.rmse_k.is_finite() && e.max_abs_k.is_finite() && e.bias_k.is_finite()) {
+            if !(e.rmse_k.is_finite()
+                && e.max_abs_k.is_finite()
+                && e.bias_k.is_finite()
+                && e.inside_band95.is_finite())
+            {
                 return Err(bad(&c.column));
             }
         }
@@ -662,6 +768,7 @@ impl super::command::ToArgs for CalibrateOptions {
         if !self.initial_from_trace {
             a.push("--keep-initial".into());
         }
+        a.extend(["--residuals".into(), self.residuals.clone()]);
         a
     }
 }

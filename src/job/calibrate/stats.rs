@@ -84,15 +84,16 @@ pub struct Linearised {
     pub in_null: Vec<bool>,
 }
 
-/// Linearised statistics from the residuals' Jacobian `j` (m × P) and sum of squares `ssr`.
+/// Linearised statistics from the residuals' Jacobian `j` (m × P) and sum of squares `ssr`;
+/// `lost` degrees of freedom go to the residual model's own parameters.
 /// Parameters not `identifiable` (no influence, at a bound) are left out. The covariance is the
 /// pseudo-inverse σ²·D⁻¹(Σ u uᵀ/λ)D⁻¹ over the eigenpairs (λ, u) of the scaled information
 /// above [`NULL_EIGENVALUE`]: a parameter that takes part in a null direction gets no standard
 /// error, the others their variance across it.
-pub fn linearised(j: &DMatrix<f64>, ssr: f64, identifiable: &[bool]) -> Linearised {
+pub fn linearised(j: &DMatrix<f64>, ssr: f64, identifiable: &[bool], lost: usize) -> Linearised {
     let (m, p) = j.shape();
     let keep: Vec<usize> = (0..p).filter(|&k| identifiable[k]).collect();
-    let dof = m.saturating_sub(keep.len()).max(1);
+    let dof = m.saturating_sub(keep.len() + lost).max(1);
     let sigma2 = ssr / dof as f64;
     let jk = DMatrix::from_fn(m, keep.len(), |r, c| j[(r, keep[c])]);
     let a = jk.transpose() * &jk;
@@ -179,13 +180,13 @@ mod tests {
         // y = a + b·x: Cov = σ²(XᵀX)⁻¹, checked against the closed form of simple regression.
         let x: Vec<f64> = (0..10).map(|k| k as f64).collect();
         let j = DMatrix::from_fn(10, 2, |r, c| if c == 0 { 1.0 } else { x[r] });
-        let l = linearised(&j, 8.0, &[true, true]);
+        let l = linearised(&j, 8.0, &[true, true], 0);
         let sxx: f64 = x.iter().map(|v| (v - 4.5).powi(2)).sum();
         assert!((l.sigma2 - 1.0).abs() < 1e-12);
         assert!((l.std_err[1].unwrap() - (1.0 / sxx).sqrt()).abs() < 1e-12);
         let r = l.correlation[0][1];
         assert!((r - (-4.5 / (sxx / 10.0 + 20.25).sqrt())).abs() < 1e-9, "{r}");
-        let l = linearised(&j, 8.0, &[true, false]);
+        let l = linearised(&j, 8.0, &[true, false], 0);
         assert!(l.std_err[1].is_none() && l.std_err[0].is_some());
     }
 
@@ -194,7 +195,7 @@ mod tests {
         // y = (a + b)·x + c: a and b enter only as their sum; c is determined.
         let x: Vec<f64> = (0..10).map(|k| k as f64).collect();
         let j = DMatrix::from_fn(10, 3, |r, c| if c < 2 { x[r] } else { 1.0 });
-        let l = linearised(&j, 8.0, &[true, true, true]);
+        let l = linearised(&j, 8.0, &[true, true, true], 0);
         assert!(l.in_null[0] && l.in_null[1] && !l.in_null[2], "{:?}", l.in_null);
         assert!(l.std_err[0].is_none() && l.std_err[1].is_none());
         let se = l.std_err[2].unwrap();
