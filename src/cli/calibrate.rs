@@ -44,9 +44,10 @@ pub struct CalibrateArgs {
     /// Start from the model's initial temperatures instead of the trace's first row.
     #[arg(long)]
     pub keep_initial: bool,
-    /// Residual model: ar1 (per channel AR(1) errors, generalised least squares; the intervals
-    /// of independent errors are reported beside) or independent (ordinary least squares).
-    #[arg(long, default_value = "ar1", value_name = "ar1|independent")]
+    /// Residual model: ar1 (least squares, intervals and bands from per channel AR(1) errors;
+    /// those of independent errors reported beside), ar1-gls (generalised least squares under
+    /// AR(1) errors) or independent.
+    #[arg(long, default_value = "ar1", value_name = "ar1|ar1-gls|independent")]
     pub residuals: String,
     /// Print calibration.json on stdout.
     #[arg(long)]

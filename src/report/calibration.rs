@@ -45,24 +45,25 @@ pub struct Errors {
     pub max_abs_k: f64,
     /// Mean of simulated − measured, K.
     pub bias_k: f64,
-    /// Fraction of the measured values inside the 95 % prediction band.
-    pub inside_band95: f64,
+    /// Fraction of the measured values inside the 95 % prediction band (null when the run
+    /// fitted no rows: the residual process, and so the band, is then unknown).
+    pub inside_band95: Option<f64>,
 }
 
 impl Errors {
     /// Errors of the residuals `r` with the band half-widths `half` (None when empty).
-    pub fn of(r: &[f64], half: &[f64]) -> Option<Errors> {
+    pub fn of(r: &[f64], half: Option<&[f64]>) -> Option<Errors> {
         if r.is_empty() {
             return None;
         }
         let n = r.len() as f64;
-        let inside = r.iter().zip(half).filter(|(x, h)| x.abs() <= **h).count();
+        let inside = half.map(|h| r.iter().zip(h).filter(|(x, h)| x.abs() <= **h).count() as f64 / n);
         Some(Errors {
             rows: r.len(),
             rmse_k: (r.iter().map(|x| x * x).sum::<f64>() / n).sqrt(),
             max_abs_k: r.iter().fold(0.0, |m, x| m.max(x.abs())),
             bias_k: r.iter().sum::<f64>() / n,
-            inside_band95: inside as f64 / n,
+            inside_band95: inside,
         })
     }
 }
@@ -250,12 +251,10 @@ pub fn to_text(s: &CalibrationSummary) -> String {
     for c in &s.channels {
         let e = |x: &Option<Errors>| {
             x.map_or("—".to_string(), |e| {
-                format!(
-                    "{:.3} / {:.3} / {:.1} %",
-                    e.rmse_k,
-                    e.max_abs_k,
-                    100.0 * e.inside_band95
-                )
+                let band = e
+                    .inside_band95
+                    .map_or("—".into(), |f| format!("{:.1} %", 100.0 * f));
+                format!("{:.3} / {:.3} / {band}", e.rmse_k, e.max_abs_k)
             })
         };
         let acf: Vec<String> = c

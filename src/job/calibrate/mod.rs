@@ -54,8 +54,9 @@ pub const MIN_INFLUENCE_K: f64 = 1e-6;
 pub const CORRELATION_WARNING: f64 = 0.95;
 
 /// A direction of the scaled Fisher information whose relative eigenvalue lies below this is
-/// reported as weakly determined (for two parameters: a correlation above about 0.998).
-pub const WEAK_EIGENVALUE: f64 = 1e-3;
+/// reported as weakly determined (for two parameters λ/λ_max = (1 − |r|)/(1 + |r|): a
+/// correlation above about 0.98).
+pub const WEAK_EIGENVALUE: f64 = 1e-2;
 
 /// Most evaluations with sensitivities.
 pub const MAX_ITERATIONS: Limit = Limit {
@@ -87,8 +88,8 @@ pub struct CalibrateOptions {
     /// Start every measured node at its first measured value and the others at their mean
     /// (else at the model's initial temperatures).
     pub initial_from_trace: bool,
-    /// Residual model: `ar1` (per channel AR(1) errors, generalised least squares) or
-    /// `independent` (ordinary least squares).
+    /// Residual model: `ar1` (least squares; intervals and bands from per channel AR(1)
+    /// errors), `ar1-gls` (generalised least squares under those errors) or `independent`.
     pub residuals: String,
 }
 
@@ -140,15 +141,15 @@ impl CalibrateOptions {
         limits::ATOL.check(self.atol)?;
         limits::MAX_STEPS.check(self.max_steps as f64)?;
         MAX_ITERATIONS.check(self.max_iterations as f64)?;
-        if !["ar1", "independent"].contains(&self.residuals.as_str()) {
+        if !["ar1", "ar1-gls", "independent"].contains(&self.residuals.as_str()) {
             let msg = format!(
-                "residuals (--residuals) = {}: must be ar1 or independent",
+                "residuals (--residuals) = {}: must be ar1, ar1-gls or independent",
                 self.residuals
             );
             return Err(JobError::option(
                 "residuals",
                 &self.residuals,
-                "ar1 or independent",
+                "ar1, ar1-gls or independent",
                 msg,
             ));
         }
@@ -351,15 +352,22 @@ pub fn fit(m: &Model, p: &Prepared<'_>, o: &CalibrateOptions) -> Result<Calibrat
         theta: ols.theta.clone(),
     };
     let layout = residuals::Layout::of(&p.held, pr.channels.len());
-    let (res, noise) = if o.residuals == "ar1" {
-        let (res, models) = residuals::refit(|th| evaluate(p, th), ols, &layout, &bounds, &free, &lmo)?;
-        (res, Some(models))
-    } else {
-        (ols, None)
+    let known = !layout.stretch.is_empty();
+    let (res, noise) = match o.residuals.as_str() {
+        "ar1-gls" if known => {
+            let (res, models) = residuals::refit(|th| evaluate(p, th), ols, &layout, &bounds, &free, &lmo)?;
+            (res, Some(models))
+        }
+        "ar1" if known => {
+            let models = layout.estimate(&ols.at.r);
+            (ols, Some(models))
+        }
+        _ => (ols, None),
     };
     let fitted = Fitted {
         res,
         noise,
+        whitened: o.residuals == "ar1-gls",
         layout,
         independent,
         influence,
@@ -381,6 +389,9 @@ struct Fitted {
     res: lm::LmResult,
     /// The channels' AR(1) errors (None: independent).
     noise: Option<Vec<residuals::Ar1>>,
+    /// `res` is the generalised least-squares fit (its evaluation whitened); else the ordinary
+    /// one, whose covariance under AR(1) errors is the sandwich.
+    whitened: bool,
     layout: residuals::Layout,
     independent: Independent,
     influence: Vec<f64>,
@@ -559,14 +570,16 @@ fn channel_errors(
             let rows = |held: bool| (0..p.held.len()).filter(move |&r| p.held[r] == held);
             let res =
                 |held: bool| -> Vec<f64> { rows(held).map(|r| temps_c[r][c] - ch.values_c[r]).collect() };
-            let half = |held: bool| -> Vec<f64> { rows(held).map(|r| band[r][c]).collect() };
+            let known = !f.layout.stretch.is_empty();
+            let half =
+                |held: bool| -> Option<Vec<f64>> { known.then(|| rows(held).map(|r| band[r][c]).collect()) };
             let fitted = res(false);
             let acf = [1, 2, 6].map(|lag| f.layout.autocorrelation(&fitted, lag));
             ChannelErrors {
                 column: ch.column.clone(),
                 node: ch.name.clone(),
-                fitted: Errors::of(&fitted, &half(false)),
-                holdout: Errors::of(&res(true), &half(true)),
+                fitted: Errors::of(&fitted, half(false).as_deref()),
+                holdout: Errors::of(&res(true), half(true).as_deref()),
                 noise: Noise {
                     phi: noise[c].phi,
                     innovation_sd_k: noise[c].sigma,
@@ -618,6 +631,10 @@ fn assemble(
     let identifiable = identifiable(&res.theta, &bounds, &f.free);
     let lost = f.noise.as_ref().map_or(0, Vec::len);
     let mut lin = stats::linearised(&res.at.j, res.at.r.norm_squared(), &identifiable, lost);
+    if let (Some(models), false) = (&f.noise, f.whitened) {
+        let sj = f.layout.covariance_times(&res.at.j, models);
+        stats::sandwich(&mut lin, &(res.at.j.transpose() * sj));
+    }
     if let Some(models) = &f.noise {
         let used = identifiable.iter().filter(|&&k| k).count() as f64;
         let eff = residuals::effective_rows(&f.layout, models) - used;
@@ -724,7 +741,7 @@ fn check_finite(s: &CalibrationSummary) -> Result<(), JobError> {
             if !(e.rmse_k.is_finite()
                 && e.max_abs_k.is_finite()
                 && e.bias_k.is_finite()
-                && e.inside_band95.is_finite())
+                && e.inside_band95.map_or(true, f64::is_finite))
             {
                 return Err(bad(&c.column));
             }

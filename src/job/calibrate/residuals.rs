@@ -146,6 +146,36 @@ impl Layout {
         Evaluation { r, j }
     }
 
+    /// Σ·x for every column x of `j`: Σ the residuals' covariance under the AR(1) models,
+    /// σ_a²/(1 − φ²)·φ^|i−k| between rows i and k of one channel and stretch, 0 otherwise
+    /// (forward and backward recursions, O(m) per column).
+    pub fn covariance_times(&self, j: &DMatrix<f64>, models: &[Ar1]) -> DMatrix<f64> {
+        let n = self.stretch.len();
+        let mut out = DMatrix::zeros(j.nrows(), j.ncols());
+        for col in 0..j.ncols() {
+            for (c, a) in models.iter().enumerate() {
+                let x: Vec<f64> = (0..n).map(|i| j[(i * self.nc + c, col)]).collect();
+                let mut f = x.clone();
+                for i in 1..n {
+                    if self.continues(i) {
+                        f[i] += a.phi * f[i - 1];
+                    }
+                }
+                let mut b = x.clone();
+                for i in (0..n.saturating_sub(1)).rev() {
+                    if self.continues(i + 1) {
+                        b[i] += a.phi * b[i + 1];
+                    }
+                }
+                let v = a.marginal_sd().powi(2);
+                for i in 0..n {
+                    out[(i * self.nc + c, col)] = v * (f[i] + b[i] - x[i]);
+                }
+            }
+        }
+        out
+    }
+
     /// The residuals and Jacobian from their whitened values (the inverse of [`Self::whiten`]).
     pub fn unwhiten_evaluation(&self, e: &Evaluation, models: &[Ar1]) -> Evaluation {
         let r = self.unwhiten(&e.r, models);
@@ -291,5 +321,13 @@ mod tests {
         assert!((back - &r).amax() < 1e-9);
         let acf = lay.autocorrelation(r.as_slice(), 1).unwrap();
         assert!((acf - 0.9).abs() < 0.02, "{acf}");
+        // Σ·e_k is column k of Σ: σ_a²/(1 − φ²)·φ^|i−k| within the stretch.
+        let small = Layout::of(&[false, false, false, true, false], 1);
+        let m = Ar1 { phi: 0.5, sigma: 1.0 };
+        let unit = DMatrix::from_fn(4, 1, |i, _| f64::from(u8::from(i == 1)));
+        let col = small.covariance_times(&unit, &[m]);
+        let v = 1.0 / 0.75;
+        let want = [0.5 * v, v, 0.5 * v, 0.0];
+        assert!((0..4).all(|i| (col[(i, 0)] - want[i]).abs() < 1e-12), "{col}");
     }
 }

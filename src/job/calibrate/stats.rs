@@ -82,6 +82,8 @@ pub struct Linearised {
     pub directions: Vec<EigenDirection>,
     /// Per parameter: takes part in a null direction (the data do not fix it).
     pub in_null: Vec<bool>,
+    /// √(JᵀJ)_kk per parameter (0 for one left out).
+    pub scale: Vec<f64>,
 }
 
 /// Linearised statistics from the residuals' Jacobian `j` (m × P) and sum of squares `ssr`;
@@ -106,7 +108,11 @@ pub fn linearised(j: &DMatrix<f64>, ssr: f64, identifiable: &[bool], lost: usize
         covariance: vec![vec![f64::NAN; p]; p],
         directions: Vec::new(),
         in_null: vec![false; p],
+        scale: vec![0.0; p],
     };
+    for (c, &k) in keep.iter().enumerate() {
+        out.scale[k] = d[c];
+    }
     if keep.is_empty() || d.iter().any(|&x| !(x > 0.0 && x.is_finite())) {
         return out;
     }
@@ -157,6 +163,57 @@ pub fn linearised(j: &DMatrix<f64>, ssr: f64, identifiable: &[bool], lost: usize
         }
     }
     out
+}
+
+/// The sandwich covariance of the least-squares estimate when the residuals have covariance
+/// Σ instead of σ²I (Seber & Wild, Nonlinear Regression, 1989, §2.1.4 and §6.1):
+/// Cov = A⁺(JᵀΣJ)A⁺, A⁺ the pseudo-inverse of JᵀJ of `lin` (its covariance over σ²), `b` =
+/// JᵀΣJ. The standard errors, correlations and the directions' standard errors follow.
+pub fn sandwich(lin: &mut Linearised, b: &DMatrix<f64>) {
+    let p = lin.covariance.len();
+    let kept: Vec<usize> = (0..p).filter(|&k| lin.scale[k] > 0.0).collect();
+    if kept.is_empty() || lin.sigma2.is_nan() || lin.sigma2 <= 0.0 {
+        return;
+    }
+    let ap = DMatrix::from_fn(kept.len(), kept.len(), |x, y| {
+        lin.covariance[kept[x]][kept[y]] / lin.sigma2
+    });
+    let bk = DMatrix::from_fn(kept.len(), kept.len(), |x, y| b[(kept[x], kept[y])]);
+    let cov = &ap * bk * &ap;
+    for (x, &kx) in kept.iter().enumerate() {
+        for (y, &ky) in kept.iter().enumerate() {
+            lin.covariance[kx][ky] = cov[(x, y)];
+        }
+    }
+    for &kx in &kept {
+        if !lin.in_null[kx] {
+            lin.std_err[kx] = Some(lin.covariance[kx][kx].max(0.0).sqrt());
+        }
+        for &ky in &kept {
+            let v = lin.covariance[kx][kx] * lin.covariance[ky][ky];
+            if !lin.in_null[kx] && !lin.in_null[ky] && v > 0.0 {
+                lin.correlation[kx][ky] = lin.covariance[kx][ky] / v.sqrt();
+            }
+        }
+    }
+    // The step s along v = D⁻¹u/max|D⁻¹u| is s = max|D⁻¹u|·uᵀDθ = w·θ with w = max²·D²v.
+    for d in lin.directions.iter_mut().filter(|d| d.std_error.is_some()) {
+        let vmax2 = 1.0
+            / kept
+                .iter()
+                .map(|&k| (d.direction[k] * lin.scale[k]).powi(2))
+                .sum::<f64>();
+        let w: Vec<f64> = (0..p)
+            .map(|k| vmax2 * lin.scale[k].powi(2) * d.direction[k])
+            .collect();
+        let mut v = 0.0;
+        for &kx in &kept {
+            for &ky in &kept {
+                v += w[kx] * lin.covariance[kx][ky] * w[ky];
+            }
+        }
+        d.std_error = Some(v.max(0.0).sqrt());
+    }
 }
 
 #[cfg(test)]
