@@ -159,7 +159,22 @@ fn a_calibration_writes_its_outputs() {
     assert_eq!(json["channels"][0]["holdout"]["rows"], 2);
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(
-        stdout.contains("95 % interval") && stdout.contains("oil-housing"),
+        stdout.contains("95 % interval")
+            && stdout.contains("oil-housing")
+            && stdout.contains("acf lag 1, 2, 6"),
         "{stdout}"
     );
+    let csv = std::fs::read_to_string(out.join("fit.csv")).unwrap();
+    assert!(csv.starts_with("time_s,holdout,oil_measured_c,oil_simulated_c,oil_residual_k,oil_band95_k\n"));
+    let cal = std::fs::read_to_string(out.join("calibrated.toml")).unwrap();
+    assert!(
+        cal.contains("# [calibration]") && cal.contains("# covariance = [["),
+        "{cal}"
+    );
+    // An unknown residual model: exit 1 naming the option, nothing written.
+    let bad = d.path().join("bad");
+    let o = calibrate(&t, &bad, &["--residuals", "ar2"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.code() == Some(1) && err.contains("--residuals"), "{err}");
+    assert!(!bad.exists());
 }

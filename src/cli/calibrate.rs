@@ -51,6 +51,11 @@ pub struct CalibrateArgs {
     /// Refuse a trace with empty cells (by default their rows are dropped and counted).
     #[arg(long)]
     pub refuse_missing: bool,
+    /// Residual model: ar1 (least squares, intervals and bands from per channel AR(1) errors;
+    /// those of independent errors reported beside), ar1-gls (generalised least squares under
+    /// AR(1) errors) or independent.
+    #[arg(long, default_value = "ar1", value_name = "ar1|ar1-gls|independent")]
+    pub residuals: String,
     /// Print calibration.json on stdout.
     #[arg(long)]
     pub json: bool,
@@ -70,6 +75,7 @@ impl CalibrateArgs {
             initial_from_trace: !self.keep_initial,
             segment: self.segment,
             refuse_missing: self.refuse_missing,
+            residuals: self.residuals.clone(),
         }
     }
 }

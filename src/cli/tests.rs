@@ -190,6 +190,7 @@ fn calibrate_options_round_trip() {
             initial_from_trace: false,
             segment: Some(2),
             refuse_missing: true,
+            residuals: "independent".into(),
         },
     ];
     for o in all {

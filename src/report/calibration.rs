@@ -25,6 +25,11 @@ pub struct FittedParameter {
     pub ci95_low: Option<f64>,
     /// 95 % interval, upper end.
     pub ci95_high: Option<f64>,
+    /// The 95 % interval of an ordinary least-squares fit with independent errors (the
+    /// residual model `independent`), lower end: reported beside for comparison.
+    pub ci95_independent_low: Option<f64>,
+    /// Its upper end.
+    pub ci95_independent_high: Option<f64>,
     /// Largest change of a fitted temperature per unit of the coordinate, K.
     pub influence_k: f64,
 }
@@ -40,22 +45,40 @@ pub struct Errors {
     pub max_abs_k: f64,
     /// Mean of simulated − measured, K.
     pub bias_k: f64,
+    /// Fraction of the measured values inside the 95 % prediction band (null when the run
+    /// fitted no rows: the residual process, and so the band, is then unknown).
+    pub inside_band95: Option<f64>,
 }
 
 impl Errors {
-    /// Errors of the residuals `r` (None when empty).
-    pub fn of(r: &[f64]) -> Option<Errors> {
+    /// Errors of the residuals `r` with the band half-widths `half` (None when empty).
+    pub fn of(r: &[f64], half: Option<&[f64]>) -> Option<Errors> {
         if r.is_empty() {
             return None;
         }
         let n = r.len() as f64;
+        let inside = half.map(|h| r.iter().zip(h).filter(|(x, h)| x.abs() <= **h).count() as f64 / n);
         Some(Errors {
             rows: r.len(),
             rmse_k: (r.iter().map(|x| x * x).sum::<f64>() / n).sqrt(),
             max_abs_k: r.iter().fold(0.0, |m, x| m.max(x.abs())),
             bias_k: r.iter().sum::<f64>() / n,
+            inside_band95: inside,
         })
     }
+}
+
+/// The residual process of one channel.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Noise {
+    /// AR(1) coefficient φ (0 for the residual model `independent`).
+    pub phi: f64,
+    /// Innovation standard deviation, K.
+    pub innovation_sd_k: f64,
+    /// Stationary standard deviation, K (the residual process's part of the band).
+    pub marginal_sd_k: f64,
+    /// Autocorrelation of the fitted rows' residuals at lags 1, 2 and 6 rows.
+    pub autocorrelation_lag_1_2_6: [Option<f64>; 3],
 }
 
 /// One measured channel.
@@ -69,6 +92,8 @@ pub struct ChannelErrors {
     pub fitted: Option<Errors>,
     /// On the held-out rows.
     pub holdout: Option<Errors>,
+    /// The residual process.
+    pub noise: Noise,
 }
 
 /// The correlation matrix of the fitted coordinates.
@@ -80,6 +105,28 @@ pub struct Correlation {
     pub matrix: Vec<Vec<Option<f64>>>,
 }
 
+/// One parameter's part in an eigen-direction.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Component {
+    /// Key path.
+    pub key_path: String,
+    /// Component in the fitted coordinate (ln p or p), the largest ±1.
+    pub component: f64,
+}
+
+/// An eigen-direction of the scaled Fisher information: how well the trace fixes a step along it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Direction {
+    /// `not determined` (null), `weakly determined` or `determined`.
+    pub status: &'static str,
+    /// λ/λ_max of the scaled information.
+    pub relative_eigenvalue: f64,
+    /// The direction (components above 0.05 only).
+    pub components: Vec<Component>,
+    /// 95 % half-width of the step along the direction (null: none).
+    pub ci95_half_width: Option<f64>,
+}
+
 /// How the fit went.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FitStats {
@@ -89,9 +136,16 @@ pub struct FitStats {
     pub iterations: usize,
     /// Why it stopped.
     pub stop: String,
-    /// Residual standard deviation σ = √(SSR/(m − P)), K.
+    /// Residual model: `ar1` or `independent`.
+    pub residual_model: String,
+    /// Residual standard deviation, K: √(SSR/(m − P)) with independent errors; with AR(1)
+    /// errors the root-mean-square of the channels' stationary standard deviations.
     pub sigma_k: f64,
-    /// Degrees of freedom m − P.
+    /// √(SSR/dof) of the residuals the intervals use (K with independent errors; the whitened,
+    /// dimensionless residuals with AR(1) errors, about 1 when the model fits).
+    pub scale: f64,
+    /// Degrees of freedom of the t quantile: m − P with independent errors; with AR(1) errors
+    /// the effective number of independent residuals less the parameters (at most m − P − channels).
     pub dof: usize,
     /// Student's t(0.975, dof).
     pub t975: f64,
@@ -116,8 +170,12 @@ pub struct CalibrationSummary {
     pub holdout_s: Vec<(f64, f64)>,
     /// Fitted parameters.
     pub parameters: Vec<FittedParameter>,
+    /// Their covariance in the fitted coordinates (ln p or p; null where undefined).
+    pub covariance: Vec<Vec<Option<f64>>>,
     /// Their correlations.
     pub correlation: Correlation,
+    /// The eigen-directions of the scaled Fisher information, least determined first.
+    pub identifiability: Vec<Direction>,
     /// Errors per measured channel.
     pub channels: Vec<ChannelErrors>,
     /// The fit.
@@ -128,24 +186,27 @@ pub struct CalibrationSummary {
 }
 
 /// `fit.csv`: `time_s,holdout`, then per channel `<node>_measured_c,<node>_simulated_c,
-/// <node>_residual_k`.
+/// <node>_residual_k,<node>_band95_k` (the half-width of the 95 % prediction band).
 pub fn fit_csv(
     times: &[f64],
     holdout: &[bool],
     nodes: &[String],
     measured: &[Vec<f64>],
     simulated: &[Vec<f64>],
+    band: &[Vec<f64>],
 ) -> String {
     let mut s = String::from("time_s,holdout");
     for n in nodes {
-        s.push_str(&format!(",{n}_measured_c,{n}_simulated_c,{n}_residual_k"));
+        s.push_str(&format!(
+            ",{n}_measured_c,{n}_simulated_c,{n}_residual_k,{n}_band95_k"
+        ));
     }
     s.push('\n');
     for (r, t) in times.iter().enumerate() {
         s.push_str(&format!("{t},{}", u8::from(holdout[r])));
         for c in 0..nodes.len() {
             let (m, x) = (measured[c][r], simulated[r][c]);
-            s.push_str(&format!(",{m},{x:.6},{:.6}", x - m));
+            s.push_str(&format!(",{m},{x:.6},{:.6},{:.6}", x - m, band[r][c]));
         }
         s.push('\n');
     }
@@ -160,30 +221,70 @@ pub fn to_text(s: &CalibrationSummary) -> String {
         s.fit.wall_time_s
     );
     if !s.parameters.is_empty() {
-        t.push_str("parameter                                   start        fitted     95 % interval\n");
+        t.push_str(&format!(
+            "parameter                                   start        fitted     95 % interval ({} residuals)    \
+             [independent errors]\n",
+            s.fit.residual_model
+        ));
     }
     for p in &s.parameters {
-        let ci = match (p.ci95_low, p.ci95_high) {
+        let ci = |lo: Option<f64>, hi: Option<f64>| match (lo, hi) {
             (Some(a), Some(b)) => format!("[{a:.5}, {b:.5}]"),
             _ => "not identifiable".into(),
         };
+        let ind = match (p.ci95_independent_low, p.ci95_independent_high) {
+            (None, None) => String::new(),
+            (a, b) => format!("   {}", ci(a, b)),
+        };
         t.push_str(&format!(
-            "  {:<40} {:>10.5} {:>12.5}   {ci}\n",
-            p.key_path, p.start, p.value
+            "  {:<40} {:>10.5} {:>12.5}   {}{ind}\n",
+            p.key_path,
+            p.start,
+            p.value,
+            ci(p.ci95_low, p.ci95_high)
         ));
     }
-    t.push_str("channel               fitted rmse / max, K    held-out rmse / max, K\n");
+    t.push_str(
+        "channel          fitted rmse / max, K / in band   held-out rmse / max, K / in band   \
+         φ     σ_a, K  acf lag 1, 2, 6\n",
+    );
     for c in &s.channels {
         let e = |x: &Option<Errors>| {
             x.map_or("—".to_string(), |e| {
-                format!("{:.3} / {:.3}", e.rmse_k, e.max_abs_k)
+                let band = e
+                    .inside_band95
+                    .map_or("—".into(), |f| format!("{:.1} %", 100.0 * f));
+                format!("{:.3} / {:.3} / {band}", e.rmse_k, e.max_abs_k)
             })
         };
+        let acf: Vec<String> = c
+            .noise
+            .autocorrelation_lag_1_2_6
+            .iter()
+            .map(|a| a.map_or("—".into(), |v| format!("{v:.3}")))
+            .collect();
         t.push_str(&format!(
-            "  {:<20} {:>22} {:>24}\n",
+            "  {:<14} {:>32} {:>34}   {:.3} {:.3}  {}\n",
             c.node,
             e(&c.fitted),
-            e(&c.holdout)
+            e(&c.holdout),
+            c.noise.phi,
+            c.noise.innovation_sd_k,
+            acf.join(", ")
+        ));
+    }
+    for d in s.identifiability.iter().filter(|d| d.status != "determined") {
+        let along: Vec<String> = d
+            .components
+            .iter()
+            .map(|c| format!("{:+.3} {}", c.component, c.key_path))
+            .collect();
+        let half = d.ci95_half_width.map_or("none".into(), |h| format!("±{h:.3}"));
+        t.push_str(&format!(
+            "{}: direction ({}), relative eigenvalue {:.1e}, 95 % step {half}\n",
+            d.status,
+            along.join(", "),
+            d.relative_eigenvalue
         ));
     }
     t

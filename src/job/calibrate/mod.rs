@@ -11,10 +11,13 @@
 //! - [`stats`]: covariance, t quantile, correlations;
 //! - [`model_file`]: the calibrated model text.
 
+pub mod bands;
+pub mod checks;
 pub mod lm;
 pub mod model_file;
 pub mod params;
 pub mod problem;
+pub mod residuals;
 pub mod stats;
 pub mod trace;
 pub mod trace_file;
@@ -28,7 +31,8 @@ use crate::model::overrides;
 use crate::model::parse::parse_document;
 use crate::model::Problems;
 use crate::report::calibration::{
-    fit_csv, CalibrationSummary, ChannelErrors, Correlation, Errors, FitStats, FittedParameter,
+    fit_csv, CalibrationSummary, ChannelErrors, Component, Correlation, Direction, Errors, FitStats,
+    FittedParameter, Noise,
 };
 use crate::solve::sensitivity::SensitivityOptions;
 
@@ -50,6 +54,11 @@ pub const DEFAULT_MAX_ITERATIONS: usize = 30;
 pub const MIN_INFLUENCE_K: f64 = 1e-6;
 /// Correlation above which two parameters are reported as not told apart by the trace.
 pub const CORRELATION_WARNING: f64 = 0.95;
+
+/// A direction of the scaled Fisher information whose relative eigenvalue lies below this is
+/// reported as weakly determined (for two parameters λ/λ_max = (1 − |r|)/(1 + |r|): a
+/// correlation above about 0.98).
+pub const WEAK_EIGENVALUE: f64 = 1e-2;
 
 /// Most evaluations with sensitivities.
 pub const MAX_ITERATIONS: Limit = Limit {
@@ -85,6 +94,9 @@ pub struct CalibrateOptions {
     pub segment: Option<usize>,
     /// Refuse empty cells (else their rows are dropped and counted).
     pub refuse_missing: bool,
+    /// Residual model: `ar1` (least squares; intervals and bands from per channel AR(1)
+    /// errors), `ar1-gls` (generalised least squares under those errors) or `independent`.
+    pub residuals: String,
 }
 
 impl CalibrateOptions {
@@ -111,6 +123,7 @@ impl Default for CalibrateOptions {
             initial_from_trace: true,
             segment: None,
             refuse_missing: false,
+            residuals: "ar1".into(),
         }
     }
 }
@@ -147,6 +160,18 @@ impl CalibrateOptions {
         limits::ATOL.check(self.atol)?;
         limits::MAX_STEPS.check(self.max_steps as f64)?;
         MAX_ITERATIONS.check(self.max_iterations as f64)?;
+        if !["ar1", "ar1-gls", "independent"].contains(&self.residuals.as_str()) {
+            let msg = format!(
+                "residuals (--residuals) = {}: must be ar1, ar1-gls or independent",
+                self.residuals
+            );
+            return Err(JobError::option(
+                "residuals",
+                &self.residuals,
+                "ar1, ar1-gls or independent",
+                msg,
+            ));
+        }
         let mut specs: Vec<FitSpec> = Vec::with_capacity(self.fit.len());
         for f in &self.fit {
             let s: FitSpec = f
@@ -238,6 +263,7 @@ pub fn prepare<'a>(
                 .map_err(|e| JobError::option("fit", s.to_string(), "a number in the model", e))
         })
         .collect::<Result<Vec<_>, _>>()?;
+    checks::fitted_once(&specs, &doc)?;
     let opts = SensitivityOptions {
         rtol: o.rtol,
         atol: o.atol,
@@ -260,7 +286,9 @@ pub fn prepare<'a>(
         )));
     }
     // The model at the start point must check (bounds written into the file are checked there).
-    problem.gearbox_at(&start(&problem.params))?;
+    problem.gearbox_at(&problem.start())?;
+    checks::boundaries_in_model_range(m, &problem)?;
+    checks::measured_in_envelope(m, &problem)?;
     Ok(Prepared {
         problem,
         windows,
@@ -268,11 +296,27 @@ pub fn prepare<'a>(
     })
 }
 
-fn start(params: &[Parameter]) -> Vec<f64> {
-    params.iter().map(|p| p.theta(p.start)).collect()
+/// The error of a fitted model whose trajectory leaves the physics envelope (exit 2).
+fn breach_error(p: &Prepared<'_>, theta: &[f64], breach: &str) -> JobError {
+    let pr = &p.problem;
+    let values: Vec<String> = pr
+        .params
+        .iter()
+        .zip(theta)
+        .map(|(q, &t)| format!("{} = {}", q.name(), q.written(t)))
+        .collect();
+    JobError::numerical(format!(
+        "{} on {}: with {} the trajectory leaves the range where the models hold {breach}: no calibrated \
+         model is written (narrow the bounds or check the trace)",
+        pr.file.display(),
+        pr.trace.source,
+        values.join(", ")
+    ))
 }
 
-/// Residuals (simulated − measured, K) and their Jacobian over the fitted rows.
+/// Residuals (simulated − measured, K) and their Jacobian over the fitted rows. The points the
+/// fit passes through may leave the physics envelope (a start far from the data); the fitted
+/// point may not ([`fit`]).
 fn evaluate(p: &Prepared<'_>, theta: &[f64]) -> Result<Evaluation, JobError> {
     let pr = &p.problem;
     let sim = pr.simulate(theta, true)?;
@@ -309,7 +353,7 @@ pub fn calibrate(
 pub fn fit(m: &Model, p: &Prepared<'_>, o: &CalibrateOptions) -> Result<CalibrateResult, JobError> {
     let clock = Instant::now();
     let pr = &p.problem;
-    let theta0 = start(&pr.params);
+    let theta0 = pr.start();
     let at0 = evaluate(p, &theta0)?;
     let influence: Vec<f64> = (0..pr.params.len())
         .map(|k| at0.j.column(k).iter().fold(0.0, |a: f64, x| a.max(x.abs())))
@@ -320,9 +364,64 @@ pub fn fit(m: &Model, p: &Prepared<'_>, o: &CalibrateOptions) -> Result<Calibrat
         max_iterations: o.max_iterations,
         ..LmOptions::default()
     };
-    let res = lm::minimise(|th| evaluate(p, th), &theta0, at0, &bounds, &free, &lmo)?;
-    let wall = clock.elapsed().as_secs_f64();
-    assemble(m, p, o, &res, &influence, &free, wall)
+    let ols = lm::minimise(|th| evaluate(p, th), &theta0, at0, &bounds, &free, &lmo)?;
+    let id_ols = identifiable(&ols.theta, &bounds, &free);
+    let independent = Independent {
+        lin: stats::linearised(&ols.at.j, ols.at.r.norm_squared(), &id_ols, 0),
+        theta: ols.theta.clone(),
+    };
+    let layout = residuals::Layout::of(&p.held, pr.channels.len());
+    let known = !layout.stretch.is_empty();
+    let (res, noise) = match o.residuals.as_str() {
+        "ar1-gls" if known => {
+            let (res, models) = residuals::refit(|th| evaluate(p, th), ols, &layout, &bounds, &free, &lmo)?;
+            (res, Some(models))
+        }
+        "ar1" if known => {
+            let models = layout.estimate(&ols.at.r);
+            (ols, Some(models))
+        }
+        _ => (ols, None),
+    };
+    let fitted = Fitted {
+        res,
+        noise,
+        whitened: o.residuals == "ar1-gls",
+        layout,
+        independent,
+        influence,
+        free,
+    };
+    assemble(m, p, o, &fitted, clock)
+}
+
+/// The ordinary least-squares fit's statistics (the residual model `independent`), reported
+/// beside those of the AR(1) model.
+struct Independent {
+    lin: stats::Linearised,
+    theta: Vec<f64>,
+}
+
+/// A finished fit.
+struct Fitted {
+    /// The last fit (its evaluation whitened with `noise`).
+    res: lm::LmResult,
+    /// The channels' AR(1) errors (None: independent).
+    noise: Option<Vec<residuals::Ar1>>,
+    /// `res` is the generalised least-squares fit (its evaluation whitened); else the ordinary
+    /// one, whose covariance under AR(1) errors is the sandwich.
+    whitened: bool,
+    layout: residuals::Layout,
+    independent: Independent,
+    influence: Vec<f64>,
+    free: Vec<bool>,
+}
+
+/// Free and not at a bound.
+fn identifiable(theta: &[f64], bounds: &[(f64, f64)], free: &[bool]) -> Vec<bool> {
+    (0..free.len())
+        .map(|k| free[k] && !at_bound(theta[k], bounds[k]))
+        .collect()
 }
 
 /// A fitted coordinate within 1e-6 of the bounds' width of a bound.
@@ -334,16 +433,19 @@ fn at_bound(theta: f64, (lo, hi): (f64, f64)) -> bool {
 /// The parameters with their intervals, and the warnings about them.
 fn parameters(
     pr: &Problem<'_>,
-    res: &lm::LmResult,
-    influence: &[f64],
+    f: &Fitted,
     identifiable: &[bool],
     lin: &stats::Linearised,
     t: f64,
     warnings: &mut Vec<String>,
 ) -> Vec<FittedParameter> {
+    let (res, influence) = (&f.res, &f.influence);
+    let ind = &f.independent;
+    let t_ind = stats::t975(ind.lin.dof);
     let mut out = Vec::with_capacity(pr.params.len());
     for (k, par) in pr.params.iter().enumerate() {
         let th = res.theta[k];
+        let (ith, ise) = (ind.theta[k], ind.lin.std_err[k].filter(|_| f.noise.is_some()));
         if influence[k] <= MIN_INFLUENCE_K {
             warnings.push(format!(
                 "{}: the trace does not influence this parameter (no fitted temperature moves by more than \
@@ -355,20 +457,22 @@ fn parameters(
             warnings.push(format!(
                 "{}: at its bound ({}): no interval; widen the bounds or fix the parameter",
                 par.name(),
-                par.value(th)
+                par.written(th)
             ));
         }
         let se = lin.std_err[k];
         out.push(FittedParameter {
             key_path: par.name(),
             start: par.start,
-            value: par.value(th),
+            value: par.written(th),
             lower_bound: par.lo,
             upper_bound: par.hi,
             scale: if par.log { "log" } else { "linear" },
             std_error: se,
             ci95_low: se.map(|s| par.value(th - t * s)),
             ci95_high: se.map(|s| par.value(th + t * s)),
+            ci95_independent_low: ise.map(|s| par.value(ith - t_ind * s)),
+            ci95_independent_high: ise.map(|s| par.value(ith + t_ind * s)),
             influence_k: influence[k],
         });
     }
@@ -401,25 +505,106 @@ fn correlation(pr: &Problem<'_>, lin: &stats::Linearised, warnings: &mut Vec<Str
     }
 }
 
-/// Errors per channel on the fitted and the held-out rows.
-fn channel_errors(p: &Prepared<'_>, temps_c: &[Vec<f64>]) -> Vec<ChannelErrors> {
+/// The eigen-directions as reported, with a warning for each the trace does not or only weakly
+/// determines.
+fn identifiability(
+    pr: &Problem<'_>,
+    lin: &stats::Linearised,
+    t: f64,
+    warnings: &mut Vec<String>,
+) -> Vec<Direction> {
+    let mut out = Vec::new();
+    for d in &lin.directions {
+        let components: Vec<Component> = pr
+            .params
+            .iter()
+            .zip(&d.direction)
+            .filter(|(_, c)| c.abs() > stats::INVOLVED)
+            .map(|(q, &c)| Component {
+                key_path: q.name(),
+                component: c,
+            })
+            .collect();
+        let label = |c: &Component| {
+            let log = pr.params.iter().any(|q| q.name() == c.key_path && q.log);
+            if log {
+                format!("{:+.3}·ln {}", c.component, c.key_path)
+            } else {
+                format!("{:+.3}·{}", c.component, c.key_path)
+            }
+        };
+        let along: Vec<String> = components.iter().map(label).collect();
+        let names: Vec<&str> = components.iter().map(|c| c.key_path.as_str()).collect();
+        let half = d.std_error.map(|s| t * s);
+        let status = match half {
+            None => "not determined",
+            Some(_) if d.relative_eigenvalue < WEAK_EIGENVALUE => "weakly determined",
+            Some(_) => "determined",
+        };
+        match half {
+            None => warnings.push(format!(
+                "{} are not identifiable: a step along ({}) leaves the fitted temperatures unchanged (relative \
+                 eigenvalue {:.1e} of the scaled Fisher information): the trace fixes only the combinations \
+                 across it; fix all but one of them, give a prior, or add a trace that separates them",
+                names.join(" and "),
+                along.join(", "),
+                d.relative_eigenvalue
+            )),
+            Some(h) if d.relative_eigenvalue < WEAK_EIGENVALUE && components.len() > 1 => {
+                warnings.push(format!(
+                    "{} move together: the trace fixes a step along ({}) only to ±{h:.3} (95 %; relative \
+                     eigenvalue {:.1e})",
+                    names.join(" and "),
+                    along.join(", "),
+                    d.relative_eigenvalue
+                ))
+            }
+            _ => {}
+        }
+        out.push(Direction {
+            status,
+            relative_eigenvalue: d.relative_eigenvalue,
+            components,
+            ci95_half_width: half,
+        });
+    }
+    out
+}
+
+/// Errors per channel on the fitted and the held-out rows (with the fraction inside the band),
+/// and the residual process (its autocorrelation at lags 1, 2 and 6 rows on the fitted rows).
+fn channel_errors(
+    p: &Prepared<'_>,
+    f: &Fitted,
+    temps_c: &[Vec<f64>],
+    band: &[Vec<f64>],
+    noise: &[residuals::Ar1],
+) -> Vec<ChannelErrors> {
     let pr = &p.problem;
     pr.trace
         .measured
         .iter()
         .enumerate()
         .map(|(c, ch)| {
-            let res = |held: bool| -> Vec<f64> {
-                (0..p.held.len())
-                    .filter(|&r| p.held[r] == held)
-                    .map(|r| temps_c[r][c] - ch.values_c[r])
-                    .collect()
-            };
+            let rows = |held: bool| (0..p.held.len()).filter(move |&r| p.held[r] == held);
+            let res =
+                |held: bool| -> Vec<f64> { rows(held).map(|r| temps_c[r][c] - ch.values_c[r]).collect() };
+            let known = !f.layout.stretch.is_empty();
+            let half =
+                |held: bool| -> Option<Vec<f64>> { known.then(|| rows(held).map(|r| band[r][c]).collect()) };
+            let fitted = res(false);
+            let acf = [1, 2, 6].map(|lag| f.layout.autocorrelation(&fitted, lag));
             ChannelErrors {
                 column: ch.column.clone(),
                 node: ch.name.clone(),
-                fitted: Errors::of(&res(false)),
-                holdout: Errors::of(&res(true)),
+                fitted: Errors::of(&fitted, half(false).as_deref()),
+                holdout: Errors::of(&res(true), half(true).as_deref()),
+                noise: Noise {
+                    phi: noise[c].phi,
+                    innovation_sd_k: noise[c].sigma,
+                    marginal_sd_k: noise[c].marginal_sd(),
+                    autocorrelation_lag_1_2_6: acf,
+                },
             }
         })
         .collect()
@@ -457,58 +642,68 @@ fn assemble(
     m: &Model,
     p: &Prepared<'_>,
     o: &CalibrateOptions,
-    res: &lm::LmResult,
-    influence: &[f64],
-    free: &[bool],
-    wall: f64,
+    f: &Fitted,
+    clock: Instant,
 ) -> Result<CalibrateResult, JobError> {
-    let pr = &p.problem;
+    let (pr, res) = (&p.problem, &f.res);
     let bounds: Vec<(f64, f64)> = pr.params.iter().map(Parameter::theta_bounds).collect();
-    let identifiable: Vec<bool> = (0..free.len())
-        .map(|k| free[k] && !at_bound(res.theta[k], bounds[k]))
-        .collect();
-    let ssr = res.at.r.norm_squared();
-    let lin = stats::linearised(&res.at.j, ssr, &identifiable);
+    let identifiable = identifiable(&res.theta, &bounds, &f.free);
+    let lost = f.noise.as_ref().map_or(0, Vec::len);
+    let mut lin = stats::linearised(&res.at.j, res.at.r.norm_squared(), &identifiable, lost);
+    if let (Some(models), false) = (&f.noise, f.whitened) {
+        let sj = f.layout.covariance_times(&res.at.j, models);
+        stats::sandwich(&mut lin, &(res.at.j.transpose() * sj));
+    }
+    if let Some(models) = &f.noise {
+        let used = identifiable.iter().filter(|&&k| k).count() as f64;
+        let eff = residuals::effective_rows(&f.layout, models) - used;
+        lin.dof = lin.dof.min(eff.floor().max(1.0) as usize);
+    }
     let t = stats::t975(lin.dof);
     let mut warnings = pr.trace.notes.clone();
-    let parameters = parameters(pr, res, influence, &identifiable, &lin, t, &mut warnings);
+    let parameters = parameters(pr, f, &identifiable, &lin, t, &mut warnings);
     let correlation = correlation(pr, &lin, &mut warnings);
+    let identifiability = identifiability(pr, &lin, t, &mut warnings);
     if res.stop == lm::Stop::Budget {
         warnings.push(format!(
             "the fit stopped after {} evaluations (max_iterations) before converging",
             res.evaluations
         ));
     }
-    let sim = pr.simulate(&res.theta, false)?;
-    let channels = channel_errors(p, &sim.temps_c);
+    let sim = pr.simulate(&res.theta, !pr.params.is_empty())?;
+    if let Some(b) = &sim.breach {
+        return Err(breach_error(p, &res.theta, b));
+    }
+    let noise = f.noise.clone().unwrap_or_else(|| {
+        let a = residuals::Ar1 {
+            phi: 0.0,
+            sigma: lin.sigma2.sqrt(),
+        };
+        vec![a; pr.channels.len()]
+    });
+    let band = bands::half_widths(&sim, &lin.covariance, &noise, t);
+    let channels = channel_errors(p, f, &sim.temps_c, &band, &noise);
     let nodes: Vec<String> = pr.trace.measured.iter().map(|c| c.name.clone()).collect();
     let measured: Vec<Vec<f64>> = pr.trace.measured.iter().map(|c| c.values_c.clone()).collect();
-    let csv = fit_csv(&pr.trace.times, &p.held, &nodes, &measured, &sim.temps_c);
-    let series: Vec<(String, Vec<(f64, f64)>)> = pr
-        .trace
-        .boundaries
+    let csv = fit_csv(&pr.trace.times, &p.held, &nodes, &measured, &sim.temps_c, &band);
+    let covariance: Vec<Vec<Option<f64>>> = lin
+        .covariance
         .iter()
-        .map(|c| {
-            (
-                c.name.clone(),
-                pr.trace
-                    .times
-                    .iter()
-                    .copied()
-                    .zip(c.values_c.iter().copied())
-                    .collect(),
-            )
-        })
+        .map(|row| row.iter().map(|&x| x.is_finite().then_some(x)).collect())
         .collect();
-    let calibrated = model_file::calibrated_text(pr.text, &pr.overrides_at(&res.theta), &series)
-        .map_err(|e| JobError::invalid(format!("{}: {e}", m.label())))?;
+    let mut calibrated =
+        model_file::calibrated_text(pr.text, &pr.overrides_at(&res.theta), &pr.boundary_series())
+            .map_err(|e| JobError::invalid(format!("{}: {e}", m.label())))?;
+    calibrated.push_str(&model_file::covariance_comment(&parameters, &covariance));
     let summary = CalibrationSummary {
         model: m.gearbox.name.clone(),
         trace: pr.trace.source.clone(),
         rows: pr.trace.len(),
         holdout_s: p.windows.clone(),
         parameters,
+        covariance,
         correlation,
+        identifiability,
         channels,
         fit: FitStats {
             evaluations: res.evaluations,
@@ -517,12 +712,15 @@ fn assemble(
                 .ok()
                 .and_then(|v| v.as_str().map(String::from))
                 .unwrap_or_default(),
-            sigma_k: lin.sigma2.sqrt(),
+            residual_model: o.residuals.clone(),
+            sigma_k: (noise.iter().map(|a| a.marginal_sd().powi(2)).sum::<f64>() / noise.len().max(1) as f64)
+                .sqrt(),
+            scale: lin.sigma2.sqrt(),
             dof: lin.dof,
             t975: t,
             rtol: o.rtol,
             atol: o.atol,
-            wall_time_s: wall,
+            wall_time_s: clock.elapsed().as_secs_f64(),
         },
         warnings,
     };
@@ -549,6 +747,8 @@ fn check_finite(s: &CalibrationSummary) -> Result<(), JobError> {
             p.std_error,
             p.ci95_low,
             p.ci95_high,
+            p.ci95_independent_low,
+            p.ci95_independent_high,
             Some(p.influence_k),
         ];
         if vals.iter().flatten().any(|v| !v.is_finite()) {
@@ -557,9 +757,21 @@ fn check_finite(s: &CalibrationSummary) -> Result<(), JobError> {
     }
     for c in &s.channels {
         for e in [c.fitted, c.holdout].iter().flatten() {
-            if !(e.rmse_k.is_finite() && e.max_abs_k.is_finite() && e.bias_k.is_finite()) {
+            if !(e.rmse_k.is_finite()
+                && e.max_abs_k.is_finite()
+                && e.bias_k.is_finite()
+                && e.inside_band95.map_or(true, f64::is_finite))
+            {
                 return Err(bad(&c.column));
             }
+        }
+    }
+    for d in &s.identifiability {
+        let vals = [Some(d.relative_eigenvalue), d.ci95_half_width];
+        if vals.iter().flatten().any(|v| !v.is_finite())
+            || d.components.iter().any(|c| !c.component.is_finite())
+        {
+            return Err(bad("an eigen-direction of the Fisher information"));
         }
     }
     if !s.fit.sigma_k.is_finite() {
@@ -598,6 +810,7 @@ impl super::command::ToArgs for CalibrateOptions {
         if self.refuse_missing {
             a.push("--refuse-missing".into());
         }
+        a.extend(["--residuals".into(), self.residuals.clone()]);
         a
     }
 }

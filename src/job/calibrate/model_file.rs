@@ -6,6 +6,7 @@ use toml_edit::{Array, DocumentMut, Item, Table, TableLike, Value};
 
 use crate::model::overrides::Step;
 use crate::model::Override;
+use crate::report::calibration::FittedParameter;
 
 /// The table-like item at the end of `steps` (keys, each optionally followed by a selector
 /// into an array of tables: `[N]` or `["name"]`), creating missing tables for keys.
@@ -105,6 +106,46 @@ pub fn calibrated_text(
         t.insert("series", Item::Value(Value::Array(arr)));
     }
     Ok(doc.to_string())
+}
+
+/// The fitted parameters' covariance as a comment block at the end of `calibrated.toml` (a
+/// TOML table once the leading `# ` of its lines is removed; the model file has no section for
+/// it): key paths, scales, values and the covariance in the fitted coordinates (ln p or p).
+pub fn covariance_comment(params: &[FittedParameter], cov: &[Vec<Option<f64>>]) -> String {
+    if params.is_empty() {
+        return String::new();
+    }
+    let quote = |s: &str| format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""));
+    let list = |v: Vec<String>| format!("[{}]", v.join(", "));
+    let mut s = String::from(
+        "\n# The fitted parameters' covariance in their fitted coordinates (ln p for scale \"log\", p for \
+         \"linear\"),\n# nan where not identifiable: remove the leading \"# \" for a TOML table.\n\
+         # [calibration]\n",
+    );
+    s.push_str(&format!(
+        "# parameters = {}\n",
+        list(params.iter().map(|p| quote(&p.key_path)).collect())
+    ));
+    s.push_str(&format!(
+        "# scale = {}\n",
+        list(params.iter().map(|p| quote(p.scale)).collect())
+    ));
+    s.push_str(&format!(
+        "# value = {}\n",
+        list(params.iter().map(|p| format!("{:?}", p.value)).collect())
+    ));
+    let rows: Vec<String> = cov
+        .iter()
+        .map(|r| {
+            list(
+                r.iter()
+                    .map(|x| x.map_or("nan".into(), |v| format!("{v:?}")))
+                    .collect(),
+            )
+        })
+        .collect();
+    s.push_str(&format!("# covariance = [{}]\n", rows.join(", ")));
+    s
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@
 
 use toml::{Table, Value};
 
-use crate::model::overrides::{self, KeyPath};
+use crate::model::overrides::{self, KeyPath, Step};
 use crate::model::Override;
 
 /// Default span of a positive parameter without bounds: [p/10, 10·p].
@@ -41,6 +41,8 @@ pub struct Parameter {
     pub hi: f64,
     /// Fitted on ln p (else on p).
     pub log: bool,
+    /// The model holds an integer there: written as one (rounded).
+    pub integer: bool,
 }
 
 fn split_bounds(s: &str) -> (&str, Option<&str>) {
@@ -107,7 +109,9 @@ impl Parameter {
     /// Resolve a spec against the model document (after the base overrides).
     pub fn resolve(spec: &FitSpec, doc: &Table) -> Result<Parameter, String> {
         let name = spec.path.to_string();
-        let value = match overrides::get(doc, &spec.path) {
+        let got = overrides::get(doc, &spec.path);
+        let integer = matches!(got, Ok(Value::Integer(_)));
+        let value = match got {
             Ok(Value::Float(x)) => Some(x),
             Ok(Value::Integer(i)) => Some(i as f64),
             Ok(v) => {
@@ -148,6 +152,7 @@ impl Parameter {
             lo,
             hi,
             log,
+            integer,
         })
     }
 
@@ -169,6 +174,35 @@ impl Parameter {
         }
     }
 
+    /// The value written into the model at coordinate θ: the start itself at the start's
+    /// coordinate (ln and exp do not return it to the last bit), within the bounds (a
+    /// coordinate at its bound's coordinate maps to the bound, not to a value one bit outside),
+    /// rounded for an integer.
+    pub fn written(&self, theta: f64) -> f64 {
+        let v = if theta == self.theta(self.start) {
+            self.start
+        } else {
+            self.value(theta).clamp(self.lo, self.hi)
+        };
+        if self.integer {
+            v.round()
+        } else {
+            v
+        }
+    }
+
+    /// The two coordinates of the central difference about θ and its half-step: θ ± δ, the
+    /// pair moved inside the bounds when θ lies within δ of one (the model is never evaluated
+    /// outside the user's bounds; the difference is then centred up to δ away from θ, an
+    /// error of order δ in the derivative), the half-step shrunk to half the bounds' width when
+    /// that is narrower than 2δ.
+    pub fn difference_pair(&self, theta: f64) -> (f64, f64, f64) {
+        let (lo, hi) = self.theta_bounds();
+        let d = self.delta().min(0.5 * (hi - lo));
+        let c = theta.clamp(lo + d, hi - d);
+        ((c + d).min(hi), (c - d).max(lo), d)
+    }
+
     /// Bounds in the coordinate.
     pub fn theta_bounds(&self) -> (f64, f64) {
         (self.theta(self.lo), self.theta(self.hi))
@@ -188,9 +222,14 @@ impl Parameter {
 
     /// The override that writes value p.
     pub fn override_at(&self, p: f64) -> Override {
+        let value = if self.integer {
+            Value::Integer(p.round() as i64)
+        } else {
+            Value::Float(p)
+        };
         Override {
             path: self.path.clone(),
-            value: Value::Float(p),
+            value,
         }
     }
 
@@ -198,6 +237,31 @@ impl Parameter {
     pub fn name(&self) -> String {
         self.path.to_string()
     }
+}
+
+/// The key path with every `["name"]` selector replaced by the index of the entry it names in
+/// `doc`: two spellings of one key (`thermal.nodes[4].mass_kg`, `thermal.nodes["housing"].
+/// mass_kg`) give the same canonical path. A selector that names nothing is kept.
+pub fn canonical(path: &KeyPath, doc: &Table) -> KeyPath {
+    let mut at: Option<&Value> = None;
+    let mut out = Vec::with_capacity(path.0.len());
+    for step in &path.0 {
+        let step = match (step, at) {
+            (Step::Named(n), Some(Value::Array(a))) => a
+                .iter()
+                .position(|e| e.get("name").and_then(Value::as_str) == Some(n.as_str()))
+                .map_or_else(|| step.clone(), Step::Index),
+            _ => step.clone(),
+        };
+        at = match (&step, at) {
+            (Step::Key(k), None) => doc.get(k),
+            (Step::Key(k), Some(v)) => v.get(k),
+            (Step::Index(i), Some(Value::Array(a))) => a.get(*i),
+            _ => None,
+        };
+        out.push(step);
+    }
+    KeyPath(out)
 }
 
 #[cfg(test)]
@@ -229,5 +293,23 @@ mod tests {
         let m = Parameter::resolve(&"a.missing=1:4".parse().unwrap(), &doc).unwrap();
         assert_eq!(m.start, 2.0);
         assert!(Parameter::resolve(&"a.b=3:4".parse().unwrap(), &doc).is_err());
+    }
+
+    #[test]
+    fn written_values_are_the_start_the_bounds_and_integers() {
+        let doc: Table = "[a]\nh = 250.0\nteeth = 16\n".parse().unwrap();
+        let h = Parameter::resolve(&"a.h=14:1000".parse().unwrap(), &doc).unwrap();
+        assert_ne!(h.value(h.theta(250.0)), 250.0);
+        assert_eq!(h.written(h.theta(250.0)), 250.0);
+        assert_eq!(h.written(h.theta(14.0)), 14.0);
+        assert_eq!(h.written(h.theta_bounds().0 - 1.0), 14.0);
+        let (up, down, d) = h.difference_pair(h.theta_bounds().1);
+        assert!(up <= h.theta_bounds().1 && (up - down - 2.0 * d).abs() < 1e-12);
+        let t = Parameter::resolve(&"a.teeth".parse().unwrap(), &doc).unwrap();
+        assert!(t.integer && t.written(t.theta(16.0)) == 16.0);
+        assert_eq!(
+            t.override_at(t.written(t.theta(16.0) + 1e-3)).value,
+            Value::Integer(16)
+        );
     }
 }

@@ -19,6 +19,7 @@ use crate::solve::transient::Segment;
 
 use super::params::Parameter;
 use super::trace::Trace;
+use crate::job::envelope::Envelope;
 use crate::job::{JobError, Model};
 
 /// Everything a simulation at a parameter point needs.
@@ -57,6 +58,8 @@ pub struct Simulation {
     pub sens: Vec<Vec<f64>>,
     /// Steps and rejected steps of the integration.
     pub steps: (usize, usize),
+    /// Where the trajectory first leaves the physics envelope (time and node), if it does.
+    pub breach: Option<String>,
 }
 
 fn invalid(label: &str, what: String) -> JobError {
@@ -198,7 +201,7 @@ impl<'a> Problem<'a> {
             self.params
                 .iter()
                 .zip(theta)
-                .map(|(p, &t)| p.override_at(p.value(t))),
+                .map(|(p, &t)| p.override_at(p.written(t))),
         );
         ovs
     }
@@ -210,7 +213,7 @@ impl<'a> Problem<'a> {
         let mut doc = self.doc.clone();
         let mut problems = Problems::default();
         for (p, &t) in self.params.iter().zip(theta) {
-            if let Err(e) = overrides::apply(&mut doc, &p.override_at(p.value(t))) {
+            if let Err(e) = overrides::apply(&mut doc, &p.override_at(p.written(t))) {
                 problems.push(p.name(), t, e);
             }
         }
@@ -255,11 +258,11 @@ impl<'a> Problem<'a> {
         let mut pairs = Vec::new();
         if sens {
             for (k, p) in self.params.iter().enumerate() {
-                let d = p.delta();
+                let (up, down, d) = p.difference_pair(theta[k]);
                 let mut th = theta.to_vec();
-                th[k] = theta[k] + d;
+                th[k] = up;
                 let plus = self.scene_at(&th)?;
-                th[k] = theta[k] - d;
+                th[k] = down;
                 let minus = self.scene_at(&th)?;
                 for s in [&plus, &minus] {
                     if s.nodes() != scene.nodes() || s.items() != scene.items() {
@@ -284,7 +287,26 @@ impl<'a> Problem<'a> {
             .collect();
         let traj = integrate_sensitivities(&scene, &dirs, &self.segs, &self.opts)
             .map_err(|e| JobError::numerical(format!("{}: {e}", self.file.display())))?;
-        Ok(self.collect(&traj, dirs.len()))
+        let mut sim = self.collect(&traj, dirs.len());
+        sim.breach = trajectory_breach(&Envelope::of(&scene), &traj.times, &traj.temps);
+        Ok(sim)
+    }
+
+    /// The coordinates of the parameters' start values.
+    pub fn start(&self) -> Vec<f64> {
+        self.params.iter().map(|p| p.theta(p.start)).collect()
+    }
+
+    /// The trace's boundary columns as (name, (time s, °C) pairs).
+    pub fn boundary_series(&self) -> Vec<(String, Vec<(f64, f64)>)> {
+        self.trace
+            .boundaries
+            .iter()
+            .map(|c| {
+                let pts = self.trace.times.iter().copied().zip(c.values_c.iter().copied());
+                (c.name.clone(), pts.collect())
+            })
+            .collect()
     }
 
     /// The channels' values at the trace rows.
@@ -310,6 +332,16 @@ impl<'a> Problem<'a> {
             temps_c,
             sens,
             steps: (traj.steps.len(), traj.rejected),
+            breach: None,
         }
     }
+}
+
+/// The first output row (time, s) at which a node of `temps_k` (K, every node, per row) leaves
+/// the envelope of the scene, with the breach.
+fn trajectory_breach(envelope: &Envelope, times: &[f64], temps_k: &[Vec<f64>]) -> Option<String> {
+    temps_k
+        .iter()
+        .zip(times)
+        .find_map(|(y, t)| envelope.check(y).err().map(|b| format!("at t = {t} s: {b}")))
 }

@@ -44,6 +44,27 @@ pub fn t975(dof: usize) -> f64 {
     0.5 * (lo + hi)
 }
 
+/// Relative eigenvalue λ/λ_max of the scaled information below which a direction is not
+/// determined at all: the sensitivities are accurate to about 10⁻⁶ relative
+/// (docs/calibration.md), so singular values below √(10⁻⁹) ≈ 3·10⁻⁵ of the largest cannot be
+/// told from zero.
+pub const NULL_EIGENVALUE: f64 = 1e-9;
+/// A parameter takes part in a direction whose component (the direction scaled to its largest
+/// component 1) exceeds this.
+pub const INVOLVED: f64 = 0.05;
+
+/// An eigen-direction of the scaled information, in the fitted coordinates.
+#[derive(Debug, Clone)]
+pub struct EigenDirection {
+    /// λ/λ_max of the scaled information DᵀJᵀJD⁻¹ (D = diag(√(JᵀJ)_kk)).
+    pub relative_eigenvalue: f64,
+    /// The direction v in the fitted coordinates (one per parameter, 0 for a parameter left out),
+    /// its largest component ±1.
+    pub direction: Vec<f64>,
+    /// Standard error of the step s along v (θ = θ̂ + s·v); None for a null direction.
+    pub std_error: Option<f64>,
+}
+
 /// Covariance, correlation and standard errors of the fitted coordinates.
 #[derive(Debug, Clone)]
 pub struct Linearised {
@@ -55,34 +76,143 @@ pub struct Linearised {
     pub std_err: Vec<Option<f64>>,
     /// Correlation matrix (NaN where undefined).
     pub correlation: Vec<Vec<f64>>,
+    /// Covariance of the fitted coordinates (NaN where undefined).
+    pub covariance: Vec<Vec<f64>>,
+    /// Eigen-directions of the scaled information, least determined first.
+    pub directions: Vec<EigenDirection>,
+    /// Per parameter: takes part in a null direction (the data do not fix it).
+    pub in_null: Vec<bool>,
+    /// √(JᵀJ)_kk per parameter (0 for one left out).
+    pub scale: Vec<f64>,
 }
 
-/// Linearised statistics from the residuals' Jacobian `j` (m × P) and sum of squares `ssr`.
-/// A column that is zero (no influence) gets no standard error and is left out of the inverse.
-pub fn linearised(j: &DMatrix<f64>, ssr: f64, identifiable: &[bool]) -> Linearised {
+/// Linearised statistics from the residuals' Jacobian `j` (m × P) and sum of squares `ssr`;
+/// `lost` degrees of freedom go to the residual model's own parameters.
+/// Parameters not `identifiable` (no influence, at a bound) are left out. The covariance is the
+/// pseudo-inverse σ²·D⁻¹(Σ u uᵀ/λ)D⁻¹ over the eigenpairs (λ, u) of the scaled information
+/// above [`NULL_EIGENVALUE`]: a parameter that takes part in a null direction gets no standard
+/// error, the others their variance across it.
+pub fn linearised(j: &DMatrix<f64>, ssr: f64, identifiable: &[bool], lost: usize) -> Linearised {
     let (m, p) = j.shape();
     let keep: Vec<usize> = (0..p).filter(|&k| identifiable[k]).collect();
-    let dof = m.saturating_sub(keep.len()).max(1);
+    let dof = m.saturating_sub(keep.len() + lost).max(1);
     let sigma2 = ssr / dof as f64;
     let jk = DMatrix::from_fn(m, keep.len(), |r, c| j[(r, keep[c])]);
     let a = jk.transpose() * &jk;
-    let inv = a.clone().try_inverse();
-    let mut std_err = vec![None; p];
-    let mut correlation = vec![vec![f64::NAN; p]; p];
-    if let Some(inv) = inv {
-        for (a_, &ka) in keep.iter().enumerate() {
-            std_err[ka] = Some((inv[(a_, a_)] * sigma2).max(0.0).sqrt());
-            for (b_, &kb) in keep.iter().enumerate() {
-                let d = (inv[(a_, a_)] * inv[(b_, b_)]).sqrt();
-                correlation[ka][kb] = if d > 0.0 { inv[(a_, b_)] / d } else { f64::NAN };
+    let d: Vec<f64> = (0..keep.len()).map(|k| a[(k, k)].max(0.0).sqrt()).collect();
+    let mut out = Linearised {
+        sigma2,
+        dof,
+        std_err: vec![None; p],
+        correlation: vec![vec![f64::NAN; p]; p],
+        covariance: vec![vec![f64::NAN; p]; p],
+        directions: Vec::new(),
+        in_null: vec![false; p],
+        scale: vec![0.0; p],
+    };
+    for (c, &k) in keep.iter().enumerate() {
+        out.scale[k] = d[c];
+    }
+    if keep.is_empty() || d.iter().any(|&x| !(x > 0.0 && x.is_finite())) {
+        return out;
+    }
+    let s = DMatrix::from_fn(keep.len(), keep.len(), |r, c| a[(r, c)] / (d[r] * d[c]));
+    let eig = s.symmetric_eigen();
+    let lmax = eig.eigenvalues.iter().fold(0.0_f64, |x, &y| x.max(y));
+    let mut pinv = DMatrix::zeros(keep.len(), keep.len());
+    let mut order: Vec<usize> = (0..keep.len()).collect();
+    order.sort_by(|&x, &y| eig.eigenvalues[x].total_cmp(&eig.eigenvalues[y]));
+    for &i in &order {
+        let (lam, u) = (eig.eigenvalues[i], eig.eigenvectors.column(i));
+        let rel = if lmax > 0.0 { lam / lmax } else { 0.0 };
+        let v: Vec<f64> = (0..keep.len()).map(|k| u[k] / d[k]).collect();
+        let vmax = v.iter().fold(0.0_f64, |x, y| x.max(y.abs()));
+        let null = rel.is_nan() || rel <= NULL_EIGENVALUE;
+        let mut direction = vec![0.0; p];
+        for (c, &k) in keep.iter().enumerate() {
+            direction[k] = v[c] / vmax;
+            if null && (v[c] / vmax).abs() > INVOLVED {
+                out.in_null[k] = true;
+            }
+        }
+        if !null {
+            pinv += (u * u.transpose()) / lam;
+        }
+        out.directions.push(EigenDirection {
+            relative_eigenvalue: rel.max(0.0),
+            direction,
+            std_error: (!null).then(|| (sigma2 / lam).sqrt() * vmax),
+        });
+    }
+    for (x, &kx) in keep.iter().enumerate() {
+        for (y, &ky) in keep.iter().enumerate() {
+            out.covariance[kx][ky] = sigma2 * pinv[(x, y)] / (d[x] * d[y]);
+        }
+    }
+    for &kx in &keep {
+        if !out.in_null[kx] {
+            out.std_err[kx] = Some(out.covariance[kx][kx].max(0.0).sqrt());
+        }
+    }
+    for &kx in &keep {
+        for &ky in &keep {
+            let v = out.covariance[kx][kx] * out.covariance[ky][ky];
+            if !out.in_null[kx] && !out.in_null[ky] && v > 0.0 {
+                out.correlation[kx][ky] = out.covariance[kx][ky] / v.sqrt();
             }
         }
     }
-    Linearised {
-        sigma2,
-        dof,
-        std_err,
-        correlation,
+    out
+}
+
+/// The sandwich covariance of the least-squares estimate when the residuals have covariance
+/// Σ instead of σ²I (Seber & Wild, Nonlinear Regression, 1989, §2.1.4 and §6.1):
+/// Cov = A⁺(JᵀΣJ)A⁺, A⁺ the pseudo-inverse of JᵀJ of `lin` (its covariance over σ²), `b` =
+/// JᵀΣJ. The standard errors, correlations and the directions' standard errors follow.
+pub fn sandwich(lin: &mut Linearised, b: &DMatrix<f64>) {
+    let p = lin.covariance.len();
+    let kept: Vec<usize> = (0..p).filter(|&k| lin.scale[k] > 0.0).collect();
+    if kept.is_empty() || lin.sigma2.is_nan() || lin.sigma2 <= 0.0 {
+        return;
+    }
+    let ap = DMatrix::from_fn(kept.len(), kept.len(), |x, y| {
+        lin.covariance[kept[x]][kept[y]] / lin.sigma2
+    });
+    let bk = DMatrix::from_fn(kept.len(), kept.len(), |x, y| b[(kept[x], kept[y])]);
+    let cov = &ap * bk * &ap;
+    for (x, &kx) in kept.iter().enumerate() {
+        for (y, &ky) in kept.iter().enumerate() {
+            lin.covariance[kx][ky] = cov[(x, y)];
+        }
+    }
+    for &kx in &kept {
+        if !lin.in_null[kx] {
+            lin.std_err[kx] = Some(lin.covariance[kx][kx].max(0.0).sqrt());
+        }
+        for &ky in &kept {
+            let v = lin.covariance[kx][kx] * lin.covariance[ky][ky];
+            if !lin.in_null[kx] && !lin.in_null[ky] && v > 0.0 {
+                lin.correlation[kx][ky] = lin.covariance[kx][ky] / v.sqrt();
+            }
+        }
+    }
+    // The step s along v = D⁻¹u/max|D⁻¹u| is s = max|D⁻¹u|·uᵀDθ = w·θ with w = max²·D²v.
+    for d in lin.directions.iter_mut().filter(|d| d.std_error.is_some()) {
+        let vmax2 = 1.0
+            / kept
+                .iter()
+                .map(|&k| (d.direction[k] * lin.scale[k]).powi(2))
+                .sum::<f64>();
+        let w: Vec<f64> = (0..p)
+            .map(|k| vmax2 * lin.scale[k].powi(2) * d.direction[k])
+            .collect();
+        let mut v = 0.0;
+        for &kx in &kept {
+            for &ky in &kept {
+                v += w[kx] * lin.covariance[kx][ky] * w[ky];
+            }
+        }
+        d.std_error = Some(v.max(0.0).sqrt());
     }
 }
 
@@ -107,13 +237,31 @@ mod tests {
         // y = a + b·x: Cov = σ²(XᵀX)⁻¹, checked against the closed form of simple regression.
         let x: Vec<f64> = (0..10).map(|k| k as f64).collect();
         let j = DMatrix::from_fn(10, 2, |r, c| if c == 0 { 1.0 } else { x[r] });
-        let l = linearised(&j, 8.0, &[true, true]);
+        let l = linearised(&j, 8.0, &[true, true], 0);
         let sxx: f64 = x.iter().map(|v| (v - 4.5).powi(2)).sum();
         assert!((l.sigma2 - 1.0).abs() < 1e-12);
         assert!((l.std_err[1].unwrap() - (1.0 / sxx).sqrt()).abs() < 1e-12);
         let r = l.correlation[0][1];
         assert!((r - (-4.5 / (sxx / 10.0 + 20.25).sqrt())).abs() < 1e-9, "{r}");
-        let l = linearised(&j, 8.0, &[true, false]);
+        let l = linearised(&j, 8.0, &[true, false], 0);
         assert!(l.std_err[1].is_none() && l.std_err[0].is_some());
+    }
+
+    #[test]
+    fn a_null_direction_is_named() {
+        // y = (a + b)·x + c: a and b enter only as their sum; c is determined.
+        let x: Vec<f64> = (0..10).map(|k| k as f64).collect();
+        let j = DMatrix::from_fn(10, 3, |r, c| if c < 2 { x[r] } else { 1.0 });
+        let l = linearised(&j, 8.0, &[true, true, true], 0);
+        assert!(l.in_null[0] && l.in_null[1] && !l.in_null[2], "{:?}", l.in_null);
+        assert!(l.std_err[0].is_none() && l.std_err[1].is_none());
+        let se = l.std_err[2].unwrap();
+        // c's standard error is that of the intercept of y = s·x + c.
+        let sxx: f64 = x.iter().map(|v| (v - 4.5).powi(2)).sum();
+        let want = (l.sigma2 * (0.1 + 20.25 / sxx)).sqrt();
+        assert!((se - want).abs() < 1e-9 * want, "{se} {want}");
+        let n = &l.directions[0];
+        assert!(n.std_error.is_none() && n.relative_eigenvalue < 1e-12);
+        assert!((n.direction[0] + n.direction[1]).abs() < 1e-9 && n.direction[2].abs() < 1e-9);
     }
 }

@@ -34,19 +34,19 @@ fn read_fit(dir: &Path) -> Result<Fit, PlotError> {
     };
     let mut lines = text.lines();
     let head: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
-    if head.len() < 5 || head[0] != "time_s" || head[1] != "holdout" || (head.len() - 2) % 3 != 0 {
+    if head.len() < 5 || head[0] != "time_s" || head[1] != "holdout" || (head.len() - 2) % 4 != 0 {
         return Err(PlotError::Data {
             path: path.clone(),
-            what: "not a fit.csv: expected time_s,holdout and three columns per channel".into(),
+            what: "not a fit.csv: expected time_s,holdout and four columns per channel".into(),
         });
     }
-    let nc = (head.len() - 2) / 3;
+    let nc = (head.len() - 2) / 4;
     let mut fit = Fit {
         time_s: Vec::new(),
         holdout: Vec::new(),
         channels: (0..nc)
             .map(|c| {
-                let name = head[2 + 3 * c].trim_end_matches("_measured_c").to_string();
+                let name = head[2 + 4 * c].trim_end_matches("_measured_c").to_string();
                 (name, Vec::new(), Vec::new(), Vec::new())
             })
             .collect(),
@@ -74,9 +74,9 @@ fn read_fit(dir: &Path) -> Result<Fit, PlotError> {
         fit.time_s.push(num(0)?);
         fit.holdout.push(f[1] == "1");
         for c in 0..nc {
-            fit.channels[c].1.push(num(2 + 3 * c)?);
-            fit.channels[c].2.push(num(3 + 3 * c)?);
-            fit.channels[c].3.push(num(4 + 3 * c)?);
+            fit.channels[c].1.push(num(2 + 4 * c)?);
+            fit.channels[c].2.push(num(3 + 4 * c)?);
+            fit.channels[c].3.push(num(4 + 4 * c)?);
         }
     }
     if fit.time_s.is_empty() {
