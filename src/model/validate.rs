@@ -80,6 +80,7 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         .and_then(|spec| launch::validate_launch(spec, &ratios, problems));
     let items = ItemNames {
         gears: &s.gears,
+        declared: file.gears.iter().map(|g| g.name.as_str()).collect(),
         meshes: &s.meshes,
         bearings: &bearings,
         seals: &seals,
@@ -207,6 +208,8 @@ fn structure<'a>(file: &'a ModelFile, problems: &mut Problems) -> (Structure, pa
 /// The loss items of the model by source, for heat rules (`"<source>:<name>"`).
 struct ItemNames<'a> {
     gears: &'a [gears::Gear],
+    /// Every gear name the file declares, checked or not.
+    declared: Vec<&'a str>,
     meshes: &'a [meshes::Mesh],
     bearings: &'a [bearings::Bearing],
     seals: &'a [seals::Seal],
@@ -230,7 +233,21 @@ fn check_thermal(
             name: &g.name,
             radius: 0.5 * g.geometry.d_a.max(g.geometry.d_f),
             face_width: g.geometry.spec.b,
+            checked: true,
         })
+        .chain(
+            it.declared
+                .iter()
+                // Only after a problem: a gear dropped without one stays an unknown name.
+                .filter(|_| !problems.is_empty())
+                .filter(|d| !it.gears.iter().any(|g| g.name == **d))
+                .map(|d| thermal::GearInfo {
+                    name: d,
+                    radius: 0.0,
+                    face_width: 0.0,
+                    checked: false,
+                }),
+        )
         .collect();
     let mut names = thermal::LossItemNames::default();
     names.set(Source::Churning, it.gears.iter().map(|g| g.name.as_str()));

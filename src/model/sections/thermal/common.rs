@@ -24,6 +24,9 @@ pub struct GearInfo<'a> {
     pub radius: f64,
     /// Face width, m.
     pub face_width: f64,
+    /// False for a gear the file declares whose own checks failed: a reference to it is not a
+    /// second problem (the first is reported where the gear is defined).
+    pub checked: bool,
 }
 
 /// Names of the loss items of each source that heat rules may name (`"<source>:<name>"`):

@@ -314,6 +314,9 @@ fn link_law(
                 return None;
             };
             let g = &gears[gi];
+            if !g.checked {
+                return None;
+            }
             // Default wetted area: both faces and the rim of the disc.
             let default = 2.0 * std::f64::consts::PI * g.radius * (g.radius + g.face_width);
             let a = if l.area_m2.is_some() {

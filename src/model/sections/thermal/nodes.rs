@@ -71,6 +71,9 @@ pub(crate) fn check_nodes(
                 problems.push(&gp, g, "unknown gear");
                 continue;
             };
+            if !gears[idx].checked {
+                continue;
+            }
             if let Some(prev) = gear_owner.insert(idx, i) {
                 problems.push(
                     &gp,
