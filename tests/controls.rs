@@ -367,3 +367,34 @@ fn steady_state_with_a_consistent_mode_is_an_equilibrium() {
     assert!(eq.solution.temperatures[0] > 10.0 + KELVIN_OFFSET);
     assert!(eq.solution.method.contains("newton"));
 }
+
+/// A fan that never switches on: its link runs at `off_fraction` of its conductance, which
+/// moves heat, but its time on (and so its duty cycle) stays 0.
+#[test]
+fn a_fan_that_stays_off_has_no_time_on() {
+    let text = heater_network(ON_C, OFF_C, POWER, C1).replace(
+        "[[thermal.links]]\nbetween = [\"casing\", \"ambient\"]",
+        "[[thermal.links]]\nname = \"casing-air\"\nbetween = [\"casing\", \"ambient\"]",
+    ) + r#"
+[[thermal.controls]]
+name = "fan"
+kind = "two_point"
+sensor = "casing"
+on_c = 150.0
+off_c = 140.0
+link = "casing-air"
+off_fraction = 0.4
+"#;
+    let mut scene = fzg_with(&text);
+    scene.frozen_oil_temp = Some(40.0 + KELVIN_OFFSET);
+    let segs = uniform(steady_inputs(0.0, 0.0), 40, 50.0);
+    let traj = run(&scene, &segs, Method::Ros3, 1e-8);
+    let fan = scene.control_row_index() + geartherm::scene::controls::ROWS_PER_CONTROL;
+    let last = traj.states.last().unwrap();
+    assert_eq!(last[fan + 1], 0.0, "time on of a fan that never switched on");
+    assert!(
+        last[fan] > 0.0,
+        "the link at its off share still moves heat: {}",
+        last[fan]
+    );
+}

@@ -29,8 +29,37 @@ EXPECTED = {
 TEMPLATE_OF = {"run": "run", "map": "map", "bench": "bench", "rating": "rating"}
 
 
+# A bundled model with switching controllers appended (a fan on the housing's convection and
+# a thermostatic heater in the oil), so that mutations and `--set` reach [[thermal.controls]].
+CONTROLS = "helical_stage_controls.toml"
+CONTROLS_TEXT = """
+[[thermal.controls]]
+name = "fan"
+kind = "two_point"
+sensor = "oil"
+on_c = 70.0
+off_c = 65.0
+link = "housing-air"
+off_fraction = 0.4
+
+[[thermal.controls]]
+name = "heater"
+kind = "two_point"
+sensor = "oil"
+on_c = 20.0
+off_c = 25.0
+heater_w = 300.0
+"""
+MODELS.append(CONTROLS)
+GEAR[CONTROLS] = GEAR["helical_stage.toml"]
+
+
 def model_texts(root):
-    return {m: open(os.path.join(root, "models", m)).read() for m in MODELS}
+    def text(m):
+        if m == CONTROLS:
+            return open(os.path.join(root, "models", "helical_stage.toml")).read() + CONTROLS_TEXT
+        return open(os.path.join(root, "models", m)).read()
+    return {m: text(m) for m in MODELS}
 
 
 def mutate_model(text, rng):

@@ -753,7 +753,13 @@ impl ThermalScene {
         let bt = &work.boundary_t;
         for (k, c) in self.controls.iter().enumerate() {
             let (x, _) = c.share(work.mode[k], temps[c.sensor]);
-            out[ROWS_PER_CONTROL * k + 1] = x;
+            // Time on: a two-point controller's on-indicator (its share while off is not time
+            // on), a valve's share.
+            out[ROWS_PER_CONTROL * k + 1] = if c.is_two_point() {
+                f64::from(u8::from(work.mode[k] == 1))
+            } else {
+                x
+            };
             if let Action::Heater { power, .. } = c.action {
                 out[ROWS_PER_CONTROL * k] = x * power;
             }
