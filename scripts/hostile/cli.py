@@ -113,11 +113,30 @@ def gen_cycle(rng):
     return "\n".join(rows) + "\n"
 
 
+def gen_trace(rng):
+    """A measured-trace CSV as `calibrate --trace` and `trace` read it: gaps in time, empty and
+    hostile cells, columns missing or repeated."""
+    cols = ["time_s", "input_speed_rpm", "input_torque_nm", "gear", "node:oil", "boundary:ambient"]
+    if rng.random() < 0.2:
+        cols = rng.sample(cols, rng.randint(1, len(cols))) + ([rng.choice(cols)] if rng.random() < 0.3 else [])
+    rows, t = [",".join(cols)], 0.0
+    for _ in range(rng.randint(0, 40)):
+        t += rng.choice([1, 1, 1, 600, 1e-12, 0, -1, 1e6])
+        good = {"input_speed_rpm": "1500", "input_torque_nm": "300", "gear": "1", "node:oil": "55.5",
+                "boundary:ambient": "20", "time_s": str(t)}
+        cells = [str(t)] + [good[c] if rng.random() < 0.95 else rng.choice([""] + HOSTILE) for c in cols[1:]]
+        rows.append(",".join(cells[:len(cols)]))
+    return "\n".join(rows) + "\n"
+
+
 def base_args(cmd, m, rng, v, gear):
     """Options of `cmd` on model `m`: valid ones, each replaced by a hostile value with the
     chance `v` gives."""
     if cmd == "check":
         return ["check", "MODEL"]
+    if cmd == "trace":
+        return ["trace", "CYCLE"] + (["--json"] if rng.random() < 0.5 else []) + (
+            ["--refuse-missing"] if rng.random() < 0.3 else [])
     if cmd == "info":
         return ["info", "MODEL"] + (["--json"] if rng.random() < 0.5 else [])
     if cmd == "losses":
@@ -177,11 +196,14 @@ def make_case(i, rng, texts, family):
         elif r < 0.65:
             text = extreme_model(text, rng)
     cmds = ["check", "info", "losses", "losses", "steady", "steady", "map", "run", "run", "rating"]
+    cmds += ["trace"] if family == "cli" else []
     cmd = rng.choice(cmds + (["bench"] if family == "set" else []))
     gear = GEAR[m] if rng.random() < 0.9 else rng.choice(["0", "R", "x", "1\n"])
     hostile_p = 0.3 if family == "cli" else 0.05
     v = lambda good: rng.choice(HOSTILE) if rng.random() < hostile_p else rng.choice(good)
     case = {"id": i, "family": family, "model": m, "model_text": text, "cmd": cmd, "cycle": None}
+    if cmd == "trace":
+        case["cycle"] = gen_trace(rng)
     args = base_args(cmd, m, rng, v, gear) or run_args(rng, v, case)
     if family == "set":
         args[2:2] = set_args(rng, texts[m])

@@ -210,6 +210,11 @@ fn split(rows: &[Row<'_>], col: Option<usize>) -> Vec<std::ops::Range<usize>> {
         return vec![whole];
     };
     let mut steps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
+    // Times that do not increase: one segment, so the reader names the row with the file's own
+    // time (a segment's times counted from its first row would show another value).
+    if steps.iter().any(|s| *s <= 0.0) {
+        return vec![whole];
+    }
     steps.sort_by(f64::total_cmp);
     let median = steps[steps.len() / 2];
     let mut out = Vec::new();
@@ -386,5 +391,17 @@ mod tests {
         let text = rows(&[0.0, 600.0, 1200.0, 1e6, 1e6 + 600.0]).replace(",24\n", ",x\n");
         let e = read(&text, "t.csv", Missing::Drop).unwrap_err().to_string();
         assert!(e.contains("line 6") && e.contains("not a number"), "{e}");
+    }
+
+    #[test]
+    fn a_time_that_goes_back_is_named_with_the_files_own_value() {
+        // A gap later in the file would cut it into segments counted from their first rows;
+        // the row whose time goes back is still named with the time the file holds.
+        let text = rows(&[600.0, 0.0, -600.0, 1200.0, 1e6, 1e6 + 600.0]);
+        let e = read(&text, "t.csv", Missing::Drop).unwrap_err().to_string();
+        assert!(
+            e.contains("line 3") && e.contains("\"0\"") && e.contains("increase"),
+            "{e}"
+        );
     }
 }
