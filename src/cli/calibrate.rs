@@ -56,6 +56,18 @@ pub struct CalibrateArgs {
     /// AR(1) errors) or independent.
     #[arg(long, default_value = "ar1", value_name = "ar1|ar1-gls|independent")]
     pub residuals: String,
+    /// A prior on a fitted parameter (a MAP fit): KEYPATH=normal:MEAN:SD or
+    /// KEYPATH=lognormal:MEDIAN:SD_LN (SD_LN the standard deviation of ln p; repeatable).
+    #[arg(long, value_name = "KEYPATH=DIST:LOC:WIDTH")]
+    pub prior: Vec<String>,
+    /// A TOML file of priors: [[prior]] tables with key, distribution ("normal": mean, sd;
+    /// "lognormal": median, sd_ln).
+    #[arg(long, value_name = "FILE")]
+    pub priors: Option<PathBuf>,
+    /// Compute the profile likelihood of a fitted parameter (repeatable): profile.csv and its
+    /// 95 % interval.
+    #[arg(long, value_name = "KEYPATH")]
+    pub profile: Vec<String>,
     /// Print calibration.json on stdout.
     #[arg(long)]
     pub json: bool,
@@ -76,6 +88,8 @@ impl CalibrateArgs {
             segment: self.segment,
             refuse_missing: self.refuse_missing,
             residuals: self.residuals.clone(),
+            prior: self.prior.clone(),
+            profile: self.profile.clone(),
         }
     }
 }
@@ -86,7 +100,14 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
     let m = args.source.load()?;
     let text = std::fs::read_to_string(&args.source.model)
         .map_err(|e| io_failure(format!("{}: {e}", args.source.model.display())))?;
-    let o = args.options();
+    let mut o = args.options();
+    if let Some(path) = &args.priors {
+        let text =
+            std::fs::read_to_string(path).map_err(|e| io_failure(format!("{}: {e}", path.display())))?;
+        let mut from_file = calibrate::prior::from_file(&text, &path.display().to_string())?;
+        from_file.append(&mut o.prior);
+        o.prior = from_file;
+    }
     let file = TraceFile::load(&args.trace, o.missing())
         .map_err(|e| io_failure(format!("{}: {e}", args.trace.display())))?
         .map_err(|e| invalid(e.to_string()))?;

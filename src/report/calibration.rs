@@ -32,6 +32,59 @@ pub struct FittedParameter {
     pub ci95_independent_high: Option<f64>,
     /// Largest change of a fitted temperature per unit of the coordinate, K.
     pub influence_k: f64,
+    /// The prior on this parameter and its influence (null: none).
+    pub prior: Option<PriorInfluence>,
+}
+
+/// A prior and how much it moved and narrowed the result.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PriorInfluence {
+    /// `normal` or `lognormal`.
+    pub distribution: &'static str,
+    /// Mean (normal) or median (log-normal).
+    pub location: f64,
+    /// Standard deviation of p (normal) or ln p (log-normal).
+    pub width: f64,
+    /// The prior's standard deviation in the fitted coordinate at the fitted value.
+    pub prior_sd: f64,
+    /// Standard error from the data alone at the fitted value (null: the data do not fix it).
+    pub data_std_error: Option<f64>,
+    /// Posterior standard error (the parameter's `std_error`).
+    pub posterior_std_error: Option<f64>,
+    /// Posterior over prior standard deviation: near 1 the data add nothing, near 0 the prior
+    /// adds little.
+    pub width_ratio: Option<f64>,
+    /// The prior's share of the posterior precision, 1 − Var_post/Var_data (1 when the data
+    /// do not fix the parameter).
+    pub prior_share: Option<f64>,
+    /// The value the fit without priors gave (least squares).
+    pub without_prior: f64,
+}
+
+/// One point of a profile likelihood.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ProfilePoint {
+    /// The parameter's value, held.
+    pub value: f64,
+    /// D = S(value) − S_min, the objective's rise with the other parameters refitted.
+    pub statistic: f64,
+}
+
+/// The profile likelihood of one parameter.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Profile {
+    /// Key path.
+    pub key_path: String,
+    /// D at the 95 % interval's ends, t(0.975, ν)².
+    pub threshold: f64,
+    /// The grid, ascending.
+    pub points: Vec<ProfilePoint>,
+    /// Lower end of the 95 % profile interval (null: not reached within the grid or the bounds).
+    pub ci95_low: Option<f64>,
+    /// Upper end.
+    pub ci95_high: Option<f64>,
+    /// Evaluations with sensitivities the profile took.
+    pub evaluations: usize,
 }
 
 /// Errors of one measured channel on a set of rows.
@@ -180,6 +233,8 @@ pub struct CalibrationSummary {
     pub channels: Vec<ChannelErrors>,
     /// The fit.
     pub fit: FitStats,
+    /// Profile likelihoods asked for (`--profile`).
+    pub profiles: Vec<Profile>,
     /// What the user should know: pairs the trace cannot tell apart, parameters without
     /// influence or at a bound, a fit that ran out of iterations.
     pub warnings: Vec<String>,
@@ -244,6 +299,22 @@ pub fn to_text(s: &CalibrationSummary) -> String {
             ci(p.ci95_low, p.ci95_high)
         ));
     }
+    for p in &s.parameters {
+        if let Some(q) = &p.prior {
+            let opt = |x: Option<f64>, f: &dyn Fn(f64) -> String| x.map_or("—".to_string(), f);
+            t.push_str(&format!(
+                "  prior {} {}({}, {}): posterior/prior width {}, prior's share of the precision {}, \
+                 without the prior {:.5}\n",
+                p.key_path,
+                q.distribution,
+                q.location,
+                q.width,
+                opt(q.width_ratio, &|v| format!("{v:.3}")),
+                opt(q.prior_share, &|v| format!("{:.1} %", 100.0 * v)),
+                q.without_prior
+            ));
+        }
+    }
     t.push_str(
         "channel          fitted rmse / max, K / in band   held-out rmse / max, K / in band   \
          φ     σ_a, K  acf lag 1, 2, 6\n",
@@ -285,6 +356,18 @@ pub fn to_text(s: &CalibrationSummary) -> String {
             d.status,
             along.join(", "),
             d.relative_eigenvalue
+        ));
+    }
+    for p in &s.profiles {
+        let end = |x: Option<f64>| x.map_or("beyond the grid".to_string(), |v| format!("{v:.5}"));
+        t.push_str(&format!(
+            "profile {}: 95 % interval [{}, {}] (D ≤ {:.3}; {} points, {} evaluations)\n",
+            p.key_path,
+            end(p.ci95_low),
+            end(p.ci95_high),
+            p.threshold,
+            p.points.len(),
+            p.evaluations
         ));
     }
     t
