@@ -68,6 +68,14 @@ pub struct CalibrateArgs {
     /// 95 % interval.
     #[arg(long, value_name = "KEYPATH")]
     pub profile: Vec<String>,
+    /// Compare the calibrated losses with the sourced figure for this kind of gearbox
+    /// (wind-turbine) and warn when outside.
+    #[arg(long, value_name = "KIND")]
+    pub gearbox_kind: Option<String>,
+    /// A rated point at which the calibrated losses and efficiency are reported: RPM:NM (input
+    /// speed and torque).
+    #[arg(long, value_name = "RPM:NM", allow_hyphen_values = true)]
+    pub rated: Option<String>,
     /// Print calibration.json on stdout.
     #[arg(long)]
     pub json: bool,
@@ -90,6 +98,8 @@ impl CalibrateArgs {
             residuals: self.residuals.clone(),
             prior: self.prior.clone(),
             profile: self.profile.clone(),
+            gearbox_kind: self.gearbox_kind.clone(),
+            rated: self.rated.clone(),
         }
     }
 }

@@ -61,6 +61,55 @@ pub struct PriorInfluence {
     pub without_prior: f64,
 }
 
+/// The calibrated model's losses at one operating point (or the mean of several).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LossAt {
+    /// Input speed, rpm.
+    pub input_speed_rpm: f64,
+    /// Input torque, N·m (negative: power flows from the output to the input).
+    pub input_torque_nm: f64,
+    /// Power through the gearbox |T·ω| at the input, W.
+    pub power_w: f64,
+    /// Oil temperature the losses are evaluated at (the simulated oil), °C.
+    pub oil_temp_c: f64,
+    /// Loss per source, W.
+    pub loss_by_source_w: Vec<(String, f64)>,
+    /// Total loss, W.
+    pub loss_total_w: f64,
+    /// |P|/(|P| + loss).
+    pub efficiency: Option<f64>,
+}
+
+/// A sourced loss figure for the kind of gearbox, and where the calibrated model lies.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Reference {
+    /// Gearbox kind (`--gearbox-kind`).
+    pub kind: &'static str,
+    /// What the source states.
+    pub statement: &'static str,
+    /// The source.
+    pub source: &'static str,
+    /// Loss share bounds the warning uses.
+    pub loss_share_bounds: (f64, f64),
+    /// The calibrated model's loss share (at the rated point when given, else the highest-power rows).
+    pub loss_share: f64,
+    /// Within the bounds.
+    pub inside: bool,
+}
+
+/// Losses and efficiency of the calibrated model where they matter.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Plausibility {
+    /// Rows averaged (the highest-power 1 % of the trace).
+    pub rows: usize,
+    /// Mean over the trace's highest-power rows at their simulated oil temperatures.
+    pub highest_power: LossAt,
+    /// At the rated point given (`--rated`), at the highest-power rows' mean oil temperature.
+    pub rated: Option<LossAt>,
+    /// The sourced figure for the gearbox kind (`--gearbox-kind`).
+    pub reference: Option<Reference>,
+}
+
 /// One point of a profile likelihood.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ProfilePoint {
@@ -235,6 +284,8 @@ pub struct CalibrationSummary {
     pub fit: FitStats,
     /// Profile likelihoods asked for (`--profile`).
     pub profiles: Vec<Profile>,
+    /// Losses and efficiency of the calibrated model (null: a vehicle trace or the oil not measured).
+    pub plausibility: Option<Plausibility>,
     /// What the user should know: pairs the trace cannot tell apart, parameters without
     /// influence or at a bound, a fit that ran out of iterations.
     pub warnings: Vec<String>,
@@ -357,6 +408,42 @@ pub fn to_text(s: &CalibrationSummary) -> String {
             along.join(", "),
             d.relative_eigenvalue
         ));
+    }
+    if let Some(p) = &s.plausibility {
+        let line = |what: &str, x: &LossAt| {
+            let by: Vec<String> = x
+                .loss_by_source_w
+                .iter()
+                .map(|(k, v)| format!("{k} {:.1}", v / 1e3))
+                .collect();
+            format!(
+                "{what}: {:.0} kW at {:.0} rpm, {:.0} N m, oil {:.1} °C: loss {:.1} kW ({}), efficiency {}\n",
+                x.power_w / 1e3,
+                x.input_speed_rpm,
+                x.input_torque_nm,
+                x.oil_temp_c,
+                x.loss_total_w / 1e3,
+                by.join(", "),
+                x.efficiency.map_or("—".into(), |e| format!("{e:.4}"))
+            )
+        };
+        t.push_str(&line(
+            &format!("highest-power rows ({})", p.rows),
+            &p.highest_power,
+        ));
+        if let Some(r) = &p.rated {
+            t.push_str(&line("rated point", r));
+        }
+        if let Some(r) = &p.reference {
+            t.push_str(&format!(
+                "  {} gearbox: {} ({}); the model: {:.2} % ({})\n",
+                r.kind,
+                r.statement,
+                r.source,
+                100.0 * r.loss_share,
+                if r.inside { "within" } else { "OUTSIDE" }
+            ));
+        }
     }
     for p in &s.profiles {
         let end = |x: Option<f64>| x.map_or("beyond the grid".to_string(), |v| format!("{v:.5}"));

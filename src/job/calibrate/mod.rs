@@ -16,6 +16,7 @@ pub mod checks;
 pub mod lm;
 pub mod model_file;
 pub mod params;
+pub mod plausibility;
 pub mod prior;
 pub mod problem;
 pub mod profile;
@@ -103,6 +104,11 @@ pub struct CalibrateOptions {
     pub prior: Vec<String>,
     /// Parameters (fitted key paths) whose profile likelihood is computed.
     pub profile: Vec<String>,
+    /// Kind of gearbox whose sourced loss figure the calibrated losses are compared with
+    /// (`wind-turbine`).
+    pub gearbox_kind: Option<String>,
+    /// Rated point `RPM:NM` (input speed and torque) at which the calibrated losses are reported.
+    pub rated: Option<String>,
 }
 
 impl CalibrateOptions {
@@ -132,6 +138,8 @@ impl Default for CalibrateOptions {
             residuals: "ar1".into(),
             prior: Vec::new(),
             profile: Vec::new(),
+            gearbox_kind: None,
+            rated: None,
         }
     }
 }
@@ -196,6 +204,12 @@ impl CalibrateOptions {
             .iter()
             .map(|h| window(h))
             .collect::<Result<Vec<_>, _>>()?;
+        if let Some(k) = &self.gearbox_kind {
+            plausibility::check_kind(k)?;
+        }
+        if let Some(r) = &self.rated {
+            plausibility::rated_point(r)?;
+        }
         let priors = self
             .prior
             .iter()
@@ -811,6 +825,15 @@ fn assemble(
         vec![a; pr.channels.len()]
     });
     let band = bands::half_widths(&sim, &lin.covariance, &noise, t);
+    let rated = o.rated.as_deref().map(plausibility::rated_point).transpose()?;
+    let plausibility = plausibility::assess(
+        pr,
+        &res.theta,
+        &sim.temps_c,
+        o.gearbox_kind.as_deref(),
+        rated,
+        &mut warnings,
+    )?;
     let objective = profile::Objective {
         p,
         noise: &noise,
@@ -863,6 +886,7 @@ fn assemble(
             wall_time_s: clock.elapsed().as_secs_f64(),
         },
         profiles,
+        plausibility,
         warnings,
     };
     check_finite(&summary)?;
@@ -933,6 +957,25 @@ fn check_finite(s: &CalibrationSummary) -> Result<(), JobError> {
             }
         }
     }
+    if let Some(p) = &s.plausibility {
+        let mut xs = vec![&p.highest_power];
+        xs.extend(p.rated.as_ref());
+        for x in xs {
+            let vals = [
+                x.power_w,
+                x.loss_total_w,
+                x.oil_temp_c,
+                x.efficiency.unwrap_or(0.0),
+            ];
+            if vals
+                .iter()
+                .chain(x.loss_by_source_w.iter().map(|(_, v)| v))
+                .any(|v| !v.is_finite())
+            {
+                return Err(bad("the losses of the plausibility check"));
+            }
+        }
+    }
     for p in &s.profiles {
         let ends = [p.ci95_low, p.ci95_high];
         if ends.iter().flatten().any(|v| !v.is_finite())
@@ -982,6 +1025,12 @@ impl super::command::ToArgs for CalibrateOptions {
         }
         for p in &self.profile {
             a.extend(["--profile".to_string(), p.clone()]);
+        }
+        if let Some(k) = &self.gearbox_kind {
+            a.extend(["--gearbox-kind".to_string(), k.clone()]);
+        }
+        if let Some(r) = &self.rated {
+            a.extend(["--rated".to_string(), r.clone()]);
         }
         a
     }
