@@ -221,3 +221,54 @@ fn bad_priors_are_refused_by_the_command() {
         assert!(!out.exists(), "{extra:?}: output written");
     }
 }
+
+/// A prediction (no fit, every row held out) takes its band from a previous calibration: the
+/// half-width is at least t·σ of the residual process it carries, and the fraction inside is
+/// reported; a run that fits, or a calibration without the trace's channel, is refused.
+#[test]
+fn a_prediction_takes_its_band_from_a_calibration() {
+    let cal = fit(&[H, M], &[], &[]);
+    let json = serde_json::to_string(&cal.summary).unwrap();
+    let model = Model::from_text(&cal.calibrated_model, Path::new("calibrated.toml"), &[]).unwrap();
+    let t = Trace::parse(&measured(), "other.csv").unwrap();
+    let predict = CalibrateOptions {
+        holdout: vec!["0:1e9".into()],
+        residuals: "independent".into(),
+        ..CalibrateOptions::default()
+    };
+    let mut p = calibrate::prepare(&model, &cal.calibrated_model, &t, &predict).unwrap();
+    p.band_from(&json, "cal.json").unwrap();
+    let r = calibrate::fit(&model, &p, &predict).unwrap();
+    let sd = cal.summary.channels[0].noise.marginal_sd_k;
+    let inside = r.summary.channels[0]
+        .holdout
+        .unwrap()
+        .inside_band95
+        .expect("a band");
+    assert!(inside > 0.8, "{inside}");
+    for line in r.fit_csv.lines().skip(1) {
+        let band: f64 = line.split(',').nth(5).unwrap().parse().unwrap();
+        assert!(band >= cal.summary.fit.t975 * sd * (1.0 - 1e-9), "{band} vs {sd}");
+    }
+    // Without --band-from the prediction has no band.
+    let p = calibrate::prepare(&model, &cal.calibrated_model, &t, &predict).unwrap();
+    let r = calibrate::fit(&model, &p, &predict).unwrap();
+    assert!(r.summary.channels[0].holdout.unwrap().inside_band95.is_none());
+    // Refused: a run that fits; a calibration that lacks the housing channel.
+    let fits = CalibrateOptions {
+        fit: vec![H.into()],
+        ..CalibrateOptions::default()
+    };
+    let mut p = calibrate::prepare(&model, &cal.calibrated_model, &t, &fits).unwrap();
+    let e = p.band_from(&json, "cal.json").unwrap_err();
+    assert!(e.exit_code() == 1 && e.to_string().contains("band_from"), "{e}");
+    let mut v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    v["channels"].as_array_mut().unwrap().pop();
+    let mut p = calibrate::prepare(&model, &cal.calibrated_model, &t, &predict).unwrap();
+    let e = p.band_from(&v.to_string(), "cal.json").unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("cal.json: channels: no channel for node housing"),
+        "{e}"
+    );
+}

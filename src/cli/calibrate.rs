@@ -76,6 +76,10 @@ pub struct CalibrateArgs {
     /// speed and torque).
     #[arg(long, value_name = "RPM:NM", allow_hyphen_values = true)]
     pub rated: Option<String>,
+    /// For a prediction (no --fit, every row held out): the 95 % band from a previous
+    /// calibration's calibration.json (its covariance and residual process).
+    #[arg(long, value_name = "calibration.json")]
+    pub band_from: Option<PathBuf>,
     /// Print calibration.json on stdout.
     #[arg(long)]
     pub json: bool,
@@ -122,7 +126,12 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
         .map_err(|e| io_failure(format!("{}: {e}", args.trace.display())))?
         .map_err(|e| invalid(e.to_string()))?;
     let trace = file.select(o.segment).map_err(|e| invalid(e.to_string()))?;
-    let prepared = calibrate::prepare(&m, &text, trace, &o)?;
+    let mut prepared = calibrate::prepare(&m, &text, trace, &o)?;
+    if let Some(path) = &args.band_from {
+        let json =
+            std::fs::read_to_string(path).map_err(|e| io_failure(format!("{}: {e}", path.display())))?;
+        prepared.band_from(&json, &path.display().to_string())?;
+    }
     let dir = args
         .out
         .clone()

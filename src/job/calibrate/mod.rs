@@ -24,6 +24,7 @@ pub mod residuals;
 pub mod stats;
 pub mod trace;
 pub mod trace_file;
+pub mod transfer;
 
 use std::time::Instant;
 
@@ -292,6 +293,29 @@ pub struct Prepared<'a> {
     pub priors: prior::Priors,
     /// Index of each parameter whose profile is computed.
     pub profile: Vec<usize>,
+    /// A previous calibration whose uncertainty gives the band where this run fits no row.
+    pub band_source: Option<transfer::BandSource<'a>>,
+}
+
+impl<'a> Prepared<'a> {
+    /// Take the prediction band from a previous calibration (`calibration.json` text, `file`
+    /// naming it) for a run that fits no row: invalid input when this run fits parameters or rows.
+    pub fn band_from(&mut self, json: &str, file: &str) -> Result<(), JobError> {
+        if !self.problem.params.is_empty() || self.held.iter().any(|h| !h) {
+            return Err(JobError::option(
+                "band_from",
+                file,
+                "a run that fits nothing (no --fit, every row held out)",
+                format!(
+                    "band_from (--band-from) = {file}: only for a prediction (no --fit, --holdout over the whole \
+                     trace); this run fits its own band"
+                ),
+            ));
+        }
+        let doc = self.problem.document().clone();
+        self.band_source = Some(transfer::band_source(&self.problem, &doc, json, file)?);
+        Ok(())
+    }
 }
 
 /// Check the options and map the trace onto the model: every invalid input fails here.
@@ -349,6 +373,7 @@ pub fn prepare<'a>(
         held,
         priors,
         profile,
+        band_source: None,
     })
 }
 
@@ -716,6 +741,7 @@ fn channel_errors(
     f: &Fitted,
     temps_c: &[Vec<f64>],
     band: &[Vec<f64>],
+    band_known: bool,
     noise: &[residuals::Ar1],
 ) -> Vec<ChannelErrors> {
     let pr = &p.problem;
@@ -727,9 +753,9 @@ fn channel_errors(
             let rows = |held: bool| (0..p.held.len()).filter(move |&r| p.held[r] == held);
             let res =
                 |held: bool| -> Vec<f64> { rows(held).map(|r| temps_c[r][c] - ch.values_c[r]).collect() };
-            let known = !f.layout.stretch.is_empty();
-            let half =
-                |held: bool| -> Option<Vec<f64>> { known.then(|| rows(held).map(|r| band[r][c]).collect()) };
+            let half = |held: bool| -> Option<Vec<f64>> {
+                band_known.then(|| rows(held).map(|r| band[r][c]).collect())
+            };
             let fitted = res(false);
             let acf = [1, 2, 6].map(|lag| f.layout.autocorrelation(&fitted, lag));
             ChannelErrors {
@@ -824,7 +850,16 @@ fn assemble(
         };
         vec![a; pr.channels.len()]
     });
-    let band = bands::half_widths(&sim, &lin.covariance, &noise, t);
+    let (band, band_known) = match &p.band_source {
+        Some(b) => {
+            let s = b.problem.simulate(&b.problem.start(), true)?;
+            (bands::half_widths(&s, &b.covariance, &b.noise, b.t975), true)
+        }
+        None => (
+            bands::half_widths(&sim, &lin.covariance, &noise, t),
+            !f.layout.stretch.is_empty(),
+        ),
+    };
     let rated = o.rated.as_deref().map(plausibility::rated_point).transpose()?;
     let plausibility = plausibility::assess(
         pr,
@@ -845,7 +880,8 @@ fn assemble(
         .iter()
         .map(|&k| profile::profile(&objective, k, &res.theta, lin.std_err[k], lin.dof, &f.free))
         .collect::<Result<Vec<_>, _>>()?;
-    let channels = channel_errors(p, f, &sim.temps_c, &band, &noise);
+    let noise = p.band_source.as_ref().map_or(noise, |b| b.noise.clone());
+    let channels = channel_errors(p, f, &sim.temps_c, &band, band_known, &noise);
     let nodes: Vec<String> = pr.trace.measured.iter().map(|c| c.name.clone()).collect();
     let measured: Vec<Vec<f64>> = pr.trace.measured.iter().map(|c| c.values_c.clone()).collect();
     let csv = fit_csv(&pr.trace.times, &p.held, &nodes, &measured, &sim.temps_c, &band);
