@@ -134,6 +134,9 @@ pub struct Profile {
     pub ci95_high: Option<f64>,
     /// Evaluations with sensitivities the profile took.
     pub evaluations: usize,
+    /// The objective's drop below the fit's (refitted) optimum at the profile's least point, when
+    /// that point is not the fitted value: the fit stopped short along a flat valley.
+    pub below_fit: Option<f64>,
 }
 
 /// Errors of one measured channel on a set of rows.

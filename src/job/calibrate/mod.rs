@@ -880,6 +880,15 @@ fn assemble(
         .iter()
         .map(|&k| profile::profile(&objective, k, &res.theta, lin.std_err[k], lin.dof, &f.free))
         .collect::<Result<Vec<_>, _>>()?;
+    for q in profiles.iter().filter(|q| q.below_fit.is_some()) {
+        warnings.push(format!(
+            "profile of {}: the objective is lower by {:.3} at {} than at the fitted value: the fit stopped short \
+             along a flat valley (the least point of profile.csv is the better one)",
+            q.key_path,
+            q.below_fit.unwrap_or(0.0),
+            q.points.iter().find(|x| x.statistic == 0.0).map_or(f64::NAN, |x| x.value)
+        ));
+    }
     let noise = p.band_source.as_ref().map_or(noise, |b| b.noise.clone());
     let channels = channel_errors(p, f, &sim.temps_c, &band, band_known, &noise);
     let nodes: Vec<String> = pr.trace.measured.iter().map(|c| c.name.clone()).collect();
@@ -1013,7 +1022,7 @@ fn check_finite(s: &CalibrationSummary) -> Result<(), JobError> {
         }
     }
     for p in &s.profiles {
-        let ends = [p.ci95_low, p.ci95_high];
+        let ends = [p.ci95_low, p.ci95_high, p.below_fit];
         if ends.iter().flatten().any(|v| !v.is_finite())
             || p.points
                 .iter()

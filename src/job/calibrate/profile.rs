@@ -187,6 +187,8 @@ pub fn profile(
         x.1 -= s_min;
     }
     let at = pts.iter().position(|x| x.1 == 0.0).unwrap_or(0);
+    let below = s0 - s_min;
+    let below_fit = (pts[at].0 != best[k] && below > 1e-6 * s0.max(1e-300)).then_some(below);
     let low = first_crossing(&pts, at, (0..at).rev(), q);
     let high = first_crossing(&pts, at, at + 1..pts.len(), q);
     Ok(Profile {
@@ -202,5 +204,6 @@ pub fn profile(
         ci95_low: low.map(|t| par.value(t)),
         ci95_high: high.map(|t| par.value(t)),
         evaluations,
+        below_fit,
     })
 }
