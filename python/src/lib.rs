@@ -4,6 +4,8 @@
 //! as JSON or CSV text that the Python package (`pysrc/geartherm/`) turns into dicts and pandas
 //! DataFrames. Every solve runs with the GIL released.
 
+mod calibrate;
+
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
@@ -757,5 +759,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(render_calibration, m)?)?;
     m.add_function(wrap_pyfunction!(study_case, m)?)?;
     m.add_function(wrap_pyfunction!(sources, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate::priors_from_file, m)?)?;
     Ok(())
 }

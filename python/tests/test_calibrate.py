@@ -57,3 +57,41 @@ def test_bad_traces_are_refused_like_the_cli():
     assert e.value.line == 5 and e.value.path == "node:oil"
     with pytest.raises(geartherm.GearthermError, match="max_iterations"):
         base.calibrate(rig(), fit=[H], max_iterations=0)
+
+
+def test_priors_profiles_bands_and_losses_as_dataframes(tmp_path):
+    base = geartherm.Model.load(MODEL)
+    truth = base.override({H: 400.0, M: 11.0})
+    sim = truth.calibrate(rig(), holdout=[(0.0, 1e9)]).fit
+    values = [(a + 0.05 * math.sin(k), b - 0.05 * math.cos(k))
+              for k, (a, b) in enumerate(zip(sim["oil_simulated_c"], sim["housing_simulated_c"]))]
+    kw = dict(fit=[H, M], holdout=[(2400.0, 3600.0)], residuals="independent")
+    free = base.calibrate(rig(values), **kw)
+    r = base.calibrate(rig(values), prior={M: ("normal", 11.0, 100.0)}, profile=[M],
+                       gearbox_kind="wind-turbine", rated=(3000.0, 200.0), **kw)
+    # A wide prior: the fit is the one without it; its influence is reported.
+    v0 = free.parameters.set_index("key_path").loc[M, "value"]
+    assert math.isclose(r.parameters.set_index("key_path").loc[M, "value"], v0, rel_tol=1e-3)
+    pr = r.priors.set_index("key_path").loc[M]
+    assert pr["distribution"] == "normal" and pr["prior_share"] < 0.01
+    # The profile: a grid around the fitted value, its least point at 0.
+    assert set(r.profiles["key_path"]) == {M} and len(r.profiles) >= 9
+    assert r.profiles["statistic"].min() == 0.0
+    assert r.summary["profiles"][0]["ci95_low"] < v0 < r.summary["profiles"][0]["ci95_high"]
+    # Bands as columns: the simulated value ± the half-width.
+    f = r.fit
+    assert ((f["oil_band95_low_c"] < f["oil_simulated_c"]) & (f["oil_simulated_c"] < f["oil_band95_high_c"])).all()
+    # Losses per source at the highest-power rows and the rated point.
+    assert set(r.plausibility["at"]) == {"highest_power", "rated"}
+    assert (r.plausibility["loss_w"] >= 0).all()
+    # A priors file as the CLI reads it; a negative width is an InputError naming the key path.
+    good = tmp_path / "priors.toml"
+    good.write_text(f"[[prior]]\nkey = '{M}'\ndistribution = 'normal'\nmean = 11\nsd = 100\n")
+    g = base.calibrate(rig(values), priors_file=good, **kw)
+    assert len(g.priors) == 1
+    bad = tmp_path / "bad.toml"
+    bad.write_text(f"[[prior]]\nkey = '{M}'\ndistribution = 'normal'\nmean = 11\nsd = -1\n")
+    with pytest.raises(geartherm.GearthermError, match=r"bad.toml: prior\[0\].sd = -1"):
+        base.calibrate(rig(values), priors_file=bad, **kw)
+    with pytest.raises(geartherm.GearthermError, match="sd"):
+        base.calibrate(rig(values), prior={M: ("normal", 11.0, -1.0)}, **kw)

@@ -56,6 +56,30 @@ pub struct CalibrateArgs {
     /// AR(1) errors) or independent.
     #[arg(long, default_value = "ar1", value_name = "ar1|ar1-gls|independent")]
     pub residuals: String,
+    /// A prior on a fitted parameter (a MAP fit): KEYPATH=normal:MEAN:SD or
+    /// KEYPATH=lognormal:MEDIAN:SD_LN (SD_LN the standard deviation of ln p; repeatable).
+    #[arg(long, value_name = "KEYPATH=DIST:LOC:WIDTH")]
+    pub prior: Vec<String>,
+    /// A TOML file of priors: [[prior]] tables with key, distribution ("normal": mean, sd;
+    /// "lognormal": median, sd_ln).
+    #[arg(long, value_name = "FILE")]
+    pub priors: Option<PathBuf>,
+    /// Compute the profile likelihood of a fitted parameter (repeatable): profile.csv and its
+    /// 95 % interval.
+    #[arg(long, value_name = "KEYPATH")]
+    pub profile: Vec<String>,
+    /// Compare the calibrated losses with the sourced figure for this kind of gearbox
+    /// (wind-turbine) and warn when outside.
+    #[arg(long, value_name = "KIND")]
+    pub gearbox_kind: Option<String>,
+    /// A rated point at which the calibrated losses and efficiency are reported: RPM:NM (input
+    /// speed and torque).
+    #[arg(long, value_name = "RPM:NM", allow_hyphen_values = true)]
+    pub rated: Option<String>,
+    /// For a prediction (no --fit, every row held out): the 95 % band from a previous
+    /// calibration's calibration.json (its covariance and residual process).
+    #[arg(long, value_name = "calibration.json")]
+    pub band_from: Option<PathBuf>,
     /// Print calibration.json on stdout.
     #[arg(long)]
     pub json: bool,
@@ -76,6 +100,10 @@ impl CalibrateArgs {
             segment: self.segment,
             refuse_missing: self.refuse_missing,
             residuals: self.residuals.clone(),
+            prior: self.prior.clone(),
+            profile: self.profile.clone(),
+            gearbox_kind: self.gearbox_kind.clone(),
+            rated: self.rated.clone(),
         }
     }
 }
@@ -86,12 +114,24 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
     let m = args.source.load()?;
     let text = std::fs::read_to_string(&args.source.model)
         .map_err(|e| io_failure(format!("{}: {e}", args.source.model.display())))?;
-    let o = args.options();
+    let mut o = args.options();
+    if let Some(path) = &args.priors {
+        let text =
+            std::fs::read_to_string(path).map_err(|e| io_failure(format!("{}: {e}", path.display())))?;
+        let mut from_file = calibrate::prior::from_file(&text, &path.display().to_string())?;
+        from_file.append(&mut o.prior);
+        o.prior = from_file;
+    }
     let file = TraceFile::load(&args.trace, o.missing())
         .map_err(|e| io_failure(format!("{}: {e}", args.trace.display())))?
         .map_err(|e| invalid(e.to_string()))?;
     let trace = file.select(o.segment).map_err(|e| invalid(e.to_string()))?;
-    let prepared = calibrate::prepare(&m, &text, trace, &o)?;
+    let mut prepared = calibrate::prepare(&m, &text, trace, &o)?;
+    if let Some(path) = &args.band_from {
+        let json =
+            std::fs::read_to_string(path).map_err(|e| io_failure(format!("{}: {e}", path.display())))?;
+        prepared.band_from(&json, &path.display().to_string())?;
+    }
     let dir = args
         .out
         .clone()

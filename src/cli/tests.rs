@@ -191,6 +191,10 @@ fn calibrate_options_round_trip() {
             segment: Some(2),
             refuse_missing: true,
             residuals: "independent".into(),
+            prior: vec!["thermal.nodes[\"oil\"].mass_kg=lognormal:2:0.5".into()],
+            profile: vec!["thermal.nodes[\"oil\"].mass_kg".into()],
+            gearbox_kind: Some("wind-turbine".into()),
+            rated: Some("1680:-11600".into()),
         },
     ];
     for o in all {

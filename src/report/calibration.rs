@@ -32,6 +32,111 @@ pub struct FittedParameter {
     pub ci95_independent_high: Option<f64>,
     /// Largest change of a fitted temperature per unit of the coordinate, K.
     pub influence_k: f64,
+    /// The prior on this parameter and its influence (null: none).
+    pub prior: Option<PriorInfluence>,
+}
+
+/// A prior and how much it moved and narrowed the result.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PriorInfluence {
+    /// `normal` or `lognormal`.
+    pub distribution: &'static str,
+    /// Mean (normal) or median (log-normal).
+    pub location: f64,
+    /// Standard deviation of p (normal) or ln p (log-normal).
+    pub width: f64,
+    /// The prior's standard deviation in the fitted coordinate at the fitted value.
+    pub prior_sd: f64,
+    /// Standard error from the data alone at the fitted value (null: the data do not fix it).
+    pub data_std_error: Option<f64>,
+    /// Posterior standard error (the parameter's `std_error`).
+    pub posterior_std_error: Option<f64>,
+    /// Posterior over prior standard deviation: near 1 the data add nothing, near 0 the prior
+    /// adds little.
+    pub width_ratio: Option<f64>,
+    /// The prior's share of the posterior precision, 1 − Var_post/Var_data (1 when the data
+    /// do not fix the parameter).
+    pub prior_share: Option<f64>,
+    /// The value the fit without priors gave (least squares).
+    pub without_prior: f64,
+}
+
+/// The calibrated model's losses at one operating point (or the mean of several).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LossAt {
+    /// Input speed, rpm.
+    pub input_speed_rpm: f64,
+    /// Input torque, N·m (negative: power flows from the output to the input).
+    pub input_torque_nm: f64,
+    /// Power through the gearbox |T·ω| at the input, W.
+    pub power_w: f64,
+    /// Oil temperature the losses are evaluated at (the simulated oil), °C.
+    pub oil_temp_c: f64,
+    /// Loss per source, W.
+    pub loss_by_source_w: Vec<(String, f64)>,
+    /// Total loss, W.
+    pub loss_total_w: f64,
+    /// |P|/(|P| + loss).
+    pub efficiency: Option<f64>,
+}
+
+/// A sourced loss figure for the kind of gearbox, and where the calibrated model lies.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Reference {
+    /// Gearbox kind (`--gearbox-kind`).
+    pub kind: &'static str,
+    /// What the source states.
+    pub statement: &'static str,
+    /// The source.
+    pub source: &'static str,
+    /// Loss share bounds the warning uses.
+    pub loss_share_bounds: (f64, f64),
+    /// The calibrated model's loss share (at the rated point when given, else the highest-power rows).
+    pub loss_share: f64,
+    /// Within the bounds.
+    pub inside: bool,
+}
+
+/// Losses and efficiency of the calibrated model where they matter.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Plausibility {
+    /// Rows averaged (the highest-power 1 % of the trace).
+    pub rows: usize,
+    /// Mean over the trace's highest-power rows at their simulated oil temperatures.
+    pub highest_power: LossAt,
+    /// At the rated point given (`--rated`), at the highest-power rows' mean oil temperature.
+    pub rated: Option<LossAt>,
+    /// The sourced figure for the gearbox kind (`--gearbox-kind`).
+    pub reference: Option<Reference>,
+}
+
+/// One point of a profile likelihood.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ProfilePoint {
+    /// The parameter's value, held.
+    pub value: f64,
+    /// D = S(value) − S_min, the objective's rise with the other parameters refitted.
+    pub statistic: f64,
+}
+
+/// The profile likelihood of one parameter.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Profile {
+    /// Key path.
+    pub key_path: String,
+    /// D at the 95 % interval's ends, t(0.975, ν)².
+    pub threshold: f64,
+    /// The grid, ascending.
+    pub points: Vec<ProfilePoint>,
+    /// Lower end of the 95 % profile interval (null: not reached within the grid or the bounds).
+    pub ci95_low: Option<f64>,
+    /// Upper end.
+    pub ci95_high: Option<f64>,
+    /// Evaluations with sensitivities the profile took.
+    pub evaluations: usize,
+    /// The objective's drop below the fit's (refitted) optimum at the profile's least point, when
+    /// that point is not the fitted value: the fit stopped short along a flat valley.
+    pub below_fit: Option<f64>,
 }
 
 /// Errors of one measured channel on a set of rows.
@@ -180,6 +285,10 @@ pub struct CalibrationSummary {
     pub channels: Vec<ChannelErrors>,
     /// The fit.
     pub fit: FitStats,
+    /// Profile likelihoods asked for (`--profile`).
+    pub profiles: Vec<Profile>,
+    /// Losses and efficiency of the calibrated model (null: a vehicle trace or the oil not measured).
+    pub plausibility: Option<Plausibility>,
     /// What the user should know: pairs the trace cannot tell apart, parameters without
     /// influence or at a bound, a fit that ran out of iterations.
     pub warnings: Vec<String>,
@@ -244,6 +353,22 @@ pub fn to_text(s: &CalibrationSummary) -> String {
             ci(p.ci95_low, p.ci95_high)
         ));
     }
+    for p in &s.parameters {
+        if let Some(q) = &p.prior {
+            let opt = |x: Option<f64>, f: &dyn Fn(f64) -> String| x.map_or("—".to_string(), f);
+            t.push_str(&format!(
+                "  prior {} {}({}, {}): posterior/prior width {}, prior's share of the precision {}, \
+                 without the prior {:.5}\n",
+                p.key_path,
+                q.distribution,
+                q.location,
+                q.width,
+                opt(q.width_ratio, &|v| format!("{v:.3}")),
+                opt(q.prior_share, &|v| format!("{:.1} %", 100.0 * v)),
+                q.without_prior
+            ));
+        }
+    }
     t.push_str(
         "channel          fitted rmse / max, K / in band   held-out rmse / max, K / in band   \
          φ     σ_a, K  acf lag 1, 2, 6\n",
@@ -285,6 +410,54 @@ pub fn to_text(s: &CalibrationSummary) -> String {
             d.status,
             along.join(", "),
             d.relative_eigenvalue
+        ));
+    }
+    if let Some(p) = &s.plausibility {
+        let line = |what: &str, x: &LossAt| {
+            let by: Vec<String> = x
+                .loss_by_source_w
+                .iter()
+                .map(|(k, v)| format!("{k} {:.1}", v / 1e3))
+                .collect();
+            format!(
+                "{what}: {:.0} kW at {:.0} rpm, {:.0} N m, oil {:.1} °C: loss {:.1} kW ({}), efficiency {}\n",
+                x.power_w / 1e3,
+                x.input_speed_rpm,
+                x.input_torque_nm,
+                x.oil_temp_c,
+                x.loss_total_w / 1e3,
+                by.join(", "),
+                x.efficiency.map_or("—".into(), |e| format!("{e:.4}"))
+            )
+        };
+        t.push_str(&line(
+            &format!("highest-power rows ({})", p.rows),
+            &p.highest_power,
+        ));
+        if let Some(r) = &p.rated {
+            t.push_str(&line("rated point", r));
+        }
+        if let Some(r) = &p.reference {
+            t.push_str(&format!(
+                "  {} gearbox: {} ({}); the model: {:.2} % ({})\n",
+                r.kind,
+                r.statement,
+                r.source,
+                100.0 * r.loss_share,
+                if r.inside { "within" } else { "OUTSIDE" }
+            ));
+        }
+    }
+    for p in &s.profiles {
+        let end = |x: Option<f64>| x.map_or("beyond the grid".to_string(), |v| format!("{v:.5}"));
+        t.push_str(&format!(
+            "profile {}: 95 % interval [{}, {}] (D ≤ {:.3}; {} points, {} evaluations)\n",
+            p.key_path,
+            end(p.ci95_low),
+            end(p.ci95_high),
+            p.threshold,
+            p.points.len(),
+            p.evaluations
         ));
     }
     t

@@ -612,6 +612,12 @@ class Model:
         segment: Optional[int] = None,
         missing: Literal["drop", "refuse"] = "drop",
         name: Optional[str] = None,
+        residuals: Optional[Literal["ar1", "ar1-gls", "independent"]] = None,
+        prior: Union[Mapping[str, Tuple[str, float, float]], Sequence[str]] = (),
+        priors_file: Optional[PathLike] = None,
+        profile: Sequence[str] = (),
+        gearbox_kind: Optional[str] = None,
+        rated: Optional[Tuple[float, float]] = None,
     ) -> CalibrationResult:
         """Fit parameters (``fit``: key paths, ``"KEYPATH=LO:HI"`` with bounds) to a measured
         trace, as ``geartherm calibrate``.
@@ -636,6 +642,20 @@ class Model:
             As ``geartherm calibrate``'s options.
         name : str, optional
             The trace's name in messages (default: its path, or ``trace``).
+        residuals : {"ar1", "ar1-gls", "independent"}, optional
+            The residual model (``--residuals``; default ``ar1``).
+        prior : mapping or sequence of str
+            Priors (a MAP fit): ``{key_path: ("normal", mean, sd)}`` or
+            ``{key_path: ("lognormal", median, sd_ln)}``, or ``--prior`` strings
+            ``"KEYPATH=normal:MEAN:SD"``.
+        priors_file : path, optional
+            A TOML file of ``[[prior]]`` tables (``--priors FILE``).
+        profile : sequence of str
+            Fitted key paths whose profile likelihood is computed (:attr:`CalibrationResult.profiles`).
+        gearbox_kind : str, optional
+            ``"wind-turbine"``: compare the calibrated losses with the sourced figure.
+        rated : (rpm, N·m), optional
+            A rated point at which the calibrated losses are reported.
         """
         text, label = _trace_text(trace, name)
         windows = []
@@ -649,6 +669,24 @@ class Model:
         }
         if segment is not None:
             o["segment"] = segment
+        priors: List[str] = []
+        if priors_file is not None:
+            path = os.fspath(priors_file)
+            with open(path, encoding="utf-8") as fh:
+                priors.extend(_native.priors_from_file(fh.read(), path))
+        if isinstance(prior, Mapping):
+            for key, (dist, loc, width) in prior.items():
+                priors.append(f"{key}={dist}:{float(loc)!r}:{float(width)!r}")
+        else:
+            priors.extend(str(p) for p in prior)
+        o["prior"] = priors
+        o["profile"] = [str(k) for k in profile]
+        if residuals is not None:
+            o["residuals"] = residuals
+        if gearbox_kind is not None:
+            o["gearbox_kind"] = gearbox_kind
+        if rated is not None:
+            o["rated"] = f"{float(rated[0])!r}:{float(rated[1])!r}"
         for k, v in (("rtol", rtol), ("atol", atol), ("max_steps", max_steps), ("max_iterations", max_iterations)):
             if v is not None:
                 o[k] = v

@@ -40,7 +40,20 @@ class CalibrationResult:
         ``rmse_k``, ``max_abs_k``, ``bias_k``.
     fit : pandas.DataFrame
         ``fit.csv``: ``time_s``, ``held_out``, and per channel ``<node>_measured_c``,
-        ``<node>_simulated_c``, ``<node>_residual_k``.
+        ``<node>_simulated_c``, ``<node>_residual_k``, ``<node>_band95_k`` (the 95 % prediction
+        band's half-width) and the band itself, ``<node>_band95_low_c`` and
+        ``<node>_band95_high_c``.
+    priors : pandas.DataFrame
+        One row per prior: ``key_path``, ``distribution``, ``location``, ``width``,
+        ``prior_sd``, ``data_std_error``, ``posterior_std_error``, ``width_ratio``,
+        ``prior_share``, ``without_prior`` (empty without priors).
+    profiles : pandas.DataFrame
+        The profile likelihoods asked for: ``key_path``, ``value``, ``statistic``,
+        ``threshold``; :attr:`summary` ``["profiles"]`` has their intervals.
+    plausibility : pandas.DataFrame
+        The calibrated model's loss per source (``at``: ``highest_power`` or ``rated``;
+        ``source``, ``loss_w``, ``power_w``, ``efficiency``, ``oil_temp_c``); empty when not
+        evaluated.
     warnings : list of str
     calibrated_text : str
         The model text with the fitted values written in (``calibrated.toml``);
@@ -75,6 +88,38 @@ class CalibrationResult:
                     rows.append({"node": ch["node"], "rows_of": part, **e})
         self.errors: "pandas.DataFrame" = pd.DataFrame(rows)
         self.fit: "pandas.DataFrame" = frame(fit_csv)
+        for ch in s["channels"]:
+            n = ch["node"]
+            if f"{n}_band95_k" in self.fit.columns:
+                self.fit[f"{n}_band95_low_c"] = self.fit[f"{n}_simulated_c"] - self.fit[f"{n}_band95_k"]
+                self.fit[f"{n}_band95_high_c"] = self.fit[f"{n}_simulated_c"] + self.fit[f"{n}_band95_k"]
+        self.priors: "pandas.DataFrame" = pd.DataFrame(
+            [{"key_path": p["key_path"], **p["prior"]} for p in s["parameters"] if p.get("prior")]
+        )
+        self.profiles: "pandas.DataFrame" = pd.DataFrame(
+            [
+                {"key_path": p["key_path"], "threshold": p["threshold"], **x}
+                for p in s.get("profiles", [])
+                for x in p["points"]
+            ]
+        )
+        plaus = []
+        pl = s.get("plausibility") or {}
+        for at in ("highest_power", "rated"):
+            x = pl.get(at)
+            if x:
+                for src, w in x["loss_by_source_w"]:
+                    plaus.append(
+                        {
+                            "at": at,
+                            "source": src,
+                            "loss_w": w,
+                            "power_w": x["power_w"],
+                            "efficiency": x["efficiency"],
+                            "oil_temp_c": x["oil_temp_c"],
+                        }
+                    )
+        self.plausibility: "pandas.DataFrame" = pd.DataFrame(plaus)
         self.warnings: List[str] = list(s["warnings"])
         self.calibrated_text = calibrated_text
         self.cycle_csv = cycle_csv

@@ -16,11 +16,15 @@ pub mod checks;
 pub mod lm;
 pub mod model_file;
 pub mod params;
+pub mod plausibility;
+pub mod prior;
 pub mod problem;
+pub mod profile;
 pub mod residuals;
 pub mod stats;
 pub mod trace;
 pub mod trace_file;
+pub mod transfer;
 
 use std::time::Instant;
 
@@ -32,7 +36,7 @@ use crate::model::parse::parse_document;
 use crate::model::Problems;
 use crate::report::calibration::{
     fit_csv, CalibrationSummary, ChannelErrors, Component, Correlation, Direction, Errors, FitStats,
-    FittedParameter, Noise,
+    FittedParameter, Noise, PriorInfluence,
 };
 use crate::solve::sensitivity::SensitivityOptions;
 
@@ -97,6 +101,15 @@ pub struct CalibrateOptions {
     /// Residual model: `ar1` (least squares; intervals and bands from per channel AR(1)
     /// errors), `ar1-gls` (generalised least squares under those errors) or `independent`.
     pub residuals: String,
+    /// Priors: `KEYPATH=normal:MEAN:SD` or `KEYPATH=lognormal:MEDIAN:SD_LN` (a MAP fit).
+    pub prior: Vec<String>,
+    /// Parameters (fitted key paths) whose profile likelihood is computed.
+    pub profile: Vec<String>,
+    /// Kind of gearbox whose sourced loss figure the calibrated losses are compared with
+    /// (`wind-turbine`).
+    pub gearbox_kind: Option<String>,
+    /// Rated point `RPM:NM` (input speed and torque) at which the calibrated losses are reported.
+    pub rated: Option<String>,
 }
 
 impl CalibrateOptions {
@@ -124,6 +137,10 @@ impl Default for CalibrateOptions {
             segment: None,
             refuse_missing: false,
             residuals: "ar1".into(),
+            prior: Vec::new(),
+            profile: Vec::new(),
+            gearbox_kind: None,
+            rated: None,
         }
     }
 }
@@ -150,8 +167,8 @@ fn window(s: &str) -> Result<(f64, f64), JobError> {
     }
 }
 
-/// The parsed `--fit` specs and `--holdout` windows (s).
-pub type Checked = (Vec<FitSpec>, Vec<(f64, f64)>);
+/// The parsed `--fit` specs, `--holdout` windows (s) and `--prior` specs.
+pub type Checked = (Vec<FitSpec>, Vec<(f64, f64)>, Vec<prior::PriorSpec>);
 
 impl CalibrateOptions {
     /// Range checks; the parsed fit specs and holdout windows.
@@ -188,7 +205,18 @@ impl CalibrateOptions {
             .iter()
             .map(|h| window(h))
             .collect::<Result<Vec<_>, _>>()?;
-        Ok((specs, windows))
+        if let Some(k) = &self.gearbox_kind {
+            plausibility::check_kind(k)?;
+        }
+        if let Some(r) = &self.rated {
+            plausibility::rated_point(r)?;
+        }
+        let priors = self
+            .prior
+            .iter()
+            .map(|s| s.parse::<prior::PriorSpec>())
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok((specs, windows, priors))
     }
 }
 
@@ -212,13 +240,34 @@ impl CalibrateResult {
     pub fn files(&self) -> Result<Vec<(&'static str, Vec<u8>)>, JobError> {
         let json = serde_json::to_vec_pretty(&self.summary)
             .map_err(|e| JobError::numerical(format!("cannot serialise the calibration: {e}")))?;
-        Ok(vec![
+        let mut files = vec![
             ("calibration.json", json),
             ("fit.csv", self.fit_csv.clone().into_bytes()),
             ("calibrated.toml", self.calibrated_model.clone().into_bytes()),
             ("cycle.csv", self.cycle_csv.clone().into_bytes()),
-        ])
+        ];
+        if !self.summary.profiles.is_empty() {
+            files.push(("profile.csv", profile_csv(&self.summary.profiles).into_bytes()));
+        }
+        Ok(files)
     }
+}
+
+/// `profile.csv`: `key_path,value,statistic,threshold` for every profile point.
+fn profile_csv(profiles: &[crate::report::calibration::Profile]) -> String {
+    let mut s = String::from("key_path,value,statistic,threshold\n");
+    for p in profiles {
+        for x in &p.points {
+            s.push_str(&format!(
+                "\"{}\",{},{:.6},{:.6}\n",
+                p.key_path.replace('"', "\"\""),
+                x.value,
+                x.statistic,
+                p.threshold
+            ));
+        }
+    }
+    s
 }
 
 /// The model document with the base overrides applied (for the parameters' start values).
@@ -240,6 +289,33 @@ pub struct Prepared<'a> {
     pub windows: Vec<(f64, f64)>,
     /// Per trace row: held out.
     pub held: Vec<bool>,
+    /// The priors (a MAP fit when not empty).
+    pub priors: prior::Priors,
+    /// Index of each parameter whose profile is computed.
+    pub profile: Vec<usize>,
+    /// A previous calibration whose uncertainty gives the band where this run fits no row.
+    pub band_source: Option<transfer::BandSource<'a>>,
+}
+
+impl<'a> Prepared<'a> {
+    /// Take the prediction band from a previous calibration (`calibration.json` text, `file`
+    /// naming it) for a run that fits no row: invalid input when this run fits parameters or rows.
+    pub fn band_from(&mut self, json: &str, file: &str) -> Result<(), JobError> {
+        if !self.problem.params.is_empty() || self.held.iter().any(|h| !h) {
+            return Err(JobError::option(
+                "band_from",
+                file,
+                "a run that fits nothing (no --fit, every row held out)",
+                format!(
+                    "band_from (--band-from) = {file}: only for a prediction (no --fit, --holdout over the whole \
+                     trace); this run fits its own band"
+                ),
+            ));
+        }
+        let doc = self.problem.document().clone();
+        self.band_source = Some(transfer::band_source(&self.problem, &doc, json, file)?);
+        Ok(())
+    }
 }
 
 /// Check the options and map the trace onto the model: every invalid input fails here.
@@ -249,7 +325,7 @@ pub fn prepare<'a>(
     trace: &'a Trace,
     o: &CalibrateOptions,
 ) -> Result<Prepared<'a>, JobError> {
-    let (specs, windows) = o.check()?;
+    let (specs, windows, prior_specs) = o.check()?;
     problem::check_names(m, trace)?;
     let mut base = m.overrides.clone();
     if o.initial_from_trace {
@@ -264,6 +340,8 @@ pub fn prepare<'a>(
         })
         .collect::<Result<Vec<_>, _>>()?;
     checks::fitted_once(&specs, &doc)?;
+    let priors = prior::Priors::resolve(&prior_specs, &params, &doc)?;
+    let profile = profile::resolve(&o.profile, &params, &doc)?;
     let opts = SensitivityOptions {
         rtol: o.rtol,
         atol: o.atol,
@@ -293,6 +371,9 @@ pub fn prepare<'a>(
         problem,
         windows,
         held,
+        priors,
+        profile,
+        band_source: None,
     })
 }
 
@@ -374,25 +455,77 @@ pub fn fit(m: &Model, p: &Prepared<'_>, o: &CalibrateOptions) -> Result<Calibrat
     let known = !layout.stretch.is_empty();
     let (res, noise) = match o.residuals.as_str() {
         "ar1-gls" if known => {
-            let (res, models) = residuals::refit(|th| evaluate(p, th), ols, &layout, &bounds, &free, &lmo)?;
+            let (res, models) = residuals::refit(
+                |th| evaluate(p, th),
+                |e, th| p.priors.augment(e, &pr.params, th),
+                |e| p.priors.strip(e),
+                ols,
+                &layout,
+                &bounds,
+                &free,
+                &lmo,
+            )?;
             (res, Some(models))
         }
         "ar1" if known => {
             let models = layout.estimate(&ols.at.r);
-            (ols, Some(models))
+            let weights: Vec<f64> = models.iter().map(residuals::Ar1::long_run_sd).collect();
+            let res = map_fit(p, ols, &weights, &bounds, &free, &lmo)?;
+            let models = if p.priors.is_empty() {
+                models
+            } else {
+                layout.estimate(&res.at.r)
+            };
+            (res, Some(models))
         }
-        _ => (ols, None),
+        _ => {
+            let dof = ols.at.r.len().saturating_sub(pr.params.len()).max(1);
+            let sd = (ols.at.r.norm_squared() / dof as f64).sqrt().max(1e-12);
+            let weights = vec![sd; pr.channels.len()];
+            (map_fit(p, ols, &weights, &bounds, &free, &lmo)?, None)
+        }
     };
     let fitted = Fitted {
         res,
         noise,
-        whitened: o.residuals == "ar1-gls",
+        whitened: o.residuals == "ar1-gls" && known,
         layout,
         independent,
         influence,
         free,
     };
     assemble(m, p, o, &fitted, clock)
+}
+
+/// The MAP fit from the least-squares fit `ols`: the data rows divided by their channel's
+/// noise scale `weights`, the prior rows appended (docs/calibration.md, "Priors"). Without
+/// priors `ols` itself. The result's evaluation is the data's, unweighted; its evaluations
+/// count those of `ols`.
+fn map_fit(
+    p: &Prepared<'_>,
+    ols: lm::LmResult,
+    weights: &[f64],
+    bounds: &[(f64, f64)],
+    free: &[bool],
+    lmo: &LmOptions,
+) -> Result<lm::LmResult, JobError> {
+    if p.priors.is_empty() {
+        return Ok(ols);
+    }
+    let params = &p.problem.params;
+    let ev = |th: &[f64]| -> Result<Evaluation, JobError> {
+        let e = prior::weighted(evaluate(p, th)?, weights);
+        Ok(p.priors.augment(e, params, th))
+    };
+    let at0 = p
+        .priors
+        .augment(prior::weighted(ols.at, weights), params, &ols.theta);
+    let mut res = lm::minimise(ev, &ols.theta, at0, bounds, free, lmo)?;
+    let back: Vec<f64> = weights.iter().map(|w| 1.0 / w).collect();
+    res.at = prior::weighted(p.priors.strip(res.at), &back);
+    res.evaluations += ols.evaluations;
+    res.iterations += ols.iterations;
+    Ok(res)
 }
 
 /// The ordinary least-squares fit's statistics (the residual model `independent`), reported
@@ -415,6 +548,35 @@ struct Fitted {
     independent: Independent,
     influence: Vec<f64>,
     free: Vec<bool>,
+}
+
+/// Each prior's influence: its width against the posterior's and the data's.
+fn prior_influence(p: &Prepared<'_>, f: &Fitted, data_se: &[Option<f64>], out: &mut [FittedParameter]) {
+    let params = &p.problem.params;
+    for q in &p.priors.list {
+        let k = q.param;
+        let prior_sd = p.priors.sd_theta(q, params, &f.res.theta);
+        let post = out[k].std_error;
+        let share = match (post, data_se[k]) {
+            (Some(a), Some(d)) if d > 0.0 => Some(1.0 - (a / d).powi(2)),
+            (Some(_), None) => Some(1.0),
+            _ => None,
+        };
+        out[k].prior = Some(PriorInfluence {
+            distribution: match q.spec.kind {
+                prior::Kind::Normal => "normal",
+                prior::Kind::Lognormal => "lognormal",
+            },
+            location: q.spec.location,
+            width: q.spec.width,
+            prior_sd,
+            data_std_error: data_se[k],
+            posterior_std_error: post,
+            width_ratio: post.map(|a| a / prior_sd),
+            prior_share: share,
+            without_prior: params[k].written(f.independent.theta[k]),
+        });
+    }
 }
 
 /// Free and not at a bound.
@@ -474,6 +636,7 @@ fn parameters(
             ci95_independent_low: ise.map(|s| par.value(ith - t_ind * s)),
             ci95_independent_high: ise.map(|s| par.value(ith + t_ind * s)),
             influence_k: influence[k],
+            prior: None,
         });
     }
     out
@@ -578,6 +741,7 @@ fn channel_errors(
     f: &Fitted,
     temps_c: &[Vec<f64>],
     band: &[Vec<f64>],
+    band_known: bool,
     noise: &[residuals::Ar1],
 ) -> Vec<ChannelErrors> {
     let pr = &p.problem;
@@ -589,9 +753,9 @@ fn channel_errors(
             let rows = |held: bool| (0..p.held.len()).filter(move |&r| p.held[r] == held);
             let res =
                 |held: bool| -> Vec<f64> { rows(held).map(|r| temps_c[r][c] - ch.values_c[r]).collect() };
-            let known = !f.layout.stretch.is_empty();
-            let half =
-                |held: bool| -> Option<Vec<f64>> { known.then(|| rows(held).map(|r| band[r][c]).collect()) };
+            let half = |held: bool| -> Option<Vec<f64>> {
+                band_known.then(|| rows(held).map(|r| band[r][c]).collect())
+            };
             let fitted = res(false);
             let acf = [1, 2, 6].map(|lag| f.layout.autocorrelation(&fitted, lag));
             ChannelErrors {
@@ -659,9 +823,14 @@ fn assemble(
         let eff = residuals::effective_rows(&f.layout, models) - used;
         lin.dof = lin.dof.min(eff.floor().max(1.0) as usize);
     }
+    let data_se = lin.std_err.clone();
+    if !p.priors.is_empty() {
+        stats::posterior(&mut lin, &p.priors.information(&pr.params, &res.theta));
+    }
     let t = stats::t975(lin.dof);
     let mut warnings = pr.trace.notes.clone();
-    let parameters = parameters(pr, f, &identifiable, &lin, t, &mut warnings);
+    let mut parameters = parameters(pr, f, &identifiable, &lin, t, &mut warnings);
+    prior_influence(p, f, &data_se, &mut parameters);
     let correlation = correlation(pr, &lin, &mut warnings);
     let identifiability = identifiability(pr, &lin, t, &mut warnings);
     if res.stop == lm::Stop::Budget {
@@ -681,8 +850,47 @@ fn assemble(
         };
         vec![a; pr.channels.len()]
     });
-    let band = bands::half_widths(&sim, &lin.covariance, &noise, t);
-    let channels = channel_errors(p, f, &sim.temps_c, &band, &noise);
+    let (band, band_known) = match &p.band_source {
+        Some(b) => {
+            let s = b.problem.simulate(&b.problem.start(), true)?;
+            (bands::half_widths(&s, &b.covariance, &b.noise, b.t975), true)
+        }
+        None => (
+            bands::half_widths(&sim, &lin.covariance, &noise, t),
+            !f.layout.stretch.is_empty(),
+        ),
+    };
+    let rated = o.rated.as_deref().map(plausibility::rated_point).transpose()?;
+    let plausibility = plausibility::assess(
+        pr,
+        &res.theta,
+        &sim.temps_c,
+        o.gearbox_kind.as_deref(),
+        rated,
+        &mut warnings,
+    )?;
+    let objective = profile::Objective {
+        p,
+        noise: &noise,
+        whitened: f.whitened,
+        layout: &f.layout,
+    };
+    let profiles = p
+        .profile
+        .iter()
+        .map(|&k| profile::profile(&objective, k, &res.theta, lin.std_err[k], lin.dof, &f.free))
+        .collect::<Result<Vec<_>, _>>()?;
+    for q in profiles.iter().filter(|q| q.below_fit.is_some()) {
+        warnings.push(format!(
+            "profile of {}: the objective is lower by {:.3} at {} than at the fitted value: the fit stopped short \
+             along a flat valley (the least point of profile.csv is the better one)",
+            q.key_path,
+            q.below_fit.unwrap_or(0.0),
+            q.points.iter().find(|x| x.statistic == 0.0).map_or(f64::NAN, |x| x.value)
+        ));
+    }
+    let noise = p.band_source.as_ref().map_or(noise, |b| b.noise.clone());
+    let channels = channel_errors(p, f, &sim.temps_c, &band, band_known, &noise);
     let nodes: Vec<String> = pr.trace.measured.iter().map(|c| c.name.clone()).collect();
     let measured: Vec<Vec<f64>> = pr.trace.measured.iter().map(|c| c.values_c.clone()).collect();
     let csv = fit_csv(&pr.trace.times, &p.held, &nodes, &measured, &sim.temps_c, &band);
@@ -722,6 +930,8 @@ fn assemble(
             atol: o.atol,
             wall_time_s: clock.elapsed().as_secs_f64(),
         },
+        profiles,
+        plausibility,
         warnings,
     };
     check_finite(&summary)?;
@@ -777,6 +987,50 @@ fn check_finite(s: &CalibrationSummary) -> Result<(), JobError> {
     if !s.fit.sigma_k.is_finite() {
         return Err(bad("σ"));
     }
+    for p in &s.parameters {
+        if let Some(q) = &p.prior {
+            let vals = [
+                Some(q.prior_sd),
+                q.data_std_error,
+                q.posterior_std_error,
+                q.width_ratio,
+                q.prior_share,
+                Some(q.without_prior),
+            ];
+            if vals.iter().flatten().any(|v| !v.is_finite()) {
+                return Err(bad(&format!("the prior of {}", p.key_path)));
+            }
+        }
+    }
+    if let Some(p) = &s.plausibility {
+        let mut xs = vec![&p.highest_power];
+        xs.extend(p.rated.as_ref());
+        for x in xs {
+            let vals = [
+                x.power_w,
+                x.loss_total_w,
+                x.oil_temp_c,
+                x.efficiency.unwrap_or(0.0),
+            ];
+            if vals
+                .iter()
+                .chain(x.loss_by_source_w.iter().map(|(_, v)| v))
+                .any(|v| !v.is_finite())
+            {
+                return Err(bad("the losses of the plausibility check"));
+            }
+        }
+    }
+    for p in &s.profiles {
+        let ends = [p.ci95_low, p.ci95_high, p.below_fit];
+        if ends.iter().flatten().any(|v| !v.is_finite())
+            || p.points
+                .iter()
+                .any(|x| !(x.value.is_finite() && x.statistic.is_finite()))
+        {
+            return Err(bad(&format!("the profile of {}", p.key_path)));
+        }
+    }
     Ok(())
 }
 
@@ -811,6 +1065,18 @@ impl super::command::ToArgs for CalibrateOptions {
             a.push("--refuse-missing".into());
         }
         a.extend(["--residuals".into(), self.residuals.clone()]);
+        for p in &self.prior {
+            a.extend(["--prior".to_string(), p.clone()]);
+        }
+        for p in &self.profile {
+            a.extend(["--profile".to_string(), p.clone()]);
+        }
+        if let Some(k) = &self.gearbox_kind {
+            a.extend(["--gearbox-kind".to_string(), k.clone()]);
+        }
+        if let Some(r) = &self.rated {
+            a.extend(["--rated".to_string(), r.clone()]);
+        }
         a
     }
 }

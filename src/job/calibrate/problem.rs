@@ -194,6 +194,28 @@ impl<'a> Problem<'a> {
         })
     }
 
+    /// The same problem with other parameters.
+    pub fn with_params(&self, params: Vec<Parameter>) -> Problem<'a> {
+        Problem {
+            doc: self.doc.clone(),
+            text: self.text,
+            file: self.file.clone(),
+            base: self.base.clone(),
+            trace: self.trace,
+            params,
+            segs: self.segs.clone(),
+            needs: self.needs.clone(),
+            channels: self.channels.clone(),
+            rows: self.rows.clone(),
+            opts: self.opts.clone(),
+        }
+    }
+
+    /// The model document with the base overrides applied.
+    pub fn document(&self) -> &toml::Table {
+        &self.doc
+    }
+
     /// The overrides at coordinates θ: the base ones, then each parameter's value.
     pub fn overrides_at(&self, theta: &[f64]) -> Vec<Override> {
         let mut ovs = self.base.clone();

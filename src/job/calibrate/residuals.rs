@@ -27,6 +27,17 @@ impl Ar1 {
     pub fn marginal_sd(&self) -> f64 {
         self.sigma / (1.0 - self.phi * self.phi).sqrt()
     }
+
+    /// Long-run standard deviation σ_a/(1 − φ), K: the noise scale of a slowly varying
+    /// signal's information, Σ_t x_t²·(1 − φ)²/σ_a² (the weight of a channel's rows in a MAP
+    /// fit and a profile; for φ ≤ 0 the stationary one).
+    pub fn long_run_sd(&self) -> f64 {
+        if self.phi > 0.0 {
+            self.sigma / (1.0 - self.phi)
+        } else {
+            self.marginal_sd()
+        }
+    }
 }
 
 /// The layout of the fitted residual vector: `nc` channels per fitted row (row-major), and the
@@ -228,11 +239,15 @@ pub const MAX_PASSES: usize = 4;
 pub const PHI_SETTLED: f64 = 0.01;
 
 /// The generalised least-squares fit: from the ordinary fit `ols` (raw residuals), estimate the
-/// channels' AR(1) errors, fit the whitened residuals, re-estimate, until φ settles. Returns the
-/// last fit (its evaluation whitened, evaluations and steps summed over the passes) and the
-/// models that whitened it.
+/// channels' AR(1) errors, fit the whitened residuals (with the rows `augment` appends: the
+/// priors'; `strip` removes them), re-estimate, until φ settles. Returns the last fit (its
+/// evaluation whitened, without the appended rows, evaluations and steps summed over the
+/// passes) and the models that whitened it.
+#[allow(clippy::too_many_arguments)]
 pub fn refit<E>(
     mut eval: impl FnMut(&[f64]) -> Result<Evaluation, E>,
+    augment: impl Fn(Evaluation, &[f64]) -> Evaluation,
+    strip: impl Fn(Evaluation) -> Evaluation,
     ols: LmResult,
     layout: &Layout,
     bounds: &[(f64, f64)],
@@ -245,16 +260,17 @@ pub fn refit<E>(
     let mut pass = 0;
     loop {
         pass += 1;
-        let at = layout.whiten(&raw, &models);
+        let at = augment(layout.whiten(&raw, &models), &theta);
         let m = models.clone();
-        let res = lm::minimise(
-            |th| eval(th).map(|e| layout.whiten(&e, &m)),
+        let mut res = lm::minimise(
+            |th| eval(th).map(|e| augment(layout.whiten(&e, &m), th)),
             &theta,
             at,
             bounds,
             free,
             o,
         )?;
+        res.at = strip(res.at);
         evaluations += res.evaluations - 1;
         iterations += res.iterations;
         raw = layout.unwhiten_evaluation(&res.at, &models);

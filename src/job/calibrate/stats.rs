@@ -216,6 +216,108 @@ pub fn sandwich(lin: &mut Linearised, b: &DMatrix<f64>) {
     }
 }
 
+/// The posterior covariance (I_data + I_prior)⁻¹ replaces the data's: I_data is the
+/// pseudo-inverse of `lin`'s covariance over its identifiable parameters, `prior` the prior
+/// information per parameter (0 without a prior). Scaled by D = diag √(I)_kk and inverted over
+/// the eigenpairs above [`NULL_EIGENVALUE`], as in [`linearised`]; a parameter in a direction
+/// neither data nor prior fix keeps no standard error. Parameters left out of `lin` (no
+/// influence, at a bound) stay out.
+pub fn posterior(lin: &mut Linearised, prior: &[f64]) {
+    let p = lin.covariance.len();
+    let kept: Vec<usize> = (0..p).filter(|&k| lin.scale[k] > 0.0).collect();
+    if kept.is_empty() {
+        return;
+    }
+    let n = kept.len();
+    let cov = DMatrix::from_fn(n, n, |x, y| {
+        let v = lin.covariance[kept[x]][kept[y]];
+        if v.is_finite() {
+            v
+        } else {
+            0.0
+        }
+    });
+    let mut info = pseudo_inverse(&cov);
+    for (x, &k) in kept.iter().enumerate() {
+        info[(x, x)] += prior[k];
+    }
+    let d: Vec<f64> = (0..n).map(|k| info[(k, k)].max(0.0).sqrt()).collect();
+    let mut in_null = vec![false; n];
+    let mut pinv = DMatrix::zeros(n, n);
+    let live: Vec<usize> = (0..n).filter(|&k| d[k] > 0.0).collect();
+    for &k in &(0..n).filter(|k| !live.contains(k)).collect::<Vec<_>>() {
+        in_null[k] = true;
+    }
+    let s = DMatrix::from_fn(live.len(), live.len(), |x, y| {
+        info[(live[x], live[y])] / (d[live[x]] * d[live[y]])
+    });
+    let eig = s.symmetric_eigen();
+    let lmax = eig.eigenvalues.iter().fold(0.0_f64, |a, &b| a.max(b));
+    for i in 0..live.len() {
+        let (lam, u) = (eig.eigenvalues[i], eig.eigenvectors.column(i));
+        if lmax > 0.0 && lam / lmax > NULL_EIGENVALUE {
+            let m = (u * u.transpose()) / lam;
+            for x in 0..live.len() {
+                for y in 0..live.len() {
+                    pinv[(live[x], live[y])] += m[(x, y)] / (d[live[x]] * d[live[y]]);
+                }
+            }
+        } else {
+            let umax = u.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+            for x in 0..live.len() {
+                if (u[x] / umax).abs() > INVOLVED {
+                    in_null[live[x]] = true;
+                }
+            }
+        }
+    }
+    for (x, &kx) in kept.iter().enumerate() {
+        lin.in_null[kx] = in_null[x];
+        for (y, &ky) in kept.iter().enumerate() {
+            lin.covariance[kx][ky] = pinv[(x, y)];
+        }
+    }
+    for &kx in &kept {
+        lin.std_err[kx] = (!lin.in_null[kx]).then(|| lin.covariance[kx][kx].max(0.0).sqrt());
+        for &ky in &kept {
+            let v = lin.covariance[kx][kx] * lin.covariance[ky][ky];
+            lin.correlation[kx][ky] = if !lin.in_null[kx] && !lin.in_null[ky] && v > 0.0 {
+                lin.covariance[kx][ky] / v.sqrt()
+            } else {
+                f64::NAN
+            };
+        }
+    }
+}
+
+/// Pseudo-inverse of a symmetric positive semi-definite matrix (eigenvalues above 10⁻¹² of the
+/// largest; scaled by its diagonal first).
+fn pseudo_inverse(a: &DMatrix<f64>) -> DMatrix<f64> {
+    let n = a.nrows();
+    let d: Vec<f64> = (0..n)
+        .map(|k| {
+            let v = a[(k, k)].max(0.0).sqrt();
+            if v > 0.0 {
+                v
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let s = DMatrix::from_fn(n, n, |x, y| a[(x, y)] / (d[x] * d[y]));
+    let eig = s.symmetric_eigen();
+    let lmax = eig.eigenvalues.iter().fold(0.0_f64, |x, &y| x.max(y));
+    let mut out = DMatrix::zeros(n, n);
+    for i in 0..n {
+        let lam = eig.eigenvalues[i];
+        if lmax > 0.0 && lam > 1e-12 * lmax {
+            let u = eig.eigenvectors.column(i);
+            out += (u * u.transpose()) / lam;
+        }
+    }
+    DMatrix::from_fn(n, n, |x, y| out[(x, y)] / (d[x] * d[y]))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -263,5 +365,26 @@ mod tests {
         let n = &l.directions[0];
         assert!(n.std_error.is_none() && n.relative_eigenvalue < 1e-12);
         assert!((n.direction[0] + n.direction[1]).abs() < 1e-9 && n.direction[2].abs() < 1e-9);
+    }
+
+    #[test]
+    fn posterior_adds_the_prior_information() {
+        // Two parameters entering as a sum: the data fix a + b only; a prior of sd 0.5 on a fixes
+        // both: Var(a) = 0.25, Var(b) = Var(a + b) + Var(a).
+        let x: Vec<f64> = (0..10).map(|k| k as f64).collect();
+        let j = DMatrix::from_fn(10, 2, |r, _| x[r]);
+        let mut l = linearised(&j, 8.0, &[true, true], 0);
+        assert!(l.std_err[0].is_none());
+        let sxx: f64 = x.iter().map(|v| v * v).sum();
+        posterior(&mut l, &[4.0, 0.0]);
+        let var_sum = l.sigma2 / sxx;
+        assert!((l.std_err[0].unwrap() - 0.5).abs() < 1e-9, "{:?}", l.std_err);
+        assert!((l.std_err[1].unwrap().powi(2) - (0.25 + var_sum)).abs() < 1e-9);
+        // A determined parameter: 1/Var_post = 1/Var_data + 1/sd².
+        let j = DMatrix::from_fn(10, 1, |r, _| x[r]);
+        let mut l = linearised(&j, 8.0, &[true], 0);
+        let v = l.covariance[0][0];
+        posterior(&mut l, &[1.0 / v]);
+        assert!((l.covariance[0][0] - v / 2.0).abs() < 1e-12 * v);
     }
 }

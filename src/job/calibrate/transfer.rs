@@ -1,0 +1,115 @@
+//! The prediction band of a calibrated model on another trace (`--band-from calibration.json`):
+//! the previous calibration's covariance of its fitted coordinates carried through the
+//! sensitivities on this trace, plus each channel's residual process as that calibration
+//! estimated it (the same half-width formula as [`super::bands`]). The model run is the
+//! calibrated one (`calibrated.toml`): the parameters are evaluated at the values it holds.
+
+use serde::Deserialize;
+
+use super::params::{FitSpec, Parameter};
+use super::problem::Problem;
+use super::residuals::Ar1;
+use crate::job::JobError;
+
+#[derive(Deserialize)]
+struct JsonParameter {
+    key_path: String,
+    lower_bound: f64,
+    upper_bound: f64,
+    scale: String,
+}
+
+#[derive(Deserialize)]
+struct JsonNoise {
+    phi: f64,
+    innovation_sd_k: f64,
+}
+
+#[derive(Deserialize)]
+struct JsonChannel {
+    node: String,
+    noise: JsonNoise,
+}
+
+#[derive(Deserialize)]
+struct JsonFit {
+    t975: f64,
+}
+
+#[derive(Deserialize)]
+struct JsonCalibration {
+    parameters: Vec<JsonParameter>,
+    covariance: Vec<Vec<Option<f64>>>,
+    channels: Vec<JsonChannel>,
+    fit: JsonFit,
+}
+
+/// A previous calibration's uncertainty, mapped onto this trace.
+pub struct BandSource<'a> {
+    /// The problem with the previous calibration's parameters.
+    pub problem: Problem<'a>,
+    /// Their covariance (NaN where the calibration had none).
+    pub covariance: Vec<Vec<f64>>,
+    /// Each channel's residual process.
+    pub noise: Vec<Ar1>,
+    /// The t quantile of that calibration.
+    pub t975: f64,
+}
+
+/// Read a `calibration.json` (`file` names it) and map it onto `base` (this trace's problem
+/// without parameters): every parameter resolved in the model at hand, every measured node of the
+/// trace among the calibration's channels; else invalid input naming the file and what is missing.
+pub fn band_source<'a>(
+    base: &Problem<'a>,
+    doc: &toml::Table,
+    json: &str,
+    file: &str,
+) -> Result<BandSource<'a>, JobError> {
+    let bad = |m: String| JobError::invalid(format!("{file}: {m}"));
+    let c: JsonCalibration =
+        serde_json::from_str(json).map_err(|e| bad(format!("not a calibration.json: {e}")))?;
+    let np = c.parameters.len();
+    if c.covariance.len() != np || c.covariance.iter().any(|r| r.len() != np) {
+        return Err(bad(format!("covariance: must be {np} × {np}")));
+    }
+    let mut params = Vec::with_capacity(np);
+    for (k, q) in c.parameters.iter().enumerate() {
+        let spec: FitSpec = format!("{}={}:{}", q.key_path, q.lower_bound, q.upper_bound)
+            .parse()
+            .map_err(|e: String| bad(format!("parameters[{k}]: {e}")))?;
+        let p = Parameter::resolve(&spec, doc)
+            .map_err(|e| bad(format!("parameters[{k}] ({}): {e}", q.key_path)))?;
+        if (q.scale == "log") != p.log {
+            return Err(bad(format!(
+                "parameters[{k}] ({}): scale {} does not match the model's value {}",
+                q.key_path, q.scale, p.start
+            )));
+        }
+        params.push(p);
+    }
+    let mut noise = Vec::with_capacity(base.trace.measured.len());
+    for m in &base.trace.measured {
+        let ch = c.channels.iter().find(|x| x.node == m.name).ok_or_else(|| {
+            bad(format!(
+                "channels: no channel for node {} (column {} of {}): its residual process is unknown",
+                m.name, m.column, base.trace.source
+            ))
+        })?;
+        noise.push(Ar1 {
+            phi: ch.noise.phi,
+            sigma: ch.noise.innovation_sd_k,
+        });
+    }
+    let covariance = c
+        .covariance
+        .iter()
+        .map(|r| r.iter().map(|x| x.unwrap_or(f64::NAN)).collect())
+        .collect();
+    let problem = base.with_params(params);
+    Ok(BandSource {
+        problem,
+        covariance,
+        noise,
+        t975: c.fit.t975,
+    })
+}
