@@ -218,7 +218,11 @@ impl Tangent<'_> {
             let mut col = self.s.column_mut(j);
             col += &jump * *d;
         }
-        Ok(())
+        if self.s.iter().all(|v| v.is_finite()) {
+            return Ok(());
+        }
+        let why = "the sensitivities are not finite after a controller's switch".to_string();
+        Err(self.failure(t, why))
     }
 
     /// dτ/dθ_j of every direction for switching function `idx` at the state y, with
