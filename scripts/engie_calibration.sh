@@ -1,9 +1,6 @@
 #!/usr/bin/env sh
 # The La Haute Borne calibration of docs/validation.md ("Wind-turbine gearbox"): calibrate
-# the MM82 model with its cooler and heater as smooth exchangers (models/mm82_wind_gearbox.toml
-# with validation/engie_la_haute_borne/smooth_cooler_heater.toml in place of its switching
-# controllers; `python3 scripts/engie_controls.py --smooth-model` writes it) on turbine R80711
-# (spring 2017: the first 14 days fitted, the
+# models/mm82_wind_gearbox.toml on turbine R80711 (spring 2017: the first 14 days fitted, the
 # rest held out), then predict R80711 in summer 2016 and R80721 in both periods with the
 # calibrated model, and print the table of the docs.
 #
@@ -22,8 +19,7 @@ cargo build --release --quiet
 bin=target/release/geartherm
 mkdir -p "$out"
 python3 scripts/engie_traces.py "$extract" "$out/traces"
-python3 scripts/engie_controls.py --smooth-model "$out/mm82_smooth.toml"
-"$bin" calibrate "$out/mm82_smooth.toml" --trace "$out/traces/R80711_2017-spring.csv" \
+"$bin" calibrate models/mm82_wind_gearbox.toml --trace "$out/traces/R80711_2017-spring.csv" \
     --fit 'losses.multiplier.sliding=0.05:50' \
     --fit 'losses.multiplier.churning=0.01:100' \
     --fit 'thermal.coolers["oil_cooler"].capacity_rate_w_per_k=100:30000' \

@@ -4,19 +4,20 @@
 
     python3 scripts/engie_controls.py [--data DIR] [--out DIR] [--check FILE]
     python3 scripts/engie_controls.py --setpoints [--data DIR]
-    python3 scripts/engie_controls.py --smooth-model PATH
+    python3 scripts/engie_controls.py --switching-model PATH
 
 DIR (default ../shared/data/engie_la_haute_borne) holds the four period files
 R80711_2017-spring.csv, R80711_2016-summer.csv, R80721_2017-spring.csv, R80721_2016-summer.csv.
 
 Default: two calibrations on R80711 spring 2017 (days 1–14 fitted, days 15–27 held out), each
 followed by predictions of R80711 summer 2016 and R80721 in both periods:
-  before: models/mm82_wind_gearbox.toml with its cooler and heater block replaced by
-          validation/engie_la_haute_borne/smooth_cooler_heater.toml (a cooler with a smooth
-          thermostat, a heater as a two-way exchanger); the fit of scripts/engie_calibration.sh;
-  after:  the model as it is (a two-point fan on the cooler and a thermostatic heater, set
-          points read from the data), its loss multipliers, cooler capacity rate and nacelle
-          h fitted by a grid search on the same days (see GRID_KEYS).
+  before: models/mm82_wind_gearbox.toml as it is (a cooler with a smooth thermostat, a heater
+          as a two-way exchanger), fitted as scripts/engie_calibration.sh does;
+  after:  the model with its cooler and heater block replaced by
+          validation/engie_la_haute_borne/switching_cooler_heater.toml (a two-point fan on the
+          cooler and a thermostatic heater, set points read from the data), its loss
+          multipliers, cooler capacity rate and nacelle h fitted by a grid search on the same
+          days (see GRID_KEYS).
 Prints the table of docs/validation.md and writes OUT/figures.json. With --check FILE the sump
 RMSEs are compared with the table between the "engie-controls" markers of FILE: a difference
 above TOLERANCE_K fails (exit 1).
@@ -24,7 +25,7 @@ above TOLERANCE_K fails (exit 1).
 --setpoints prints the turning points of the measured sump temperature (the 10-minute means turn
 down when the fan has come on, up when it has gone off) while the turbine produces, and the
 lowest sump temperature of each period: where the model's set points come from.
---smooth-model writes the "before" model to PATH.
+--switching-model writes the "after" model (before its fit) to PATH.
 """
 import argparse
 import csv
@@ -36,10 +37,10 @@ import subprocess
 import sys
 
 MODEL = "models/mm82_wind_gearbox.toml"
-SMOOTH_BLOCK = "validation/engie_la_haute_borne/smooth_cooler_heater.toml"
+SWITCHING_BLOCK = "validation/engie_la_haute_borne/switching_cooler_heater.toml"
 PERIODS = ["R80711_2017-spring", "R80711_2016-summer", "R80721_2017-spring", "R80721_2016-summer"]
-BEGIN = "# >>> cooler and heater controls"
-END = "# <<< cooler and heater controls"
+BEGIN = "# >>> cooler and heater"
+END = "# <<< cooler and heater"
 # The largest drift of a sump RMSE from the documented table that --check accepts, K (the
 # figures are printed to 0.01 K; the integrations are deterministic, so only a change of the
 # model, the solver or the data moves them).
@@ -77,11 +78,11 @@ ROWS = [
 ]
 
 
-def smooth_model_text():
+def switching_model_text():
     text = open(MODEL).read()
     a, b = text.index(BEGIN), text.index(END)
     b = text.index("\n", b) + 1
-    return text[:a] + open(SMOOTH_BLOCK).read() + text[b:]
+    return text[:a] + open(SWITCHING_BLOCK).read() + text[b:]
 
 
 def read(path):
@@ -141,7 +142,7 @@ def predictions(binary, model, traces, sets, out, name, res):
 
 
 def before(model, traces, out, binary):
-    """The smooth model fitted as scripts/engie_calibration.sh does."""
+    """The model as it is (smooth cooler and heater), fitted as scripts/engie_calibration.sh does."""
     fit_dir = os.path.join(out, "before_fit")
     cmd = [binary, "calibrate", model, "--trace", os.path.join(traces, "R80711_2017-spring.csv")]
     for f in BEFORE_FIT:
@@ -234,12 +235,12 @@ def main():
     ap.add_argument("--bin", default="target/release/geartherm")
     ap.add_argument("--check")
     ap.add_argument("--setpoints", action="store_true")
-    ap.add_argument("--smooth-model")
+    ap.add_argument("--switching-model")
     a = ap.parse_args()
     if a.setpoints:
         return setpoints(a.data)
-    if a.smooth_model:
-        open(a.smooth_model, "w").write(smooth_model_text())
+    if a.switching_model:
+        open(a.switching_model, "w").write(switching_model_text())
         return
     missing = [p for p in PERIODS if not os.path.isfile(os.path.join(a.data, p + ".csv"))]
     if missing:
@@ -252,10 +253,10 @@ def main():
             os.remove(dest)
         os.symlink(os.path.abspath(os.path.join(a.data, p + ".csv")), dest)
     run([sys.executable, "scripts/engie_traces.py", extract, traces])
-    smooth = os.path.join(a.out, "mm82_smooth.toml")
-    open(smooth, "w").write(smooth_model_text())
-    results = {"before": before(smooth, traces, a.out, a.bin),
-               "after": after(MODEL, traces, a.out, a.bin)}
+    switching = os.path.join(a.out, "mm82_switching.toml")
+    open(switching, "w").write(switching_model_text())
+    results = {"before": before(MODEL, traces, a.out, a.bin),
+               "after": after(switching, traces, a.out, a.bin)}
     rmse, figures = table(results)
     print(rmse)
     print()

@@ -6,9 +6,7 @@
 //! The whole integrations at θ ± h replay the step sizes of the nominal one
 //! (`integrate_fixed`): the discrete solution as a smooth function of θ, whose derivative the
 //! tangent linear is. A second check runs both at a tight tolerance with error control, where
-//! the discrete and the exact derivative agree. A model with controllers that switch (the MM82)
-//! has only the second (its step sequence depends on θ through the switching instants);
-//! sensitivities across switches: tests/sensitivity_events.rs.
+//! the discrete and the exact derivative agree.
 
 use std::path::Path;
 
@@ -28,9 +26,8 @@ const MODELS: [&str; 6] = [
 ];
 
 /// A rig trace of `rows` samples every `dt` s in the first gear state with a speed and torque
-/// step, every node "measured" at `start` °C (the start of the integrations; later values
-/// unused here), every boundary at 25 °C.
-fn trace_for(m: &Model, rows: usize, dt: f64, start: f64) -> String {
+/// step, every node "measured" (values unused here), every boundary at 25 °C.
+fn trace_for(m: &Model, rows: usize, dt: f64) -> String {
     let gear = &m.gearbox.gear_states[0].name;
     let net = m.gearbox.thermal.as_ref().unwrap();
     let mut s = String::from("time_s,input_speed_rpm,input_torque_nm,gear");
@@ -49,7 +46,7 @@ fn trace_for(m: &Model, rows: usize, dt: f64, start: f64) -> String {
         };
         s.push_str(&format!("{},{w},{t},{gear}", k as f64 * dt));
         for _ in &net.nodes {
-            s.push_str(&format!(",{start}"));
+            s.push_str(",40");
         }
         // Boundaries held below the nodes: a two-way cooler never switches to heating (a kink
         // of the right-hand side that no derivative of a fixed step sequence follows).
@@ -87,26 +84,11 @@ fn fit_specs(text: &str) -> Vec<String> {
     out
 }
 
-/// True when the model has controllers that switch: the step sequence then depends on θ through
-/// the switching instants, so a replayed sequence is not the discrete solution at θ ± h.
-fn switches(path: &str) -> bool {
-    std::fs::read_to_string(path)
-        .unwrap()
-        .contains("[[thermal.controls]]")
-}
-
 /// max |S − CD| / max |S| over every row and node, for each parameter.
 fn check_model(path: &str, rows: usize, dt: f64, rtol: f64, replay: bool) -> Vec<(String, f64, f64)> {
     let text = std::fs::read_to_string(path).unwrap();
-    // With switches, T at an output row is only piecewise smooth in θ (a switching instant that
-    // crosses the row's time is a kink): the differences take a step small enough that no
-    // instant crosses a row, at a tolerance tight enough for that step.
-    let switching = switches(path);
     let m = Model::from_text(&text, Path::new(path), &[]).unwrap();
-    // A start off every switching surface (the MM82's heater switches on at 40 °C: a start
-    // there has no derivative with respect to the initial temperature).
-    let start = if switching { 41.0 } else { 40.0 };
-    let trace = Trace::parse(&trace_for(&m, rows, dt, start), "synthetic").unwrap();
+    let trace = Trace::parse(&trace_for(&m, rows, dt), "synthetic").unwrap();
     let o = CalibrateOptions {
         fit: fit_specs(&text),
         rtol,
@@ -152,12 +134,6 @@ fn check_model(path: &str, rows: usize, dt: f64, rtol: f64, replay: bool) -> Vec
         // rounding-level changes stay below the difference.
         let h = if replay {
             2.0 * q.delta()
-        } else if switching {
-            if q.log {
-                1e-5
-            } else {
-                1e-4
-            }
         } else if q.log {
             1e-2
         } else {
@@ -169,13 +145,6 @@ fn check_model(path: &str, rows: usize, dt: f64, rtol: f64, replay: bool) -> Vec
             let sc = pr.scene_at(&th).unwrap();
             if replay {
                 integrate_fixed(&sc, &[], &pr.segs, &opts, &nominal.steps).unwrap()
-            } else if switching {
-                let tight = SensitivityOptions {
-                    rtol: 1e-12,
-                    atol: 1e-12,
-                    ..opts.clone()
-                };
-                integrate_sensitivities(&sc, &[], &pr.segs, &tight).unwrap()
             } else {
                 integrate_sensitivities(&sc, &[], &pr.segs, &opts).unwrap()
             }
@@ -197,8 +166,7 @@ fn check_model(path: &str, rows: usize, dt: f64, rtol: f64, replay: bool) -> Vec
 
 #[test]
 fn sensitivities_match_central_differences_of_replayed_integrations() {
-    // Models with controllers: tests/sensitivity_events.rs and the adaptive check below.
-    for path in MODELS.into_iter().filter(|p| !switches(p)) {
+    for path in MODELS {
         for (name, rel, scale) in check_model(path, 31, 60.0, 1e-6, true) {
             println!("{path} {name}: max |S| {scale:.4e} K, relative error {rel:.2e}");
             assert!(scale > 0.0, "{path} {name}: no sensitivity at all");
