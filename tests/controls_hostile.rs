@@ -194,3 +194,104 @@ fn steady_reports_a_cycling_fan() {
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("no equilibrium, controller fan cycles"), "{text}");
 }
+
+/// `map` over torques where the fan cycles at some points: a point is flagged as a limit cycle
+/// (period and oil band in map.csv) exactly where `steady` reports one, with the band between
+/// the set points.
+#[test]
+fn map_flags_the_points_that_cycle() {
+    let d = tempfile::tempdir().unwrap();
+    let m = model_with(d.path(), &two_point("60.0", "55.0", "oil", COOLER));
+    let out = d.path().join("map");
+    let o = bin()
+        .arg("map")
+        .arg(&m)
+        .args(["--gear", "1", "--speed-rpm", "3000", "--torque-nm", "0,150,300"])
+        .args(["--no-plots", "--quiet", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(out.join("map.csv")).unwrap();
+    let mut lines = csv.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
+    let (tq, per, lo, hi) = (
+        col("torque_nm"),
+        col("limit_cycle_period_s"),
+        col("oil_min_c"),
+        col("oil_max_c"),
+    );
+    let mut cycles = 0;
+    for line in lines {
+        let c: Vec<&str> = line.split(',').collect();
+        let s = bin()
+            .arg("steady")
+            .arg(&m)
+            .args([
+                "--gear",
+                "1",
+                "--speed-rpm",
+                "3000",
+                "--torque-nm",
+                c[tq],
+                "--json",
+            ])
+            .output()
+            .unwrap();
+        let v: serde_json::Value = serde_json::from_slice(&s.stdout).unwrap();
+        let steady_cycles = v["method"] == "limit_cycle";
+        assert_eq!(!c[per].is_empty(), steady_cycles, "torque {}: {line}", c[tq]);
+        if steady_cycles {
+            cycles += 1;
+            let (a, b): (f64, f64) = (c[lo].parse().unwrap(), c[hi].parse().unwrap());
+            assert!((a - 55.0).abs() < 1e-6 && (b - 60.0).abs() < 1e-6, "{line}");
+            assert!(c[per].parse::<f64>().unwrap() > 0.0, "{line}");
+        } else {
+            assert!(c[lo].is_empty() && c[hi].is_empty(), "{line}");
+        }
+    }
+    assert!(cycles >= 1, "no point cycles: {csv}");
+}
+
+/// `rating` at a speed where the fan already cycles at zero torque (no mode has an equilibrium:
+/// oil mean 58.6 °C, band 55–60 °C) with the limit below that mean: the rating is the minimum
+/// torque, and the point says that its oil temperature is a limit cycle's mean (`limit_cycle`
+/// in its flags, the cycle in the JSON).
+#[test]
+fn rating_flags_a_rated_point_that_cycles() {
+    let d = tempfile::tempdir().unwrap();
+    let m = model_with(d.path(), &two_point("60.0", "55.0", "oil", COOLER));
+    let out = d.path().join("rating");
+    let o = bin()
+        .arg("rating")
+        .arg(&m)
+        .args([
+            "--gear",
+            "1",
+            "--speed-rpm",
+            "3000",
+            "--oil-limit-c",
+            "58",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(out.join("rating.csv")).unwrap();
+    let row = csv.lines().nth(1).unwrap();
+    assert!(row.ends_with(",limit_at_minimum;limit_cycle"), "{csv}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("rating.json")).unwrap()).unwrap();
+    let p = &v["points"][0];
+    let c = &p["equilibrium"]["limit_cycle"];
+    let mean = c["mean_c"]["oil"].as_f64().unwrap();
+    assert!((p["oil_temp_c"].as_f64().unwrap() - mean).abs() < 1e-9, "{p}");
+    assert!(mean > 58.0, "{p}");
+    let (lo, hi) = (
+        c["min_c"]["oil"].as_f64().unwrap(),
+        c["max_c"]["oil"].as_f64().unwrap(),
+    );
+    assert!((lo - 55.0).abs() < 1e-6 && (hi - 60.0).abs() < 1e-6, "{p}");
+}

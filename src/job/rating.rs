@@ -118,11 +118,16 @@ pub struct RatingPoint {
 }
 
 impl RatingPoint {
-    /// The flags as written in `rating.csv`: the status, `;non_monotonic` when set.
+    /// The flags as written in `rating.csv`: the status, `;non_monotonic` when set,
+    /// `;limit_cycle` when a controller cycles at the rated torque (no equilibrium: the oil
+    /// temperature is the cycle's mean, its band in `equilibrium.limit_cycle`).
     pub fn flags(&self) -> String {
         let mut f = self.status.as_str().to_string();
         if self.non_monotonic {
             f.push_str(";non_monotonic");
+        }
+        if self.equilibrium.limit_cycle.is_some() {
+            f.push_str(";limit_cycle");
         }
         f
     }

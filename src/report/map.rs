@@ -7,10 +7,14 @@ use crate::solve::sweep::MapPoint;
 use super::sources::csv_columns;
 
 /// `map.csv` text; `oil` is the oil node index. Points without equilibrium have empty fields and
-/// `converged = false`.
+/// `converged = false`. A point where a controller cycles (no equilibrium exists: the limit
+/// cycle of docs/numerics.md, "Controllers that switch") has the cycle's mean in the usual
+/// columns and its period and oil band in `limit_cycle_period_s`, `oil_min_c`, `oil_max_c`
+/// (empty at an equilibrium).
 pub fn map_csv(points: &[MapPoint], oil: usize) -> String {
     let mut csv = format!(
-        "speed_rpm,torque_nm,efficiency,loss_total_w,{},oil_temp_c,iterations,converged\n",
+        "speed_rpm,torque_nm,efficiency,loss_total_w,{},oil_temp_c,iterations,converged,\
+         limit_cycle_period_s,oil_min_c,oil_max_c\n",
         csv_columns()
     );
     for p in points {
@@ -28,13 +32,22 @@ pub fn map_csv(points: &[MapPoint], oil: usize) -> String {
                     csv.push_str(&format!("{v},"));
                 }
                 csv.push_str(&format!(
-                    "{},{},true\n",
+                    "{},{},true,",
                     e.solution.temperatures[oil] - KELVIN_OFFSET,
                     e.solution.iterations + e.solution.ptc_iterations
                 ));
+                match &e.limit_cycle {
+                    Some(c) => csv.push_str(&format!(
+                        "{},{},{}\n",
+                        c.period_s,
+                        c.min_k[oil] - KELVIN_OFFSET,
+                        c.max_k[oil] - KELVIN_OFFSET
+                    )),
+                    None => csv.push_str(",,\n"),
+                }
             }
             None => csv.push_str(&format!(
-                "{},{},,,{},,,false\n",
+                "{},{},,,{},,,false,,,\n",
                 p.speed_rpm,
                 p.torque_nm,
                 ",".repeat(N_SOURCES)

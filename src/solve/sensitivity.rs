@@ -36,6 +36,13 @@
 //! [`integrate_fixed`] replays a given step sequence without error control: the same discrete
 //! solution as a function of the parameters, so that its central differences check the
 //! sensitivities to the differencing error only (`tests/sensitivity.rs`).
+//!
+//! Controllers that switch (`[[thermal.controls]]`): a step that crosses a switching surface is
+//! cut at the switch (located as in [`super::rosenbrock`]), the controller switches there, and
+//! the sensitivities jump by the saltation term ([`events`]); the thermostats' band edges are
+//! not located here (f is continuous across them: no jump).
+
+mod events;
 
 use nalgebra::{DMatrix, DVector};
 
@@ -191,6 +198,8 @@ struct Tangent<'s> {
     s: DMatrix<f64>,
     /// LU of W of the last step.
     lu: Option<Lu>,
+    /// The controllers' switching functions and their event bookkeeping.
+    ev: events::EventScratch,
 }
 
 impl<'s> Tangent<'s> {
@@ -210,7 +219,7 @@ impl<'s> Tangent<'s> {
                 }
             }
         }
-        Tangent {
+        let mut t = Tangent {
             nominal: Eval::new(scene, seg),
             plus: dirs.iter().map(|d| Eval::new(d.plus, seg)).collect(),
             minus: dirs.iter().map(|d| Eval::new(d.minus, seg)).collect(),
@@ -222,7 +231,10 @@ impl<'s> Tangent<'s> {
             y: DVector::from_vec(y0),
             s,
             lu: None,
-        }
+            ev: events::EventScratch::new(scene),
+        };
+        t.start_modes();
+        t
     }
 
     fn switch_inputs(&mut self, seg: &Segment) {
@@ -446,20 +458,6 @@ fn drive(
         item: None,
         message: "empty input: no segment to integrate".into(),
     })?;
-    if !scene.thermal.controls.is_empty() {
-        // The tangent integrator has no event location: across a switch its sensitivities
-        // would miss the jump (the saltation term). Refused rather than wrong.
-        return Err(NumericalFailure {
-            time: first.t0,
-            node: scene.thermal.names[scene.thermal.controls[0].sensor].clone(),
-            item: None,
-            message: format!(
-                "sensitivities across the switches of controller {} are not implemented: \
-                 calibrate a model without [[thermal.controls]]",
-                scene.thermal.controls[0].name
-            ),
-        });
-    }
     let mut r = Tangent::new(scene, dirs, first, opts.initial.as_deref());
     let mut out = SensitivityTrajectory {
         times: Vec::with_capacity(segments.len() + 1),
@@ -512,14 +510,21 @@ fn integrate_segment(
             Steps::Fixed(_) => err.is_finite(),
         };
         if accept {
+            let (st, h_step) = match r.locate_event(t, &st, opts) {
+                Some(located) => located,
+                None => (st, h_try),
+            };
             r.accept(t, &st);
-            out.steps.push(h_try);
-            t = if h_try >= rest * (1.0 - 1e-9) {
+            out.steps.push(h_step);
+            t = if h_step >= rest * (1.0 - 1e-9) {
                 seg.t1
             } else {
-                t + h_try
+                t + h_step
             };
             h = h_try * (SAFETY * err.max(1e-10).powf(expo)).min(GROW_MAX);
+            if r.ev.due {
+                h = r.switch_with_saltation(t, h, opts, seg.t1 - t)?;
+            }
             if let Some(i) = r.y.iter().position(|v| !v.is_finite()) {
                 return Err(r.failure(t, format!("node {i} is not finite")));
             }

@@ -1,0 +1,173 @@
+//! Sensitivities across controller switches (the saltation condition, `solve::sensitivity`):
+//! a two-node network with a thermostatic heater on the oil and a fan on the casing's link to
+//! the air, both cycling; the sensitivities of the switch temperatures (`on_c`, `off_c` of each),
+//! the heater's power and the switched link's conductance against central differences of whole
+//! integrations with error control at a tight tolerance: within 1e-5 relative (to the largest
+//! sensitivity of that parameter over the trace).
+
+use geartherm::physics::oil::KELVIN_OFFSET;
+use geartherm::scene::Scene;
+use geartherm::solve::sensitivity::{integrate_sensitivities, Direction, SensitivityOptions};
+use geartherm::solve::transient::Segment;
+
+mod common;
+use common::{fzg_with, steady_inputs};
+
+/// The parameters: heater on, off, power; fan on, off; the switched link's conductance.
+const NOMINAL: [f64; 6] = [40.0, 45.0, 1500.0, 38.0, 36.0, 10.0];
+const NAMES: [&str; 6] = [
+    "heater on_c",
+    "heater off_c",
+    "heater_w",
+    "fan on_c",
+    "fan off_c",
+    "casing-air conductance (switched)",
+];
+
+/// Oil 2000 J/K – casing 5000 J/K (20 W/K) – air at 20 °C (`p[5]` W/K through a fan link that
+/// keeps 0.3 of it while off); a heater of `p[2]` W on the oil on at `p[0]`, off at `p[1]`; the
+/// fan on when the casing reaches `p[3]`, off at `p[4]`.
+fn network(p: &[f64; 6]) -> String {
+    format!(
+        r#"
+[thermal]
+oil_node = "oil"
+initial_temp_c = 30.0
+[[thermal.nodes]]
+name = "oil"
+capacity_j_per_k = 2000.0
+[[thermal.nodes]]
+name = "casing"
+capacity_j_per_k = 5000.0
+[[thermal.boundaries]]
+name = "ambient"
+temp_c = 20.0
+[[thermal.links]]
+between = ["oil", "casing"]
+conductance_w_per_k = 20.0
+[[thermal.links]]
+name = "casing-air"
+between = ["casing", "ambient"]
+conductance_w_per_k = {:e}
+[[thermal.controls]]
+name = "heater"
+kind = "two_point"
+sensor = "oil"
+on_c = {:e}
+off_c = {:e}
+heater_w = {:e}
+[[thermal.controls]]
+name = "fan"
+kind = "two_point"
+sensor = "casing"
+on_c = {:e}
+off_c = {:e}
+link = "casing-air"
+off_fraction = 0.3
+"#,
+        p[5], p[0], p[1], p[2], p[3], p[4]
+    )
+}
+
+fn scene(p: &[f64; 6]) -> Scene {
+    let mut s = fzg_with(&network(p));
+    s.frozen_oil_temp = Some(40.0 + KELVIN_OFFSET);
+    s
+}
+
+fn segments(n: usize, dt: f64) -> Vec<Segment> {
+    let inputs = steady_inputs(0.0, 0.0);
+    (0..n)
+        .map(|k| Segment {
+            t0: k as f64 * dt,
+            t1: (k + 1) as f64 * dt,
+            inputs,
+        })
+        .collect()
+}
+
+fn opts(rtol: f64) -> SensitivityOptions {
+    SensitivityOptions {
+        rtol,
+        atol: rtol,
+        max_steps: 10_000_000,
+        initial: None,
+    }
+}
+
+/// A parameter's step: 1e-3 K on a temperature, 1e-3 relative otherwise.
+fn step(k: usize) -> f64 {
+    if matches!(k, 2 | 5) {
+        1e-3 * NOMINAL[k]
+    } else {
+        1e-3
+    }
+}
+
+fn perturbed(k: usize, s: f64) -> [f64; 6] {
+    let mut p = NOMINAL;
+    p[k] += s * step(k);
+    p
+}
+
+#[test]
+fn sensitivities_across_switches_match_central_differences() {
+    let segs = segments(30, 50.0);
+    let nominal = scene(&NOMINAL);
+    let pairs: Vec<(Scene, Scene)> = (0..6)
+        .map(|k| (scene(&perturbed(k, 1.0)), scene(&perturbed(k, -1.0))))
+        .collect();
+    let dirs: Vec<Direction<'_>> = pairs
+        .iter()
+        .enumerate()
+        .map(|(k, (a, b))| Direction {
+            plus: a,
+            minus: b,
+            delta: step(k),
+        })
+        .collect();
+    let tangent = integrate_sensitivities(&nominal, &dirs, &segs, &opts(1e-11)).unwrap();
+    // Both controllers must cycle in the window.
+    let plain = integrate_sensitivities(&nominal, &[], &segs, &opts(1e-11)).unwrap();
+    let (oil, casing): (Vec<f64>, Vec<f64>) = plain
+        .temps
+        .iter()
+        .map(|r| (r[0] - KELVIN_OFFSET, r[1] - KELVIN_OFFSET))
+        .unzip();
+    let rises = |v: &[f64]| v.windows(2).filter(|w| w[1] > w[0]).count();
+    let falls = |v: &[f64]| v.windows(2).filter(|w| w[1] < w[0]).count();
+    assert!(
+        rises(&oil) > 3 && falls(&oil) > 3,
+        "the heater must cycle: {oil:?}"
+    );
+    assert!(
+        rises(&casing) > 3 && falls(&casing) > 3,
+        "the fan must cycle: {casing:?}"
+    );
+    let np = NOMINAL.len();
+    for k in 0..np {
+        let h = 1e-2 * step(k) * 10.0;
+        let run = |s: f64| {
+            let mut p = NOMINAL;
+            p[k] += s * h;
+            integrate_sensitivities(&scene(&p), &[], &segs, &opts(1e-12)).unwrap()
+        };
+        let (a, b) = (run(1.0), run(-1.0));
+        let (mut err, mut scale) = (0.0_f64, 0.0_f64);
+        for r in 0..tangent.times.len() {
+            for i in 0..2 {
+                let cd = (a.temps[r][i] - b.temps[r][i]) / (2.0 * h);
+                let s = tangent.sens_at(r, i, k, np);
+                err = err.max((s - cd).abs());
+                scale = scale.max(s.abs());
+            }
+        }
+        let rel = err / scale;
+        println!(
+            "{}: max |S| {scale:.4e} K per unit, relative error {rel:.2e}",
+            NAMES[k]
+        );
+        assert!(scale > 0.0, "{}: no sensitivity", NAMES[k]);
+        assert!(rel <= 1e-5, "{}: relative error {rel:.3e} > 1e-5", NAMES[k]);
+    }
+}
