@@ -56,6 +56,9 @@ pub enum Stop {
     Budget,
     /// Nothing to fit.
     NoParameter,
+    /// The damped normal equations had no solution: a non-finite residual or Jacobian entry,
+    /// or no damping made them positive definite.
+    Singular,
 }
 
 /// The fit's end point.
@@ -103,6 +106,16 @@ pub fn minimise<E>(
         let jf = masked(&at.j, free);
         let a = jf.transpose() * &jf;
         let g = jf.transpose() * &at.r;
+        let m = *mu.get_or_insert(1e-3);
+        if !a.iter().chain(g.iter()).all(|v| v.is_finite()) || m > 1e200 {
+            return Ok(LmResult {
+                theta,
+                at,
+                evaluations,
+                iterations,
+                stop: Stop::Singular,
+            });
+        }
         if gradient_small(&jf, &at.r, &g, o.g_tol) {
             return Ok(LmResult {
                 theta,
@@ -115,7 +128,6 @@ pub fn minimise<E>(
         let diag: Vec<f64> = (0..p)
             .map(|k| if free[k] { a[(k, k)].max(1e-300) } else { 1.0 })
             .collect();
-        let m = *mu.get_or_insert(1e-3);
         let mut lhs = a.clone();
         for k in 0..p {
             lhs[(k, k)] += m * diag[k];
@@ -244,5 +256,27 @@ mod tests {
         assert!((res.theta[0] - 2.0).abs() < 1e-12, "{:?}", res.theta);
         let res = fit(&[1.0, 0.7], &[(0.0, 10.0), (0.0, 5.0)], &[true, false]);
         assert!((res.theta[0] - 3.0).abs() < 1e-7 && res.theta[1] == 0.7);
+    }
+
+    /// A Jacobian with a NaN entry stops the fit as singular instead of raising the damping for
+    /// ever (the Cholesky factorisation of a matrix with NaN never succeeds).
+    #[test]
+    fn nan_jacobian_stops_as_singular() {
+        let eval = |th: &[f64]| -> Result<Evaluation, ()> {
+            let r = DVector::from_vec(vec![th[0] - 1.0, th[0] + 1.0]);
+            let j = DMatrix::from_vec(2, 1, vec![1.0, f64::NAN]);
+            Ok(Evaluation { r, j })
+        };
+        let res = minimise(
+            eval,
+            &[0.5],
+            eval(&[0.5]).unwrap(),
+            &[(-10.0, 10.0)],
+            &[true],
+            &LmOptions::default(),
+        )
+        .unwrap();
+        assert_eq!(res.stop, Stop::Singular);
+        assert_eq!(res.evaluations, 1);
     }
 }

@@ -377,6 +377,22 @@ pub fn prepare<'a>(
     })
 }
 
+/// A fit that stopped on normal equations without a solution (a non-finite residual or
+/// sensitivity) is a numerical failure (exit 2), not a result.
+fn singular(p: &Prepared<'_>, res: &lm::LmResult) -> Result<(), JobError> {
+    if res.stop != lm::Stop::Singular {
+        return Ok(());
+    }
+    Err(JobError::numerical(format!(
+        "{} on {}: the fit stopped after {} evaluations at a point where the residuals or their \
+         sensitivities are not finite, or the damped normal equations have no solution: no \
+         calibrated model is written (narrow the bounds or check the trace)",
+        p.problem.file.display(),
+        p.problem.trace.source,
+        res.evaluations
+    )))
+}
+
 /// The error of a fitted model whose trajectory leaves the physics envelope (exit 2).
 fn breach_error(p: &Prepared<'_>, theta: &[f64], breach: &str) -> JobError {
     let pr = &p.problem;
@@ -446,6 +462,7 @@ pub fn fit(m: &Model, p: &Prepared<'_>, o: &CalibrateOptions) -> Result<Calibrat
         ..LmOptions::default()
     };
     let ols = lm::minimise(|th| evaluate(p, th), &theta0, at0, &bounds, &free, &lmo)?;
+    singular(p, &ols)?;
     let id_ols = identifiable(&ols.theta, &bounds, &free);
     let independent = Independent {
         lin: stats::linearised(&ols.at.j, ols.at.r.norm_squared(), &id_ols, 0),
@@ -833,6 +850,7 @@ fn assemble(
     prior_influence(p, f, &data_se, &mut parameters);
     let correlation = correlation(pr, &lin, &mut warnings);
     let identifiability = identifiability(pr, &lin, t, &mut warnings);
+    singular(p, &res)?;
     if res.stop == lm::Stop::Budget {
         warnings.push(format!(
             "the fit stopped after {} evaluations (max_iterations) before converging",
