@@ -850,7 +850,7 @@ fn assemble(
     prior_influence(p, f, &data_se, &mut parameters);
     let correlation = correlation(pr, &lin, &mut warnings);
     let identifiability = identifiability(pr, &lin, t, &mut warnings);
-    singular(p, &res)?;
+    singular(p, res)?;
     if res.stop == lm::Stop::Budget {
         warnings.push(format!(
             "the fit stopped after {} evaluations (max_iterations) before converging",
