@@ -63,6 +63,20 @@ pub fn fmu(a: &FmuArgs) -> Result<(), Failure> {
     let model = &a.source.model;
     let text = std::fs::read_to_string(model)
         .map_err(|e| io_failure(format!("{}: cannot read: {e}", model.display())))?;
+    let o = FmuOptions {
+        params: a.params.clone(),
+        model_identifier: job_fmu::model_identifier(&stem),
+    };
+    let overrides: Vec<String> = a.source.set.iter().map(|o| o.to_string()).collect();
+    let export = job_fmu::prepare(&text, &model.display().to_string(), &overrides, &o)?;
+    let dir = a
+        .out
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !dir.is_dir() {
+        return Err(io_failure(format!("{}: no such directory", dir.display())));
+    }
     let rt = runtime_path()?;
     let runtime = std::fs::read(&rt).map_err(|e| {
         io_failure(format!(
@@ -71,19 +85,14 @@ pub fn fmu(a: &FmuArgs) -> Result<(), Failure> {
             job_fmu::RUNTIME_ENV
         ))
     })?;
-    let o = FmuOptions {
-        params: a.params.clone(),
-        model_identifier: job_fmu::model_identifier(&stem),
-    };
-    let overrides: Vec<String> = a.source.set.iter().map(|o| o.to_string()).collect();
-    let file = model.display().to_string();
-    let bytes = job_fmu::export(&text, &file, &overrides, &o, &runtime)?;
+    let bytes = export.package(&runtime)?;
     write_atomic(&a.out, &bytes)
         .map_err(|e| io_failure(format!("{}: cannot write: {e}", a.out.display())))?;
     emit(&format!(
-        "wrote {} (FMI 2.0 co-simulation, model identifier {}, {} bytes)\n",
+        "wrote {} (FMI 2.0 co-simulation, model identifier {}, {} variables, {} bytes)\n",
         a.out.display(),
         o.model_identifier,
+        export.variables(),
         bytes.len()
     ))
 }

@@ -216,17 +216,17 @@ pub fn model_identifier(stem: &str) -> String {
     id
 }
 
-/// Build the FMU's bytes (a zip: modelDescription.xml and the patched runtime library): the
-/// model `text` named `file` with `overrides`, `runtime` the runtime library's bytes. Invalid
-/// input (the model, a parameter key path, a model larger than the slot) is exit 1; a runtime
-/// library without a slot is an I/O error (exit 3).
-pub fn export(
-    text: &str,
-    file: &str,
-    overrides: &[String],
-    o: &FmuOptions,
-    runtime: &[u8],
-) -> Result<Vec<u8>, JobError> {
+/// A checked export: the model built and initialised once with its start values.
+pub struct Export {
+    fm: FmuModel,
+    payload: Vec<u8>,
+    id: String,
+}
+
+/// Check an export: the model `text` named `file` with `overrides` (`PATH = VALUE`) and the
+/// options. Every failure is invalid input (exit 1): the model, a parameter key path, a model
+/// larger than the slot, a model the FMU cannot integrate.
+pub fn prepare(text: &str, file: &str, overrides: &[String], o: &FmuOptions) -> Result<Export, JobError> {
     if model_identifier(&o.model_identifier) != o.model_identifier {
         return Err(JobError::invalid(format!(
             "model identifier `{}`: not a C identifier",
@@ -243,12 +243,30 @@ pub fn export(
     instance::check_exportable(&fm)?;
     let bytes = serde_json::to_vec(&payload)
         .map_err(|e| JobError::invalid(format!("cannot serialise the model: {e}")))?;
-    let lib = slot::patch(runtime, &bytes)?;
-    let guid = slot::guid(&bytes);
-    let xml = description::model_description(&fm, &o.model_identifier, &guid);
-    let lib_name = format!("binaries/{PLATFORM}/{}.so", o.model_identifier);
-    Ok(stored_zip(&[
-        ("modelDescription.xml", xml.as_bytes()),
-        (&lib_name, &lib),
-    ]))
+    slot::check_fits(&bytes)?;
+    Ok(Export {
+        fm,
+        payload: bytes,
+        id: o.model_identifier.clone(),
+    })
+}
+
+impl Export {
+    /// The FMU's bytes (a zip: modelDescription.xml and the runtime library `runtime` with the
+    /// model in its slot). A runtime library without a slot is an I/O error (exit 3).
+    pub fn package(&self, runtime: &[u8]) -> Result<Vec<u8>, JobError> {
+        let lib = slot::patch(runtime, &self.payload)?;
+        let guid = slot::guid(&self.payload);
+        let xml = description::model_description(&self.fm, &self.id, &guid);
+        let lib_name = format!("binaries/{PLATFORM}/{}.so", self.id);
+        Ok(stored_zip(&[
+            ("modelDescription.xml", xml.as_bytes()),
+            (&lib_name, &lib),
+        ]))
+    }
+
+    /// Number of variables.
+    pub fn variables(&self) -> usize {
+        self.fm.vars.len()
+    }
 }

@@ -64,18 +64,30 @@ pub fn patch(lib: &[u8], payload: &[u8]) -> Result<Vec<u8>, JobError> {
                 ))
             }
         };
-    let room = SLOT_LEN - HEADER_LEN;
-    if payload.len() > room || at + SLOT_LEN > lib.len() {
-        return Err(JobError::invalid(format!(
-            "the model and its overrides take {} bytes; an FMU holds at most {room}",
-            payload.len()
-        )));
+    check_fits(payload)?;
+    if at + SLOT_LEN > lib.len() {
+        return Err(JobError::io(
+            "the FMU runtime library ends inside its model slot",
+            std::io::ErrorKind::InvalidData,
+        ));
     }
     let mut out = lib.to_vec();
     let len_at = at + MAGIC.len();
     out[len_at..len_at + 8].copy_from_slice(&(payload.len() as u64).to_le_bytes());
     out[at + HEADER_LEN..at + HEADER_LEN + payload.len()].copy_from_slice(payload);
     Ok(out)
+}
+
+/// A payload larger than the slot is invalid input.
+pub fn check_fits(payload: &[u8]) -> Result<(), JobError> {
+    let room = SLOT_LEN - HEADER_LEN;
+    if payload.len() > room {
+        return Err(JobError::invalid(format!(
+            "the model and its overrides take {} bytes; an FMU holds at most {room}",
+            payload.len()
+        )));
+    }
+    Ok(())
 }
 
 /// The payload in a slot's bytes (at least the header; the runtime copies the slot out of its
