@@ -2,10 +2,10 @@
 //! found through `GEARTHERM_FMU_RUNTIME` or beside the executable; the FMU is written to a
 //! temporary file in the output's directory and renamed into place (nothing written on error).
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use crate::job::fmu::{self as job_fmu, FmuOptions};
+use crate::report::files::write_file_atomic;
 
 use super::output::{emit, invalid, io_failure};
 use super::{Failure, ModelSource};
@@ -33,22 +33,6 @@ pub fn runtime_path() -> Result<PathBuf, Failure> {
     let exe = std::env::current_exe()
         .map_err(|e| io_failure(format!("cannot find the running executable: {e}")))?;
     Ok(exe.with_file_name(job_fmu::RUNTIME_FILE))
-}
-
-/// Write `bytes` to `out` atomically: a temporary file in its directory, renamed into place.
-pub fn write_atomic(out: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = match out.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".fmu.")
-        .suffix(".tmp")
-        .tempfile_in(dir)?;
-    tmp.write_all(bytes)?;
-    tmp.as_file().sync_all()?;
-    tmp.persist(out).map_err(|e| e.error)?;
-    Ok(())
 }
 
 /// Run `fmu`.
@@ -86,7 +70,7 @@ pub fn fmu(a: &FmuArgs) -> Result<(), Failure> {
         ))
     })?;
     let bytes = export.package(&runtime)?;
-    write_atomic(&a.out, &bytes)
+    write_file_atomic(&a.out, &bytes)
         .map_err(|e| io_failure(format!("{}: cannot write: {e}", a.out.display())))?;
     emit(&format!(
         "wrote {} (FMI 2.0 co-simulation, model identifier {}, {} variables, {} bytes)\n",

@@ -365,6 +365,16 @@ impl Instance {
         let y = stepper.state();
         let by = sum_by_source(&scene.losses.items, &q);
         let total: f64 = q.iter().sum();
+        // The losses supplied through the input shaft: not the converter's slip or an
+        // engine-driven pump, paid ahead of it (as `timeseries.csv`'s input torque).
+        let shaft: f64 = scene
+            .losses
+            .items
+            .iter()
+            .zip(&q)
+            .filter(|(it, _)| !it.engine_side)
+            .map(|(_, p)| p)
+            .sum();
         let energy = scene.loss_energy_by_source(y);
         let (w, torque) = (inputs.input_speed, inputs.input_torque);
         let ratio = model.gearbox.gear_states[inputs.state].ratio();
@@ -380,7 +390,7 @@ impl Instance {
                 Role::Efficiency => efficiency(torque * w, total).unwrap_or(0.0),
                 Role::OutputSpeed => w / ratio,
                 Role::OutputTorque => torque * ratio,
-                Role::InputTorqueWithLosses => torque + if w > 0.0 { total / w } else { 0.0 },
+                Role::InputTorqueWithLosses => torque + if w > 0.0 { shaft / w } else { 0.0 },
                 Role::OilViscosity => nu,
                 _ => continue,
             };

@@ -54,7 +54,8 @@ pub enum Role {
     OutputSpeed,
     /// Output torque (loss-free input torque × ratio), N·m.
     OutputTorque,
-    /// Input torque with the losses, T + P_loss/ω_in, N·m (as `timeseries.csv`).
+    /// Input shaft torque with the losses supplied through the shaft, T + P_shaft/ω_in, N·m (as
+    /// `timeseries.csv`: the converter's slip and an engine-driven pump are paid ahead of it).
     InputTorqueWithLosses,
     /// Kinematic viscosity of the oil at the oil temperature, m²/s.
     OilViscosity,
@@ -261,7 +262,7 @@ pub fn variables(gb: &Gearbox, scene: &Scene, params: &[(String, f64)]) -> Vec<V
         Output,
         "N.m",
         None,
-        "input torque plus P_loss/input speed".into(),
+        "input shaft torque: input torque plus the losses supplied through the input shaft / input speed (converter slip and an engine-driven pump excluded)".into(),
     );
     push(
         "oil_viscosity".into(),
