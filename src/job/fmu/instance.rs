@@ -51,8 +51,19 @@ pub struct Instance {
     setup_tol: Option<f64>,
     rtol_set: bool,
     start_time: f64,
-    run: Option<(Model, Scene, Stepper)>,
+    run: Option<Run>,
     outputs_fresh: bool,
+}
+
+/// A started instance: the model with its parameters, its scene, the stepper, the envelope its
+/// states are checked against, and the boundary lines last applied.
+struct Run {
+    model: Model,
+    scene: Scene,
+    stepper: Stepper,
+    envelope: Envelope,
+    /// (value, derivative) of each boundary input as last applied to the scene.
+    applied: Vec<(f64, f64)>,
 }
 
 /// A message for the importer's logger.
@@ -182,7 +193,7 @@ impl Instance {
     }
 
     /// The model with the parameters, its scene and a stepper at the initial temperatures.
-    fn start(&self) -> Result<(Model, Scene, Stepper), Message> {
+    fn start(&self) -> Result<Run, Message> {
         let fm = &self.fm;
         let params: Vec<f64> = (0..fm.params.len())
             .map(|k| self.value_of(Role::Param(k)))
@@ -218,7 +229,24 @@ impl Instance {
             ..TransientOptions::default()
         };
         let stepper = Stepper::new(&scene, y0, self.inputs(), opts, self.start_time)?;
-        Ok((model, scene, stepper))
+        Ok(Run {
+            envelope: Envelope::of(&scene),
+            applied: self.boundary_inputs(),
+            model,
+            scene,
+            stepper,
+        })
+    }
+
+    /// (value, derivative) of every boundary input.
+    fn boundary_inputs(&self) -> Vec<(f64, f64)> {
+        self.fm
+            .vars
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| matches!(v.role, Role::Boundary(_)))
+            .map(|(k, _)| (self.values[k], self.deriv[k]))
+            .collect()
     }
 
     /// Every boundary from its input over [t, t + h] (a line with the input's derivative).
@@ -270,7 +298,7 @@ impl Instance {
         if !settable {
             return Err(format!("{} cannot be set now ({:?})", v.name, self.phase));
         }
-        let time = self.run.as_ref().map_or(self.start_time, |r| r.2.time());
+        let time = self.run.as_ref().map_or(self.start_time, |r| r.stepper.time());
         if let Err(m) = self.check_value(&v, x) {
             return self.fail(format!("t = {time} s: {m}"));
         }
@@ -306,23 +334,26 @@ impl Instance {
         }
         let inputs = self.inputs();
         let mut run = self.run.take().ok_or("no run")?;
-        let now = run.2.time();
+        let now = run.stepper.time();
         if !(h.is_finite() && h > 0.0) || (t - now).abs() > 1e-9 * now.abs().max(1.0) {
             self.run = Some(run);
             return self.fail(format!(
                 "doStep from t = {t} s over {h} s: the instance is at t = {now} s and needs h > 0"
             ));
         }
-        self.apply_boundaries(&mut run.1, now, h);
-        let (_, scene, stepper) = &mut run;
-        stepper.refresh(scene);
-        stepper.set_inputs(scene, inputs);
+        // Boundaries held at their last values need no new line (nor a fresh work area).
+        let lines = self.boundary_inputs();
+        if lines != run.applied || lines.iter().any(|b| b.1 != 0.0) {
+            self.apply_boundaries(&mut run.scene, now, h);
+            run.stepper.refresh(&run.scene);
+        }
+        run.stepper.set_inputs(&run.scene, inputs);
         let t1 = now + h;
-        let r = stepper.step(scene, t1);
-        let breach = Envelope::of(scene).check(&stepper.state()[..scene.nodes()]);
+        let r = run.stepper.step(&run.scene, t1);
+        let breach = run.envelope.check(&run.stepper.state()[..run.scene.nodes()]);
         self.deriv.iter_mut().for_each(|d| *d = 0.0);
-        // The boundaries stay at their values at t1 until the next step.
-        self.apply_boundaries(&mut run.1, t1, 0.0);
+        // A line's boundary stays at its end value after t1 (`set_boundary_ramp`).
+        run.applied = self.boundary_inputs();
         self.run = Some(run);
         self.outputs_fresh = false;
         match (r, breach) {
@@ -345,7 +376,7 @@ impl Instance {
 
     /// The current time (the start time before initialisation).
     pub fn time(&self) -> f64 {
-        self.run.as_ref().map_or(self.start_time, |r| r.2.time())
+        self.run.as_ref().map_or(self.start_time, |r| r.stepper.time())
     }
 
     /// Every output from the state at the current time with the inputs in force.
@@ -357,7 +388,13 @@ impl Instance {
             self.run = Some(self.start()?);
         }
         let inputs = self.inputs();
-        let Some((model, scene, stepper)) = self.run.as_mut() else {
+        let Some(Run {
+            model,
+            scene,
+            stepper,
+            ..
+        }) = self.run.as_mut()
+        else {
             return Err("no run".into());
         };
         stepper.set_inputs(scene, inputs);
