@@ -84,8 +84,8 @@ fn drive_instance(step: f64) -> (f64, f64) {
             inst.do_step(t0, t1 - t0).unwrap();
         }
         let row = traj.states.get(k + 1).unwrap();
-        for n in 0..nodes {
-            dt_max = dt_max.max((inst.get(vr(Role::NodeTemp(n))).unwrap() - row[n]).abs());
+        for (n, t_run) in row.iter().enumerate().take(nodes) {
+            dt_max = dt_max.max((inst.get(vr(Role::NodeTemp(n))).unwrap() - t_run).abs());
         }
         let e_run = p.scene.loss_energy_by_source(row);
         for s in geartherm::job::fmu::variables::sources(&fm.scene) {

@@ -214,8 +214,8 @@ impl Instance {
         let atol = self.value_of(Role::Atol);
         check_limit("atol", &limits::ATOL, atol)?;
         let mut y0 = scene.initial_state(None);
-        for k in 0..scene.nodes() {
-            y0[k] = self.value_of(Role::InitialTemp(k));
+        for (k, y) in y0.iter_mut().enumerate().take(scene.nodes()) {
+            *y = self.value_of(Role::InitialTemp(k));
         }
         Envelope::of(&scene)
             .check(&y0[..scene.nodes()])

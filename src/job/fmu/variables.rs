@@ -2,7 +2,7 @@
 //! scene, that both the exporter (modelDescription.xml) and the runtime (value references of
 //! `fmi2GetReal` / `fmi2SetReal`) read, so the two cannot disagree.
 
-use crate::job::run::DEFAULT_RTOL;
+use crate::job::run::{DEFAULT_ATOL, DEFAULT_RTOL};
 use crate::model::Gearbox;
 use crate::scene::{Scene, Source};
 
@@ -82,13 +82,21 @@ pub struct Variable {
     pub description: String,
 }
 
-/// Every variable of an FMU of `gb` compiled into `scene`, with `params` (key paths and their
-/// model values).
-pub fn variables(gb: &Gearbox, scene: &Scene, params: &[(String, f64)]) -> Vec<Variable> {
-    let mut v = Vec::new();
-    let mut push = |name: String, role, causality, unit, start, description: String| {
-        let vr = v.len() as u32 + 1;
-        v.push(Variable {
+/// The table being built: value references are positions from 1.
+struct Table(Vec<Variable>);
+
+impl Table {
+    fn push(
+        &mut self,
+        name: String,
+        role: Role,
+        causality: Causality,
+        unit: &'static str,
+        start: Option<f64>,
+        description: String,
+    ) {
+        let vr = self.0.len() as u32 + 1;
+        self.0.push(Variable {
             name,
             vr,
             role,
@@ -98,181 +106,156 @@ pub fn variables(gb: &Gearbox, scene: &Scene, params: &[(String, f64)]) -> Vec<V
             start,
             description,
         });
-    };
-    use Causality::*;
+    }
+
+    fn input(&mut self, name: &str, role: Role, unit: &'static str, start: f64, description: String) {
+        self.push(
+            name.into(),
+            role,
+            Causality::Input,
+            unit,
+            Some(start),
+            description,
+        );
+    }
+
+    fn parameter(&mut self, name: String, role: Role, unit: &'static str, start: f64, description: String) {
+        self.push(name, role, Causality::Parameter, unit, Some(start), description);
+    }
+
+    fn output(&mut self, name: String, role: Role, unit: &'static str, description: String) {
+        self.push(name, role, Causality::Output, unit, None, description);
+    }
+}
+
+/// Every variable of an FMU of `gb` compiled into `scene`, with `params` (key paths and their
+/// model values): inputs, parameters, outputs.
+pub fn variables(gb: &Gearbox, scene: &Scene, params: &[(String, f64)]) -> Vec<Variable> {
+    let mut t = Table(Vec::new());
+    inputs(&mut t, gb, scene);
+    parameters(&mut t, scene, params);
+    outputs(&mut t, scene);
+    t.0
+}
+
+fn inputs(t: &mut Table, gb: &Gearbox, scene: &Scene) {
     let states: Vec<String> = gb
         .gear_states
         .iter()
         .enumerate()
         .map(|(i, s)| format!("{i} = {}", s.name))
         .collect();
-    let th = &scene.thermal;
-    push(
-        "input_speed".into(),
+    t.input(
+        "input_speed",
         Role::InputSpeed,
-        Input,
         "rad/s",
-        Some(0.0),
+        0.0,
         "input shaft speed (0 to 50000 rpm)".into(),
     );
-    push(
-        "input_torque".into(),
-        Role::InputTorque,
-        Input,
-        "N.m",
-        Some(0.0),
-        "torque the gear train transmits, referred to the input, loss-free (negative: overrun)".into(),
-    );
-    push(
-        "vehicle_speed".into(),
-        Role::VehicleSpeed,
-        Input,
-        "m/s",
-        Some(0.0),
-        "vehicle speed, for speed-dependent links (0 to 400 km/h)".into(),
-    );
-    push(
-        "gear".into(),
+    let torque = "torque the gear train transmits, referred to the input, loss-free (negative: overrun)";
+    t.input("input_torque", Role::InputTorque, "N.m", 0.0, torque.into());
+    let v = "vehicle speed, for speed-dependent links (0 to 400 km/h)";
+    t.input("vehicle_speed", Role::VehicleSpeed, "m/s", 0.0, v.into());
+    t.input(
+        "gear",
         Role::Gear,
-        Input,
         "",
-        Some(0.0),
+        0.0,
         format!("gear-state index: {}", states.join(", ")),
     );
+    let th = &scene.thermal;
     for (k, name) in th.boundary_names.iter().enumerate() {
         let t0 = th.boundary_temperature_at(k, 0.0).unwrap_or(f64::NAN);
-        push(
-            format!("T_boundary.{name}"),
+        t.input(
+            &format!("T_boundary.{name}"),
             Role::Boundary(k),
-            Input,
             "K",
-            Some(t0),
+            t0,
             format!("temperature of boundary {name}"),
         );
     }
+}
+
+fn parameters(t: &mut Table, scene: &Scene, params: &[(String, f64)]) {
+    let th = &scene.thermal;
     for (k, name) in th.names.iter().enumerate() {
-        push(
+        let d = format!("initial temperature of node {name}");
+        t.parameter(
             format!("T_initial.{name}"),
             Role::InitialTemp(k),
-            Parameter,
             "K",
-            Some(th.initial[k]),
-            format!("initial temperature of node {name}"),
+            th.initial[k],
+            d,
         );
     }
-    push(
-        "rtol".into(),
-        Role::Rtol,
-        Parameter,
-        "",
-        Some(DEFAULT_RTOL),
-        "relative tolerance of the integration (1e-14 to 0.1)".into(),
-    );
-    push(
-        "atol".into(),
-        Role::Atol,
-        Parameter,
-        "K",
-        Some(crate::job::run::DEFAULT_ATOL),
-        "absolute tolerance on temperatures (1e-14 to 1)".into(),
-    );
+    let rtol = "relative tolerance of the integration (1e-14 to 0.1)";
+    t.parameter("rtol".into(), Role::Rtol, "", DEFAULT_RTOL, rtol.into());
+    let atol = "absolute tolerance on temperatures (1e-14 to 1)";
+    t.parameter("atol".into(), Role::Atol, "K", DEFAULT_ATOL, atol.into());
     for (k, (path, value)) in params.iter().enumerate() {
-        push(
-            format!("param.{path}"),
-            Role::Param(k),
-            Parameter,
-            "",
-            Some(*value),
-            format!("model value {path} (checked as the model file)"),
-        );
+        let d = format!("model value {path} (checked as the model file)");
+        t.parameter(format!("param.{path}"), Role::Param(k), "", *value, d);
     }
-    for (k, name) in th.names.iter().enumerate() {
-        push(
+}
+
+fn outputs(t: &mut Table, scene: &Scene) {
+    for (k, name) in scene.thermal.names.iter().enumerate() {
+        t.output(
             format!("T.{name}"),
             Role::NodeTemp(k),
-            Output,
             "K",
-            None,
             format!("temperature of node {name}"),
         );
     }
     for s in sources(scene) {
-        push(
-            format!("P_loss.{}", s.as_str()),
+        let n = s.as_str();
+        t.output(
+            format!("P_loss.{n}"),
             Role::SourceLoss(s),
-            Output,
             "W",
-            None,
-            format!("{} loss power", s.as_str()),
+            format!("{n} loss power"),
         );
     }
-    push(
+    t.output(
         "P_loss.total".into(),
         Role::TotalLoss,
-        Output,
         "W",
-        None,
         "total loss power".into(),
     );
     for s in sources(scene) {
-        push(
-            format!("E_loss.{}", s.as_str()),
+        let n = s.as_str();
+        t.output(
+            format!("E_loss.{n}"),
             Role::SourceEnergy(s),
-            Output,
             "J",
-            None,
-            format!("{} loss energy since the start", s.as_str()),
+            format!("{n} loss energy since the start"),
         );
     }
-    push(
+    t.output(
         "E_loss.total".into(),
         Role::TotalEnergy,
-        Output,
         "J",
-        None,
         "total loss energy since the start".into(),
     );
-    push(
-        "efficiency".into(),
-        Role::Efficiency,
-        Output,
-        "1",
-        None,
-        "P_out/(P_out + P_loss); 0 when no power flows to the output".into(),
-    );
-    push(
+    let eta = "P_out/(P_out + P_loss); 0 when no power flows to the output";
+    t.output("efficiency".into(), Role::Efficiency, "1", eta.into());
+    t.output(
         "output_speed".into(),
         Role::OutputSpeed,
-        Output,
         "rad/s",
-        None,
         "output shaft speed".into(),
     );
-    push(
-        "output_torque".into(),
-        Role::OutputTorque,
-        Output,
-        "N.m",
-        None,
-        "output torque, loss-free (input torque x ratio)".into(),
-    );
-    push(
+    let tq = "output torque, loss-free (input torque x ratio)";
+    t.output("output_torque".into(), Role::OutputTorque, "N.m", tq.into());
+    let shaft = "input shaft torque: input torque plus the losses supplied through the input shaft / input speed (converter slip and an engine-driven pump excluded)";
+    t.output(
         "input_torque_with_losses".into(),
         Role::InputTorqueWithLosses,
-        Output,
         "N.m",
-        None,
-        "input shaft torque: input torque plus the losses supplied through the input shaft / input speed (converter slip and an engine-driven pump excluded)".into(),
+        shaft.into(),
     );
-    push(
-        "oil_viscosity".into(),
-        Role::OilViscosity,
-        Output,
-        "m2/s",
-        None,
-        "kinematic viscosity of the oil at the oil temperature".into(),
-    );
-    v
+    let nu = "kinematic viscosity of the oil at the oil temperature";
+    t.output("oil_viscosity".into(), Role::OilViscosity, "m2/s", nu.into());
 }
 
 /// The loss sources the scene has items of, in output order.
