@@ -71,10 +71,12 @@ pub type Message = String;
 
 fn check_limit(name: &str, limit: &Limit, v: f64) -> Result<(), Message> {
     limit.check(v).map(|_| ()).map_err(|_| {
-        format!(
-            "{name} = {v}: outside {} (a NaN is never allowed)",
-            limit.allowed()
-        )
+        let why = if v.is_nan() {
+            "not a number; allowed"
+        } else {
+            "outside"
+        };
+        format!("{name} = {v}: {why} {}", limit.allowed())
     })
 }
 
