@@ -739,9 +739,12 @@ fn version() -> &'static str {
     env!("CARGO_PKG_VERSION")
 }
 
+mod fmu;
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Model>()?;
+    m.add_function(wrap_pyfunction!(fmu::export_fmu, m)?)?;
     m.add_function(wrap_pyfunction!(study_file, m)?)?;
     m.add_function(wrap_pyfunction!(study_cases, m)?)?;
     m.add_function(wrap_pyfunction!(run_cases, m)?)?;

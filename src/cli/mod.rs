@@ -12,6 +12,7 @@ use clap::{Parser, Subcommand};
 mod bench;
 mod calibrate;
 mod check;
+mod fmu;
 mod output;
 mod rating;
 mod report;
@@ -102,6 +103,8 @@ pub enum Command {
     /// Read a measured trace as `calibrate` does: rows, rows dropped for empty cells, the
     /// segments its gaps in time cut it into.
     Trace(calibrate::TraceArgs),
+    /// Export the model as an FMI 2.0 co-simulation FMU (Linux x86-64, self-contained).
+    Fmu(fmu::FmuArgs),
 }
 
 /// The model file and `--set PATH=VALUE` overrides, shared by every command that reads a model.
@@ -143,5 +146,6 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         Command::Report(a) => report::report(&a),
         Command::Calibrate(a) => calibrate::calibrate(&a),
         Command::Trace(a) => calibrate::trace(&a),
+        Command::Fmu(a) => fmu::fmu(&a),
     }
 }

@@ -25,6 +25,7 @@ pub mod calibrate;
 pub mod command;
 pub mod envelope;
 pub mod error;
+pub mod fmu;
 pub mod limits;
 pub mod losses;
 pub mod map;

@@ -489,6 +489,23 @@ fn exchange(_a: &Path, _b: &Path) -> bool {
     false
 }
 
+/// Write one file atomically: `bytes` go to a temporary file in `path`'s directory (which must
+/// exist: nothing is created), renamed to `path` when complete. On error nothing is left.
+pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".geartherm.")
+        .suffix(".tmp")
+        .tempfile_in(dir)?;
+    tmp.write_all(bytes)?;
+    tmp.as_file().sync_all()?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
+
 /// Write `files` (name, contents) into `dir` file by file: each is written to a temporary file
 /// (usual mode) in `dir` and all are renamed into place only when every one was written; other
 /// files in `dir` stay. For a directory that is not replaced as a whole (`study` writes its

@@ -10,3 +10,4 @@ pub mod run;
 pub mod sources;
 pub mod study;
 pub mod validation;
+pub mod zip;

@@ -616,6 +616,24 @@ impl ThermalScene {
         }
     }
 
+    /// Temperature of boundary `index` at time `t`, K (None: no such boundary).
+    pub fn boundary_temperature_at(&self, index: usize, t: f64) -> Option<f64> {
+        self.boundaries.get(index).map(|b| b.at(t))
+    }
+
+    /// Make boundary `index` go linearly from `temp0` at `t0` to `temp1` at `t1` (K; constant
+    /// when they are equal, and constant outside [t0, t1]): a co-simulation's boundary input over
+    /// one communication step.
+    pub fn set_boundary_ramp(&mut self, index: usize, (t0, temp0): (f64, f64), (t1, temp1): (f64, f64)) {
+        if let Some(b) = self.boundaries.get_mut(index) {
+            *b = if temp0 == temp1 || t1 <= t0 {
+                BoundaryTemp::Fixed(temp0)
+            } else {
+                BoundaryTemp::Series(vec![(t0, temp0), (t1, temp1)])
+            };
+        }
+    }
+
     /// Conductances of the operating-point-dependent links (call once per cycle sample).
     pub fn sample_conductances(&self, op: &Operating, work: &mut NetworkWork) {
         for (g, l) in work.sample_g.iter_mut().zip(&self.sample) {

@@ -577,6 +577,70 @@ where
     Ok(r.stats)
 }
 
+/// What ROS3 carries from one call of [`advance`] to the next, for a caller that integrates
+/// piece by piece (co-simulation, [`super::cosim`]): the state, the step-size proposal, the
+/// learnt loss slopes and the counters. Between calls the integrator is exactly where
+/// [`run`] is between two segments.
+pub(crate) struct Carry {
+    /// State (temperatures K, energies J).
+    pub y: Vec<f64>,
+    /// Next step-size proposal (None before the first step).
+    pub h: Option<f64>,
+    slopes: Option<Slopes>,
+    /// Counters.
+    pub stats: RosStats,
+}
+
+impl Carry {
+    /// At state `y0`, before any step.
+    pub fn new(y0: Vec<f64>) -> Self {
+        Self {
+            y: y0,
+            h: None,
+            slopes: None,
+            stats: RosStats::default(),
+        }
+    }
+}
+
+/// Integrate from `t0` to `t1` with the driver's current inputs, continuing from `carry` as
+/// [`run`] continues from one segment to the next: f at (t0, y) with the current inputs, the
+/// carried step-size proposal (a starting step on the first call), the carried slopes.
+pub(crate) fn advance<M, LS>(
+    d: &Driver<'_>,
+    eqn: &SceneEquations<'_, M>,
+    carry: &mut Carry,
+    t0: f64,
+    t1: f64,
+) -> Result<(), NumericalFailure>
+where
+    M: JacobianMatrix,
+    LS: IterationLu<M>,
+{
+    let mut r = Ros::<M, LS>::new(d, eqn, &carry.y);
+    if let Some(s) = carry.slopes.take() {
+        r.slopes = s;
+    }
+    r.stats = std::mem::take(&mut carry.stats);
+    let mut t = t0;
+    r.eval_f(t)?;
+    let h = carry
+        .h
+        .unwrap_or_else(|| d.restart_step(r.y.host(), r.f.host(), t1 - t0, t1 - t0));
+    let state = d.work.borrow().inputs.state;
+    let result = integrate_segment(&mut r, &mut t, h, t1, state);
+    carry.stats = std::mem::take(&mut r.stats);
+    let h = result?;
+    let y = r.y.host();
+    if let Some(i) = y.iter().position(|v| !v.is_finite()) {
+        return Err(d.failure(t1, y, format!("state component {i} is not finite")));
+    }
+    carry.y.copy_from_slice(y);
+    carry.h = Some(h);
+    carry.slopes = Some(r.slopes);
+    Ok(())
+}
+
 /// Steps from t to `t1` (f at (t, y) already evaluated); returns the next step-size proposal.
 fn integrate_segment<M: JacobianMatrix, LS: IterationLu<M>>(
     r: &mut Ros<'_, '_, M, LS>,

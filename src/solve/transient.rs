@@ -59,11 +59,7 @@ pub fn integrate(
     let method = opts.method.resolve(n);
     let ns = scene.n_states();
     let y0 = scene.initial_state(opts.initial_temp);
-    let mean_c = scene.thermal.capacity.iter().sum::<f64>() / n as f64;
-    let mut atol = vec![opts.atol; ns];
-    for a in atol.iter_mut().skip(n) {
-        *a = opts.atol * mean_c;
-    }
+    let atol = state_atol(scene, opts.atol);
     let work = RefCell::new(scene.work(first.inputs));
     {
         let mut w = work.borrow_mut();
@@ -160,6 +156,18 @@ pub fn integrate(
     traj.switches = w.net.switches.clone();
     traj.wall_time_s = start.elapsed().as_secs_f64();
     Ok(traj)
+}
+
+/// The absolute tolerance of every state: `atol` (K) on temperatures, `atol` × the mean node
+/// capacity (J) on energies.
+pub(crate) fn state_atol(scene: &Scene, atol: f64) -> Vec<f64> {
+    let n = scene.nodes();
+    let mean_c = scene.thermal.capacity.iter().sum::<f64>() / n as f64;
+    let mut out = vec![atol; scene.n_states()];
+    for a in out.iter_mut().skip(n) {
+        *a = atol * mean_c;
+    }
+    out
 }
 
 impl Driver<'_> {

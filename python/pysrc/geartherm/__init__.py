@@ -240,6 +240,41 @@ class Model:
         and ``geartherm check`` accepts the text as a model file."""
         return self._m.to_toml()
 
+    def to_fmu(
+        self,
+        path: PathLike,
+        params: Sequence[str] = (),
+        runtime: Optional[PathLike] = None,
+    ) -> str:
+        """Export the model as an FMI 2.0 co-simulation FMU (as ``geartherm fmu``; docs/fmu.md).
+
+        Parameters
+        ----------
+        path : str or path-like
+            The FMU to write, ``NAME.fmu`` (NAME, made a C identifier, is the model identifier).
+            Written to a temporary file and renamed: nothing is written on error.
+        params : sequence of str
+            Key paths exported as FMU parameters (checked as ``--set``: each must exist and hold
+            a number).
+        runtime : str or path-like, optional
+            The runtime library ``libgeartherm_fmu.so`` (``cargo build --release`` writes it to
+            ``target/release/``); default ``$GEARTHERM_FMU_RUNTIME``. The wheel does not carry it.
+
+        Returns
+        -------
+        str
+            The path written.
+
+        Raises
+        ------
+        ModelError, InputError
+            The model or a parameter key path does not check.
+        OSError
+            No runtime library, or the FMU cannot be written.
+        """
+        rt = None if runtime is None else os.fspath(runtime)
+        return _native.export_fmu(self._m, os.fspath(path), list(params), rt)
+
     def __eq__(self, other: object) -> bool:
         """Equal when the checked models are: every value bit for bit, whatever text, file name
         and overrides made them."""

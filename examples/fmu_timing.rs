@@ -1,0 +1,116 @@
+//! Cost of co-simulation through an exported FMU's instance (`job::fmu::instance`, what every
+//! `fmi2DoStep` calls; no importer overhead) on the AT6 over the WLTC, inputs from the run's
+//! segments (held), boundaries as lines, at communication steps of 1 s and 0.01 s, against the
+//! run itself (`job::run::solve`: the integration and its outputs, as `geartherm run` does it
+//! after reading the model).
+//!
+//! `cargo run --release --example fmu_timing` — CPU time of this thread (the 2-core machine is
+//! shared), median of `FMU_REPEATS` (default 3) repeats. Prints µs per doStep and the ratio of the
+//! co-simulation to the run.
+
+#[path = "common/cpu.rs"]
+mod cpu;
+use cpu::cpu_time;
+
+use std::path::Path;
+use std::sync::Arc;
+
+use geartherm::job::fmu::instance::Instance;
+use geartherm::job::fmu::{FmuModel, Payload, Role};
+use geartherm::job::{run, Model, RunOptions};
+
+const AT6: &str = "models/at6_lepelletier.toml";
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// One WLTC co-simulation at communication step `step`: (CPU seconds, doSteps).
+fn cosim(fm: &Arc<FmuModel>, p: &run::Prepared, step: f64) -> (f64, usize) {
+    let vr = |role: Role| fm.vars.iter().find(|v| v.role == role).map(|v| v.vr).unwrap_or(0);
+    let (speed, torque, vehicle, gear) = (
+        vr(Role::InputSpeed),
+        vr(Role::InputTorque),
+        vr(Role::VehicleSpeed),
+        vr(Role::Gear),
+    );
+    let boundaries: Vec<(usize, u32)> = (0..p.scene.thermal.boundary_names.len())
+        .map(|b| (b, vr(Role::Boundary(b))))
+        .collect();
+    let t0 = cpu_time();
+    let mut inst = Instance::new(fm.clone());
+    inst.enter_initialization().unwrap();
+    inst.exit_initialization().unwrap();
+    let mut steps = 0;
+    for seg in &p.segs {
+        let i = seg.inputs;
+        inst.set(speed, i.input_speed).unwrap();
+        inst.set(torque, i.input_torque).unwrap();
+        inst.set(vehicle, i.vehicle_speed).unwrap();
+        inst.set(gear, i.state as f64).unwrap();
+        let n = ((seg.t1 - seg.t0) / step).round().max(1.0) as usize;
+        for j in 0..n {
+            let a = seg.t0 + (seg.t1 - seg.t0) * j as f64 / n as f64;
+            let b = seg.t0 + (seg.t1 - seg.t0) * (j + 1) as f64 / n as f64;
+            for &(k, r) in &boundaries {
+                let at = |t| p.scene.thermal.boundary_temperature_at(k, t).unwrap();
+                inst.set(r, at(a)).unwrap();
+                inst.set_derivative(r, 1, (at(b) - at(a)) / (b - a)).unwrap();
+            }
+            inst.do_step(a, b - a).unwrap();
+            steps += 1;
+        }
+        // An importer reads the outputs at every communication point; here once per sample.
+        inst.get(vr(Role::TotalLoss)).unwrap();
+    }
+    (cpu_time() - t0, steps)
+}
+
+fn main() {
+    let repeats: usize = std::env::var("FMU_REPEATS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(3);
+    let m = Model::load(Path::new(AT6), &[]).unwrap();
+    let p = run::prepare(&m, &RunOptions::default()).unwrap();
+    let fm = Arc::new(
+        FmuModel::build(Payload {
+            file: AT6.into(),
+            text: std::fs::read_to_string(AT6).unwrap(),
+            overrides: vec![],
+            params: vec![],
+        })
+        .unwrap(),
+    );
+    let run_s = median(
+        (0..repeats)
+            .map(|_| {
+                let t0 = cpu_time();
+                run::solve(&m, &p, &mut |_, _| {}).unwrap();
+                cpu_time() - t0
+            })
+            .collect(),
+    );
+    println!("AT6 WLTC, CPU time, median of {repeats}");
+    println!("run (job::run::solve): {:.2} ms", run_s * 1e3);
+    println!("step_s,do_steps,cosim_ms,us_per_do_step,ratio_to_run");
+    for step in [1.0, 0.01] {
+        let mut n = 0;
+        let s = median(
+            (0..repeats)
+                .map(|_| {
+                    let (s, k) = cosim(&fm, &p, step);
+                    n = k;
+                    s
+                })
+                .collect(),
+        );
+        println!(
+            "{step},{n},{:.2},{:.2},{:.2}",
+            s * 1e3,
+            s * 1e6 / n as f64,
+            s / run_s
+        );
+    }
+}

@@ -1,0 +1,482 @@
+//! One co-simulation instance of an exported model: FMI 2.0's state machine (instantiated →
+//! initialisation → step mode → terminated; reset from anywhere), every value an importer sets
+//! checked as the job layer checks the CLI's options, `doStep` through
+//! [`crate::solve::cosim::Stepper`], outputs computed from the state at the current
+//! communication point with the inputs in force. No FFI here: `fmu/` wraps it.
+//!
+//! Inputs over a communication step: the input speed, torque, vehicle speed and gear are held
+//! (the scene's inputs are piecewise constant, as a drive cycle's samples); a boundary
+//! temperature follows a line from its value with the first derivative the importer set
+//! (`fmi2SetRealInputDerivatives`, order 1), held when none was set. Derivatives are forgotten
+//! after each step.
+
+use std::sync::Arc;
+
+use super::variables::{Causality, Role, Variable};
+use super::FmuModel;
+use crate::job::envelope::Envelope;
+use crate::job::limits::{self, Limit};
+use crate::job::run::DEFAULT_MAX_STEPS;
+use crate::job::{JobError, Model};
+use crate::physics::efficiency::efficiency;
+use crate::physics::oil::KELVIN_OFFSET;
+use crate::scene::{sum_by_source, Inputs, Scene};
+use crate::solve::cosim::Stepper;
+use crate::solve::transient::{Method, TransientOptions};
+
+/// Where an instance is in FMI's state machine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phase {
+    /// After instantiation or reset: parameters and start values may be set.
+    Instantiated,
+    /// Between enter and exit initialisation mode.
+    Initialization,
+    /// Stepping.
+    Step,
+    /// After terminate.
+    Terminated,
+    /// A call failed: only reset, terminate and free.
+    Error,
+}
+
+/// An instance.
+pub struct Instance {
+    fm: Arc<FmuModel>,
+    phase: Phase,
+    /// Value of every variable by value reference − 1 (outputs: the last computed).
+    values: Vec<f64>,
+    /// First derivative of each input over the next step (boundaries only are used).
+    deriv: Vec<f64>,
+    /// Tolerance of `fmi2SetupExperiment`, when defined and `rtol` was not set.
+    setup_tol: Option<f64>,
+    rtol_set: bool,
+    start_time: f64,
+    run: Option<Run>,
+    outputs_fresh: bool,
+}
+
+/// A started instance: the model with its parameters, its scene, the stepper, the envelope its
+/// states are checked against, and the boundary lines last applied.
+struct Run {
+    model: Model,
+    scene: Scene,
+    stepper: Stepper,
+    envelope: Envelope,
+    /// (value, derivative) of each boundary input as last applied to the scene.
+    applied: Vec<(f64, f64)>,
+}
+
+/// A message for the importer's logger.
+pub type Message = String;
+
+fn check_limit(name: &str, limit: &Limit, v: f64) -> Result<(), Message> {
+    limit.check(v).map(|_| ()).map_err(|_| {
+        let why = if v.is_nan() {
+            "not a number; allowed"
+        } else {
+            "outside"
+        };
+        format!("{name} = {v}: {why} {}", limit.allowed())
+    })
+}
+
+/// Check that an export of `fm` can run: an instance initialises with its start values.
+pub fn check_exportable(fm: &FmuModel) -> Result<(), JobError> {
+    let fm = Arc::new(FmuModel::build(fm.payload.clone())?);
+    let mut i = Instance::new(fm);
+    i.enter_initialization().map_err(JobError::invalid)?;
+    i.exit_initialization().map_err(JobError::invalid)?;
+    Ok(())
+}
+
+impl Instance {
+    /// A new instance with every start value.
+    pub fn new(fm: Arc<FmuModel>) -> Instance {
+        let values = fm.vars.iter().map(|v| v.start.unwrap_or(0.0)).collect();
+        let n = fm.vars.len();
+        Instance {
+            fm,
+            phase: Phase::Instantiated,
+            values,
+            deriv: vec![0.0; n],
+            setup_tol: None,
+            rtol_set: false,
+            start_time: 0.0,
+            run: None,
+            outputs_fresh: false,
+        }
+    }
+
+    /// The phase.
+    pub fn phase(&self) -> Phase {
+        self.phase
+    }
+
+    /// The variables.
+    pub fn variables(&self) -> &[Variable] {
+        &self.fm.vars
+    }
+
+    /// Back to the start values (FMI `fmi2Reset`).
+    pub fn reset(&mut self) {
+        *self = Instance::new(self.fm.clone());
+    }
+
+    /// Enter the error phase with `m`.
+    fn fail<T>(&mut self, m: Message) -> Result<T, Message> {
+        self.phase = Phase::Error;
+        Err(m)
+    }
+
+    fn var(&self, vr: u32) -> Result<&Variable, Message> {
+        (vr as usize)
+            .checked_sub(1)
+            .and_then(|k| self.fm.vars.get(k))
+            .ok_or_else(|| format!("value reference {vr} does not exist"))
+    }
+
+    /// `fmi2SetupExperiment`.
+    pub fn setup_experiment(&mut self, tolerance: Option<f64>, start: f64) -> Result<(), Message> {
+        if self.phase != Phase::Instantiated {
+            return Err("setupExperiment is allowed only after instantiation or reset".into());
+        }
+        if !start.is_finite() {
+            return self.fail(format!("start time {start} is not finite"));
+        }
+        if let Some(t) = tolerance {
+            check_limit("tolerance", &limits::RTOL, t)?;
+        }
+        self.setup_tol = tolerance;
+        self.start_time = start;
+        Ok(())
+    }
+
+    /// `fmi2EnterInitializationMode`.
+    pub fn enter_initialization(&mut self) -> Result<(), Message> {
+        if self.phase != Phase::Instantiated {
+            return Err("enterInitializationMode is allowed only after instantiation or reset".into());
+        }
+        self.phase = Phase::Initialization;
+        Ok(())
+    }
+
+    /// `fmi2ExitInitializationMode`: the parameters are applied to the model (checked as the
+    /// model file), the scene compiled, the stepper started.
+    pub fn exit_initialization(&mut self) -> Result<(), Message> {
+        if self.phase != Phase::Initialization {
+            return Err("exitInitializationMode is allowed only in initialization mode".into());
+        }
+        match self.start() {
+            Ok(run) => {
+                self.run = Some(run);
+                self.outputs_fresh = false;
+                self.phase = Phase::Step;
+                Ok(())
+            }
+            Err(m) => self.fail(m),
+        }
+    }
+
+    fn value_of(&self, role: Role) -> f64 {
+        self.fm
+            .vars
+            .iter()
+            .position(|v| v.role == role)
+            .map_or(f64::NAN, |k| self.values[k])
+    }
+
+    fn inputs(&self) -> Inputs {
+        Inputs {
+            state: self.value_of(Role::Gear) as usize,
+            input_speed: self.value_of(Role::InputSpeed),
+            input_torque: self.value_of(Role::InputTorque),
+            vehicle_speed: self.value_of(Role::VehicleSpeed),
+        }
+    }
+
+    /// The model with the parameters, its scene and a stepper at the initial temperatures.
+    fn start(&self) -> Result<Run, Message> {
+        let fm = &self.fm;
+        let params: Vec<f64> = (0..fm.params.len())
+            .map(|k| self.value_of(Role::Param(k)))
+            .collect();
+        let (model, mut scene) = if params.iter().zip(&fm.params).all(|(v, p)| *v == p.value) {
+            (
+                fm.model.clone(),
+                fm.model.compile(&super::needs()).map_err(|e| e.to_string())?,
+            )
+        } else {
+            fm.with_params(&params).map_err(|e| e.to_string())?
+        };
+        let rtol = match (self.rtol_set, self.setup_tol) {
+            (false, Some(t)) => t,
+            _ => self.value_of(Role::Rtol),
+        };
+        check_limit("rtol", &limits::RTOL, rtol)?;
+        let atol = self.value_of(Role::Atol);
+        check_limit("atol", &limits::ATOL, atol)?;
+        let mut y0 = scene.initial_state(None);
+        for (k, y) in y0.iter_mut().enumerate().take(scene.nodes()) {
+            *y = self.value_of(Role::InitialTemp(k));
+        }
+        Envelope::of(&scene)
+            .check(&y0[..scene.nodes()])
+            .map_err(|b| format!("initial temperatures (T_initial.*): {b}"))?;
+        self.apply_boundaries(&mut scene, self.start_time, 0.0);
+        let opts = TransientOptions {
+            method: Method::Ros3,
+            rtol,
+            atol,
+            max_steps: DEFAULT_MAX_STEPS,
+            ..TransientOptions::default()
+        };
+        let stepper = Stepper::new(&scene, y0, self.inputs(), opts, self.start_time)?;
+        Ok(Run {
+            envelope: Envelope::of(&scene),
+            applied: self.boundary_inputs(),
+            model,
+            scene,
+            stepper,
+        })
+    }
+
+    /// (value, derivative) of every boundary input.
+    fn boundary_inputs(&self) -> Vec<(f64, f64)> {
+        self.fm
+            .vars
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| matches!(v.role, Role::Boundary(_)))
+            .map(|(k, _)| (self.values[k], self.deriv[k]))
+            .collect()
+    }
+
+    /// Every boundary from its input over [t, t + h] (a line with the input's derivative).
+    fn apply_boundaries(&self, scene: &mut Scene, t: f64, h: f64) {
+        for (k, v) in self.fm.vars.iter().enumerate() {
+            if let Role::Boundary(b) = v.role {
+                let (x, d) = (self.values[k], self.deriv[k]);
+                scene.thermal.set_boundary_ramp(b, (t, x), (t + h, x + d * h));
+            }
+        }
+    }
+
+    /// Check a value set for `v`.
+    fn check_value(&self, v: &Variable, x: f64) -> Result<(), Message> {
+        let n = &v.name;
+        match v.role {
+            Role::InputSpeed => check_limit(n, &rad_per_s(&limits::SPEED_RPM), x),
+            Role::InputTorque => check_limit(n, &limits::TORQUE_NM, x),
+            Role::VehicleSpeed => check_limit(n, &m_per_s(&limits::VEHICLE_SPEED_KMH), x),
+            Role::Gear => {
+                let states = self.fm.model.gearbox.gear_states.len();
+                if x.fract() == 0.0 && x >= 0.0 && (x as usize) < states {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "gear = {x}: outside [0, {}] (the gear states' indices)",
+                        states - 1
+                    ))
+                }
+            }
+            Role::Boundary(_) => check_limit(n, &kelvin(&limits::AMBIENT_C), x),
+            Role::InitialTemp(_) => check_limit(n, &kelvin(&limits::INITIAL_TEMP_C), x),
+            Role::Rtol => check_limit(n, &limits::RTOL, x),
+            Role::Atol => check_limit(n, &limits::ATOL, x),
+            Role::Param(_) if !x.is_finite() => Err(format!("{n} = {x}: not a finite number")),
+            _ => Ok(()),
+        }
+    }
+
+    /// `fmi2SetReal` / `fmi2SetInteger` of one variable. A bad value is an error (the
+    /// instance then needs a reset).
+    pub fn set(&mut self, vr: u32, x: f64) -> Result<(), Message> {
+        let v = self.var(vr)?.clone();
+        let settable = match v.causality {
+            Causality::Input => self.phase != Phase::Terminated && self.phase != Phase::Error,
+            Causality::Parameter => matches!(self.phase, Phase::Instantiated | Phase::Initialization),
+            Causality::Output => false,
+        };
+        if !settable {
+            return Err(format!("{} cannot be set now ({:?})", v.name, self.phase));
+        }
+        let time = self.run.as_ref().map_or(self.start_time, |r| r.stepper.time());
+        if let Err(m) = self.check_value(&v, x) {
+            return self.fail(format!("t = {time} s: {m}"));
+        }
+        if v.role == Role::Rtol {
+            self.rtol_set = true;
+        }
+        self.values[vr as usize - 1] = x;
+        self.outputs_fresh = false;
+        Ok(())
+    }
+
+    /// `fmi2SetRealInputDerivatives` of one variable (order 1; boundaries follow it, the other
+    /// inputs are held and ignore it).
+    pub fn set_derivative(&mut self, vr: u32, order: i32, d: f64) -> Result<(), Message> {
+        let v = self.var(vr)?.clone();
+        if v.causality != Causality::Input || v.integer {
+            return Err(format!("{}: derivatives only of real inputs", v.name));
+        }
+        if order != 1 {
+            return Err(format!("{}: derivative of order {order}; only order 1", v.name));
+        }
+        if !d.is_finite() {
+            return self.fail(format!("{}: derivative {d} is not finite", v.name));
+        }
+        self.deriv[vr as usize - 1] = d;
+        Ok(())
+    }
+
+    /// `fmi2DoStep` from `t` (the current communication point) over `h`.
+    pub fn do_step(&mut self, t: f64, h: f64) -> Result<(), Message> {
+        if self.phase != Phase::Step {
+            return Err(format!("doStep is allowed only in step mode ({:?})", self.phase));
+        }
+        let inputs = self.inputs();
+        let mut run = self.run.take().ok_or("no run")?;
+        let now = run.stepper.time();
+        if !(h.is_finite() && h > 0.0) || (t - now).abs() > 1e-9 * now.abs().max(1.0) {
+            self.run = Some(run);
+            return self.fail(format!(
+                "doStep from t = {t} s over {h} s: the instance is at t = {now} s and needs h > 0"
+            ));
+        }
+        // Boundaries held at their last values need no new line (nor a fresh work area).
+        let lines = self.boundary_inputs();
+        if lines != run.applied || lines.iter().any(|b| b.1 != 0.0) {
+            self.apply_boundaries(&mut run.scene, now, h);
+            run.stepper.refresh(&run.scene);
+        }
+        run.stepper.set_inputs(&run.scene, inputs);
+        let t1 = now + h;
+        let r = run.stepper.step(&run.scene, t1);
+        let breach = run.envelope.check(&run.stepper.state()[..run.scene.nodes()]);
+        self.deriv.iter_mut().for_each(|d| *d = 0.0);
+        // A line's boundary stays at its end value after t1 (`set_boundary_ramp`).
+        run.applied = self.boundary_inputs();
+        self.run = Some(run);
+        self.outputs_fresh = false;
+        match (r, breach) {
+            (Err(e), _) => self.fail(e.to_string()),
+            (Ok(()), Err(b)) => self.fail(format!(
+                "t = {t1} s: {b}: the result is outside the range where the models hold"
+            )),
+            (Ok(()), Ok(())) => Ok(()),
+        }
+    }
+
+    /// `fmi2GetReal` / `fmi2GetInteger` of one variable.
+    pub fn get(&mut self, vr: u32) -> Result<f64, Message> {
+        let v = self.var(vr)?.clone();
+        if v.causality == Causality::Output && !self.outputs_fresh {
+            self.compute_outputs()?;
+        }
+        Ok(self.values[vr as usize - 1])
+    }
+
+    /// The current time (the start time before initialisation).
+    pub fn time(&self) -> f64 {
+        self.run.as_ref().map_or(self.start_time, |r| r.stepper.time())
+    }
+
+    /// Every output from the state at the current time with the inputs in force.
+    fn compute_outputs(&mut self) -> Result<(), Message> {
+        if self.run.is_none() {
+            if self.phase != Phase::Initialization {
+                return Err("outputs are available from initialization mode on".into());
+            }
+            self.run = Some(self.start()?);
+        }
+        let inputs = self.inputs();
+        let Some(Run {
+            model,
+            scene,
+            stepper,
+            ..
+        }) = self.run.as_mut()
+        else {
+            return Err("no run".into());
+        };
+        stepper.set_inputs(scene, inputs);
+        let q = stepper.losses(scene);
+        let y = stepper.state();
+        let by = sum_by_source(&scene.losses.items, &q);
+        let total: f64 = q.iter().sum();
+        // The losses supplied through the input shaft: not the converter's slip or an
+        // engine-driven pump, paid ahead of it (as `timeseries.csv`'s input torque).
+        let shaft: f64 = scene
+            .losses
+            .items
+            .iter()
+            .zip(&q)
+            .filter(|(it, _)| !it.engine_side)
+            .map(|(_, p)| p)
+            .sum();
+        let energy = scene.loss_energy_by_source(y);
+        let (w, torque) = (inputs.input_speed, inputs.input_torque);
+        let ratio = model.gearbox.gear_states[inputs.state].ratio();
+        let nu = model.gearbox.oil.nu(scene.oil_temp(y));
+        let nodes = y[..scene.nodes()].to_vec();
+        for (k, v) in self.fm.vars.iter().enumerate() {
+            let x = match v.role {
+                Role::NodeTemp(i) => nodes[i],
+                Role::SourceLoss(s) => by[s.index()],
+                Role::TotalLoss => total,
+                Role::SourceEnergy(s) => energy[s.index()],
+                Role::TotalEnergy => energy.iter().sum(),
+                Role::Efficiency => efficiency(torque * w, total).unwrap_or(0.0),
+                Role::OutputSpeed => w / ratio,
+                Role::OutputTorque => torque * ratio,
+                Role::InputTorqueWithLosses => torque + if w > 0.0 { shaft / w } else { 0.0 },
+                Role::OilViscosity => nu,
+                _ => continue,
+            };
+            if !x.is_finite() {
+                let t = stepper.time();
+                self.phase = Phase::Error;
+                return Err(format!("t = {t} s: output {} is not finite", v.name));
+            }
+            self.values[k] = x;
+        }
+        self.outputs_fresh = true;
+        Ok(())
+    }
+
+    /// `fmi2Terminate`.
+    pub fn terminate(&mut self) {
+        self.phase = Phase::Terminated;
+    }
+}
+
+/// A limit in rpm as one in rad/s.
+fn rad_per_s(l: &Limit) -> Limit {
+    let k = std::f64::consts::PI / 30.0;
+    Limit {
+        lo: l.lo * k,
+        hi: l.hi * k,
+        unit: "rad/s",
+        ..*l
+    }
+}
+
+/// A limit in km/h as one in m/s.
+fn m_per_s(l: &Limit) -> Limit {
+    Limit {
+        lo: l.lo / 3.6,
+        hi: l.hi / 3.6,
+        unit: "m/s",
+        ..*l
+    }
+}
+
+/// A limit in °C as one in K.
+fn kelvin(l: &Limit) -> Limit {
+    Limit {
+        lo: l.lo + KELVIN_OFFSET,
+        hi: l.hi + KELVIN_OFFSET,
+        unit: "K",
+        ..*l
+    }
+}

@@ -1,0 +1,271 @@
+//! FMU export and co-simulation: the stepper and an FMU instance reproduce `geartherm run`'s
+//! states at the communication points, bad values set through FMI are errors the instance
+//! recovers from by a reset, and bad exports exit 1 or 3 writing nothing.
+
+use std::path::Path;
+use std::process::Command;
+use std::sync::Arc;
+
+use geartherm::job::fmu::instance::{Instance, Phase};
+use geartherm::job::fmu::{slot, FmuModel, Payload, Role};
+use geartherm::job::{run, Model, RunOptions};
+use geartherm::solve::cosim::Stepper;
+use geartherm::solve::transient::integrate;
+
+const AT6: &str = "models/at6_lepelletier.toml";
+
+fn at6() -> (Model, run::Prepared) {
+    let m = Model::load(Path::new(AT6), &[]).unwrap();
+    let p = run::prepare(&m, &RunOptions::default()).unwrap();
+    (m, p)
+}
+
+fn fmu_model(params: &[&str]) -> Arc<FmuModel> {
+    Arc::new(
+        FmuModel::build(Payload {
+            file: AT6.into(),
+            text: std::fs::read_to_string(AT6).unwrap(),
+            overrides: vec![],
+            params: params.iter().map(|s| s.to_string()).collect(),
+        })
+        .unwrap(),
+    )
+}
+
+#[test]
+fn stepper_fed_a_runs_segments_reproduces_its_states() {
+    let (_, p) = at6();
+    let traj = integrate(&p.scene, &p.segs, &p.opts, &mut |_, _| {}).unwrap();
+    let y0 = p.scene.initial_state(p.opts.initial_temp);
+    let mut s = Stepper::new(&p.scene, y0, p.segs[0].inputs, p.opts.clone(), p.segs[0].t0).unwrap();
+    let mut worst = 0.0f64;
+    for (k, seg) in p.segs.iter().enumerate() {
+        s.set_inputs(&p.scene, seg.inputs);
+        // Outputs read between steps must not change the integration.
+        let _ = s.losses(&p.scene);
+        s.step(&p.scene, seg.t1).unwrap();
+        let row = traj.states.get(k + 1).unwrap();
+        for (a, b) in s.state().iter().zip(row) {
+            worst = worst.max((a - b).abs() / b.abs().max(1.0));
+        }
+    }
+    println!("stepper vs run, AT6 WLTC: largest difference {worst:.3e} (relative, states)");
+    assert!(worst <= 1e-12, "{worst:e}");
+}
+
+/// Drive an instance through the run's segments (inputs held, boundaries as lines), return the
+/// largest temperature difference (K) and energy-per-source difference (relative).
+fn drive_instance(step: f64) -> (f64, f64) {
+    let (_, p) = at6();
+    let traj = integrate(&p.scene, &p.segs, &p.opts, &mut |_, _| {}).unwrap();
+    let fm = fmu_model(&[]);
+    let mut inst = Instance::new(fm.clone());
+    let vr = |role: Role| fm.vars.iter().find(|v| v.role == role).unwrap().vr;
+    inst.enter_initialization().unwrap();
+    inst.exit_initialization().unwrap();
+    let nodes = p.scene.nodes();
+    let (mut dt_max, mut de_max) = (0.0f64, 0.0f64);
+    for (k, seg) in p.segs.iter().enumerate() {
+        let i = seg.inputs;
+        inst.set(vr(Role::InputSpeed), i.input_speed).unwrap();
+        inst.set(vr(Role::InputTorque), i.input_torque).unwrap();
+        inst.set(vr(Role::VehicleSpeed), i.vehicle_speed).unwrap();
+        inst.set(vr(Role::Gear), i.state as f64).unwrap();
+        let n_sub = ((seg.t1 - seg.t0) / step).round().max(1.0) as usize;
+        for j in 0..n_sub {
+            let t0 = seg.t0 + (seg.t1 - seg.t0) * j as f64 / n_sub as f64;
+            let t1 = seg.t0 + (seg.t1 - seg.t0) * (j + 1) as f64 / n_sub as f64;
+            for b in 0..p.scene.thermal.boundary_names.len() {
+                let at = |t| p.scene.thermal.boundary_temperature_at(b, t).unwrap();
+                inst.set(vr(Role::Boundary(b)), at(t0)).unwrap();
+                inst.set_derivative(vr(Role::Boundary(b)), 1, (at(t1) - at(t0)) / (t1 - t0))
+                    .unwrap();
+            }
+            inst.do_step(t0, t1 - t0).unwrap();
+        }
+        let row = traj.states.get(k + 1).unwrap();
+        for (n, t_run) in row.iter().enumerate().take(nodes) {
+            dt_max = dt_max.max((inst.get(vr(Role::NodeTemp(n))).unwrap() - t_run).abs());
+        }
+        let e_run = p.scene.loss_energy_by_source(row);
+        for s in geartherm::job::fmu::variables::sources(&fm.scene) {
+            let e = inst.get(vr(Role::SourceEnergy(s))).unwrap();
+            let r = e_run[s.index()];
+            de_max = de_max.max((e - r).abs() / r.abs().max(1e-300));
+        }
+    }
+    (dt_max, de_max)
+}
+
+#[test]
+fn instance_at_one_second_steps_reproduces_the_run() {
+    let (dt, de) = drive_instance(1.0);
+    println!(
+        "FMU instance vs run, AT6 WLTC, 1 s steps: |dT| ≤ {dt:.3e} K, energy per source ≤ {de:.3e} relative"
+    );
+    assert!(dt <= 1e-6, "{dt:e} K");
+    assert!(de <= 1e-9, "{de:e}");
+}
+
+#[test]
+fn instance_bad_values_are_errors_and_reset_recovers() {
+    let fm = fmu_model(&[]);
+    let vr = |role: Role| fm.vars.iter().find(|v| v.role == role).unwrap().vr;
+    let mut inst = Instance::new(fm.clone());
+    inst.enter_initialization().unwrap();
+    inst.exit_initialization().unwrap();
+    let bad: [(Role, f64, &str); 5] = [
+        (Role::InputSpeed, f64::NAN, "input_speed = NaN"),
+        (Role::InputSpeed, -1.0, "input_speed = -1"),
+        (Role::Gear, 7.0, "gear = 7: outside [0, 6]"),
+        (Role::Gear, -1.0, "gear = -1"),
+        (Role::Boundary(1), f64::INFINITY, "T_boundary.coolant = inf"),
+    ];
+    for (role, v, msg) in bad {
+        let e = inst.set(vr(role), v).unwrap_err();
+        assert!(e.contains(msg) && e.contains("t = 0 s"), "{e}");
+        assert_eq!(inst.phase(), Phase::Error);
+        assert!(inst.do_step(0.0, 1.0).is_err());
+        inst.reset();
+        inst.enter_initialization().unwrap();
+        inst.exit_initialization().unwrap();
+        inst.set(vr(Role::InputSpeed), 200.0).unwrap();
+        inst.set(vr(Role::InputTorque), 100.0).unwrap();
+        inst.do_step(0.0, 1.0).unwrap();
+        assert!(inst.get(vr(Role::NodeTemp(0))).unwrap() > 296.15);
+        inst.reset();
+        inst.enter_initialization().unwrap();
+        inst.exit_initialization().unwrap();
+    }
+    // A communication point that is not the instance's time.
+    assert!(inst.do_step(5.0, 1.0).unwrap_err().contains("at t = 0 s"));
+}
+
+#[test]
+fn parameter_changes_the_model_and_is_checked() {
+    let fm = fmu_model(&["lubrication.oil_level_mm"]);
+    let p = fm.vars.iter().find(|v| v.role == Role::Param(0)).unwrap();
+    assert_eq!(p.name, "param.lubrication.oil_level_mm");
+    let vr = |role: Role| fm.vars.iter().find(|v| v.role == role).unwrap().vr;
+    let churn = |level: f64| {
+        let mut i = Instance::new(fm.clone());
+        i.set(p.vr, level).unwrap();
+        i.enter_initialization().unwrap();
+        i.exit_initialization()?;
+        i.set(vr(Role::InputSpeed), 300.0).unwrap();
+        i.set(vr(Role::InputTorque), 100.0).unwrap();
+        i.get(vr(Role::TotalLoss))
+    };
+    let start = p.start.unwrap();
+    let (a, b) = (churn(start).unwrap(), churn(start + 20.0).unwrap());
+    assert!(b > a, "a higher oil level churns more: {a} W, {b} W");
+    let e = churn(1e6).unwrap_err();
+    assert!(e.contains("oil_level_mm"), "{e}");
+}
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_geartherm"))
+}
+
+/// A stand-in runtime library: a file holding an unpatched model slot (the export patches and
+/// packages it; it is not loaded here).
+fn fake_runtime(dir: &Path) -> std::path::PathBuf {
+    let p = dir.join("libfake.so");
+    let mut bytes = b"\x7fELF not really".to_vec();
+    bytes.extend_from_slice(&slot::unpatched());
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+fn export(dir: &Path, args: &[&str]) -> std::process::Output {
+    bin()
+        .arg("fmu")
+        .args(args)
+        .env("GEARTHERM_FMU_RUNTIME", fake_runtime(dir))
+        .output()
+        .unwrap()
+}
+
+fn listing(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn cli_export_writes_an_fmu_with_the_model_in_its_slot() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("at6.fmu");
+    let o = export(
+        dir.path(),
+        &[
+            AT6,
+            "--out",
+            out.to_str().unwrap(),
+            "--param",
+            "lubrication.oil_level_mm",
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let bytes = std::fs::read(&out).unwrap();
+    assert_eq!(&bytes[..4], b"PK\x03\x04");
+    let text = String::from_utf8_lossy(&bytes);
+    assert!(text.contains("modelDescription.xml") && text.contains("binaries/linux64/at6.so"));
+    assert!(text.contains("name=\"param.lubrication.oil_level_mm\""));
+    assert_eq!(listing(dir.path()), ["at6.fmu", "libfake.so"]);
+}
+
+#[test]
+fn cli_bad_exports_exit_1_or_3_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.fmu");
+    let out_s = out.to_str().unwrap();
+    let cases: [(Vec<&str>, i32, &str); 5] = [
+        (
+            vec!["tests/invalid/bad_loss_model.toml", "--out", out_s],
+            1,
+            "bad_loss_model.toml",
+        ),
+        (
+            vec![AT6, "--out", out_s, "--param", "lubrication.no_such_key"],
+            1,
+            "lubrication.no_such_key",
+        ),
+        (
+            vec![AT6, "--out", out_s, "--param", "oil.catalogue"],
+            1,
+            "not a number",
+        ),
+        (
+            vec![AT6, "--out", "/nonexistent_dir_38/x.fmu"],
+            3,
+            "/nonexistent_dir_38",
+        ),
+        (vec![AT6, "--out", "/proc/x.fmu"], 3, "x.fmu"),
+    ];
+    for (args, code, named) in cases {
+        let o = export(dir.path(), &args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(code), "{args:?}: {err}");
+        assert!(err.contains(named), "{args:?}: {err}");
+        assert_eq!(listing(dir.path()), ["libfake.so"], "{args:?}");
+    }
+    assert!(!Path::new("/nonexistent_dir_38").exists());
+}
+
+#[test]
+fn cli_export_without_a_runtime_library_is_an_io_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.fmu");
+    let o = bin()
+        .args(["fmu", AT6, "--out", out.to_str().unwrap()])
+        .env("GEARTHERM_FMU_RUNTIME", dir.path().join("missing.so"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(3));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("missing.so"));
+    assert!(listing(dir.path()).is_empty());
+}
