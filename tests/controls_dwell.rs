@@ -1,7 +1,7 @@
 //! Two-point controllers with minimum on and off times (`min_on_s`, `min_off_s`): a two-node
 //! network with a thermostatic heater whose solution between switches is analytic (a 2×2 linear
 //! system with a constant source). A switch requested before the minimum time ends happens when
-//! it ends (a time event); the switching instants of ROS3 and BDF within 1e-6 s of the analytic
+//! it ends (a time event); the switching instants of ROS3, BDF and ESDIRK34 within 1e-6 s of the analytic
 //! ones, the recorded temperatures within 1e-6 K, the energy balance closed. Also a controller
 //! with equal set points, accepted with a minimum time.
 
@@ -243,7 +243,11 @@ fn check(l: Law, t_end: f64, dt: f64) {
     assert!(exact.bound >= 3, "the minimum time must bind: {}", exact.bound);
     let segs = uniform(inputs, (t_end / dt) as usize, dt);
     let mut bad = Vec::new();
-    for (method, rtol) in [(Method::Ros3, 1e-12), (Method::Bdf, 1e-13)] {
+    for (method, rtol) in [
+        (Method::Ros3, 1e-12),
+        (Method::Bdf, 1e-13),
+        (Method::Esdirk34, 1e-14),
+    ] {
         let traj = run(&scene, &segs, method, rtol);
         let times: Vec<f64> = traj.events.iter().map(|e| e.0).collect();
         assert_eq!(
