@@ -295,3 +295,36 @@ fn rating_flags_a_rated_point_that_cycles() {
     );
     assert!((lo - 55.0).abs() < 1e-6 && (hi - 60.0).abs() < 1e-6, "{p}");
 }
+
+/// Minimum on and off times: negative, NaN, infinite or beyond a year refused with the key path;
+/// on a valve refused as a key of the wrong kind; equal set points accepted with one and run.
+#[test]
+fn hostile_minimum_times_are_refused() {
+    for (key, v) in [
+        ("min_on_s", "-1.0"),
+        ("min_off_s", "nan"),
+        ("min_on_s", "inf"),
+        ("min_off_s", "1e12"),
+    ] {
+        let c = two_point("60.0", "55.0", "oil", &format!("{COOLER}\n{key} = {v}"));
+        refused(
+            &c,
+            &format!("thermal.controls[0].{key}"),
+            "must lie in [0, 31560000] s",
+        );
+    }
+    let v = "[[thermal.controls]]\nname = \"valve\"\nkind = \"valve\"\nsensor = \"oil\"\n\
+             closed_c = 70.0\nopen_c = 80.0\nmin_on_s = 10.0\ncooler = \"fan_cooler\"\n";
+    refused(
+        v,
+        "thermal.controls[0].min_on_s",
+        "not a key of a valve controller",
+    );
+    // Equal set points without a minimum time keep the refusal and its reason.
+    let zero = two_point("60.0", "60.0", "oil", &format!("{COOLER}\nmin_on_s = 0.0"));
+    refused(&zero, "thermal.controls[0].off_c", "chatter");
+    let ok = two_point("60.0", "60.0", "oil", &format!("{COOLER}\nmin_on_s = 30.0"));
+    let (code, err, written) = run(&ok);
+    assert_eq!(code, 0, "{err}");
+    assert!(written);
+}

@@ -10,6 +10,12 @@
 //! `hi − T` (at the upper limit), where the share `(T − closed)/(open − closed)` meets its limits,
 //! each shifted by [`EDGE_BAND`] to the far side.
 //! An unused function is −1.
+//!
+//! A two-point controller with a minimum on (off) time: while that time since its last switch
+//! has not ended, its first function is the time event `t − (t_last + dwell)` and the state
+//! functions are not watched; at the event it switches when its state function is positive then
+//! (a switch requested during the dwell), and otherwise watches its state function again. The
+//! time of the last switch is kept beside the mode in the work area (`last_switch`).
 
 use crate::model::thermal::{Control, ControlLaw, ControlTarget};
 
@@ -22,6 +28,16 @@ pub const EDGE_BAND: f64 = 1e-8;
 /// Switching functions per controller.
 pub const EVENTS_PER_CONTROL: usize = 2;
 
+/// Relative tolerance of a dwell's end, s per s (of max(1, |end|)): a time this close before the
+/// end counts as the end (the root finders land on it within rounding).
+const DWELL_TOL: f64 = 1e-12;
+
+/// The tolerance on a dwell ending at `end`, s.
+#[inline]
+fn dwell_tol(end: f64) -> f64 {
+    DWELL_TOL * end.abs().max(1.0)
+}
+
 /// State rows per controller after the boundary-energy quadrature: the energy it moved (J) and
 /// the time integral of its share (s; a two-point controller's time on).
 pub const ROWS_PER_CONTROL: usize = 2;
@@ -29,14 +45,21 @@ pub const ROWS_PER_CONTROL: usize = 2;
 /// A controller's law, temperatures in K.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Law {
-    /// On at `on`, off at `off`; cooling when `on > off`.
+    /// On at `on`, off at `off`; cooling when `on > off` (with equal set points: a cooler's or
+    /// link's controller cools, a heater heats).
     TwoPoint {
         /// Switch-on temperature, K.
         on: f64,
         /// Switch-off temperature, K.
         off: f64,
+        /// True when it switches on as the sensor warms.
+        cooling: bool,
         /// State at the start, when given.
         initial_on: Option<bool>,
+        /// Shortest time on, s (0: none).
+        min_on: f64,
+        /// Shortest time off, s (0: none).
+        min_off: f64,
     },
     /// Share `(T − closed)/(open − closed)` between `lo` and `hi` (the temperatures where it
     /// meets `min` and `max`).
@@ -90,8 +113,22 @@ pub struct ControlTerm {
 impl ControlTerm {
     /// Compile a checked controller; `cooler_index` maps a model cooler to its compiled index.
     pub fn compile(c: &Control, cooler_index: impl Fn(usize) -> usize) -> ControlTerm {
+        let heater = matches!(c.target, ControlTarget::Heater { .. });
         let law = match c.law {
-            ControlLaw::TwoPoint { on, off, initial_on } => Law::TwoPoint { on, off, initial_on },
+            ControlLaw::TwoPoint {
+                on,
+                off,
+                initial_on,
+                min_on,
+                min_off,
+            } => Law::TwoPoint {
+                on,
+                off,
+                cooling: on > off || (on == off && !heater),
+                initial_on,
+                min_on,
+                min_off,
+            },
             ControlLaw::Valve {
                 closed,
                 open,
@@ -156,12 +193,50 @@ impl ControlTerm {
         }
     }
 
-    /// The switching functions in `mode` at sensor temperature `t` (K) into `g`.
+    /// True when the controller has a minimum on or off time.
+    pub fn has_min_time(&self) -> bool {
+        matches!(self.law, Law::TwoPoint { min_on, min_off, .. } if min_on > 0.0 || min_off > 0.0)
+    }
+
+    /// The end of the minimum time in `mode` after a switch at `last` (s), when there is one.
+    #[inline]
+    pub fn dwell_end(&self, mode: u8, last: f64) -> Option<f64> {
+        let Law::TwoPoint { min_on, min_off, .. } = self.law else {
+            return None;
+        };
+        let d = if mode == 1 { min_on } else { min_off };
+        (d > 0.0 && last.is_finite()).then_some(last + d)
+    }
+
+    /// True when at time `time` (s) the minimum time in `mode` after a switch at `last` has
+    /// not ended (within its tolerance).
+    #[inline]
+    pub fn in_dwell(&self, mode: u8, time: f64, last: f64) -> bool {
+        self.dwell_end(mode, last)
+            .is_some_and(|end| time < end - 2.0 * dwell_tol(end))
+    }
+
+    /// The switching functions in `mode` at time `time` (s) and sensor temperature `t` (K), the
+    /// last switch at `last` (s), into `g`: within a minimum time its end as a time event.
+    #[inline]
+    pub fn events_at(&self, mode: u8, time: f64, last: f64, t: f64, g: &mut [f64]) {
+        if let Some(end) = self.dwell_end(mode, last) {
+            let end = end - dwell_tol(end);
+            if time < end {
+                g[0] = time - end;
+                g[1] = -1.0;
+                return;
+            }
+        }
+        self.events(mode, t, g);
+    }
+
+    /// The switching functions in `mode` at sensor temperature `t` (K) into `g`, minimum times
+    /// aside.
     #[inline]
     pub fn events(&self, mode: u8, t: f64, g: &mut [f64]) {
         let (a, b) = match self.law {
-            Law::TwoPoint { on, off, .. } => {
-                let cooling = on > off;
+            Law::TwoPoint { on, off, cooling, .. } => {
                 let g = match (cooling, mode == 1) {
                     (true, false) => t - on,
                     (true, true) => off - t,
@@ -198,8 +273,13 @@ impl ControlTerm {
     /// else on when `t` lies beyond the switch-on temperature; a valve by where `t` lies.
     pub fn initial_mode(&self, t: f64) -> u8 {
         match self.law {
-            Law::TwoPoint { on, off, initial_on } => {
-                let beyond = if on > off { t >= on } else { t <= on };
+            Law::TwoPoint {
+                on,
+                cooling,
+                initial_on,
+                ..
+            } => {
+                let beyond = if cooling { t >= on } else { t <= on };
                 u8::from(initial_on.unwrap_or(beyond))
             }
             Law::Valve { lo, hi, .. } => {
@@ -215,13 +295,28 @@ impl ControlTerm {
     }
 
     /// A mode in which no switching function is positive at `t` (the mode after the events
-    /// that are due at this point; unchanged when none is): flips while one is.
-    pub fn settle(&self, mut mode: u8, t: f64) -> u8 {
+    /// that are due at this point; unchanged when none is): flips while one is, minimum times
+    /// aside.
+    pub fn settle(&self, mode: u8, t: f64) -> u8 {
+        self.settle_at(mode, f64::INFINITY, f64::NEG_INFINITY, t)
+    }
+
+    /// [`Self::settle`] at time `time` (s) after a switch at `last` (s): no switch within a
+    /// minimum time, and at most one when the new mode has one.
+    pub fn settle_at(&self, mut mode: u8, time: f64, last: f64, t: f64) -> u8 {
+        if self.in_dwell(mode, time, last) {
+            return mode;
+        }
         let mut g = [0.0; EVENTS_PER_CONTROL];
         for _ in 0..3 {
             self.events(mode, t, &mut g);
             match g.iter().position(|v| *v > 0.0) {
-                Some(slot) => mode = self.flip(mode, slot),
+                Some(slot) => {
+                    mode = self.flip(mode, slot);
+                    if self.dwell_end(mode, time).is_some() {
+                        break;
+                    }
+                }
                 None => break,
             }
         }

@@ -202,9 +202,29 @@ impl Scene {
         (self.thermal.controls.len() + self.thermal.kinks.len()) * super::controls::EVENTS_PER_CONTROL
     }
 
-    /// The controllers' switching functions at state `y` in the work area's modes into `g`.
+    /// The controllers' switching functions at state `y` in the work area's modes into `g`,
+    /// minimum on and off times aside (a steady state, or a scene without them).
     pub fn switching_functions(&self, y: &[f64], work: &Work, g: &mut [f64]) {
-        self.thermal.switching_functions(&y[..self.nodes()], &work.net, g);
+        self.switching_functions_at(f64::INFINITY, y, work, g);
+    }
+
+    /// The controllers' switching functions at time `t` (s) and state `y` into `g`: a
+    /// controller within its minimum on or off time has the time event of its end.
+    pub fn switching_functions_at(&self, t: f64, y: &[f64], work: &Work, g: &mut [f64]) {
+        self.thermal
+            .switching_functions(t, &y[..self.nodes()], &work.net, g);
+    }
+
+    /// True when switching function `idx` at time `t` (s) is the end of a controller's minimum
+    /// on or off time (a time event) rather than its switching surface.
+    pub fn is_dwell_event(&self, t: f64, idx: usize, work: &Work) -> bool {
+        let k = idx / super::controls::EVENTS_PER_CONTROL;
+        let Some(c) = self.thermal.controls.get(k) else {
+            return false;
+        };
+        let last = work.net.last_switch[k];
+        c.dwell_end(work.net.mode[k], last)
+            .is_some_and(|end| t <= end + 1e-9 * end.abs().max(1.0))
     }
 
     /// Set controller `k` to `mode` (counting a switch when it changes) and refresh what depends
@@ -222,13 +242,17 @@ impl Scene {
             .sample_conductances(&Self::operating(&work.inputs), &mut work.net);
     }
 
-    /// Switch the controller of switching function `idx` (the function's root was found).
-    pub fn switch_control(&self, idx: usize, work: &mut Work) {
+    /// Switch the controller of switching function `idx` (the function's root was found) at
+    /// time `t` (s; its last switch when finite).
+    pub fn switch_control(&self, t: f64, idx: usize, work: &mut Work) {
         let e = super::controls::EVENTS_PER_CONTROL;
         let (k, slot) = (idx / e, idx % e);
         if let Some(c) = self.thermal.controls.get(k) {
             let m = c.flip(work.net.mode[k], slot);
             self.set_control_mode(k, m, work);
+            if t.is_finite() {
+                work.net.last_switch[k] = t;
+            }
         } else if let Some(c) = self.thermal.kinks.get(k - self.thermal.controls.len()) {
             let j = k - self.thermal.controls.len();
             work.net.kink_mode[j] = c.flip(work.net.kink_mode[j], slot);
@@ -236,11 +260,21 @@ impl Scene {
     }
 
     /// Settle every controller at state `y`: the modes in which no switching function is
-    /// positive (the events due at this point). Returns true when a mode changed.
+    /// positive (the events due at this point), minimum times aside. Returns true when a mode
+    /// changed.
     pub fn settle_controls(&self, y: &[f64], work: &mut Work) -> bool {
+        self.settle_controls_at(f64::INFINITY, y, work)
+    }
+
+    /// [`Self::settle_controls`] at time `t` (s): a controller within its minimum on or off
+    /// time keeps its mode; one that switches records `t` (when finite) as its last switch.
+    pub fn settle_controls_at(&self, t: f64, y: &[f64], work: &mut Work) -> bool {
         let mut changed = false;
         for (k, c) in self.thermal.controls.iter().enumerate() {
-            let m = c.settle(work.net.mode[k], y[c.sensor]);
+            let m = c.settle_at(work.net.mode[k], t, work.net.last_switch[k], y[c.sensor]);
+            if m != work.net.mode[k] && t.is_finite() {
+                work.net.last_switch[k] = t;
+            }
             changed |= m != work.net.mode[k];
             self.set_control_mode(k, m, work);
         }
@@ -258,6 +292,7 @@ impl Scene {
             let m = c.initial_mode(y[c.sensor]);
             self.set_control_mode(k, m, work);
             work.net.switches[k] = 0;
+            work.net.last_switch[k] = f64::NEG_INFINITY;
         }
         for (j, c) in self.thermal.kinks.iter().enumerate() {
             work.net.kink_mode[j] = c.initial_mode(y[c.sensor]);

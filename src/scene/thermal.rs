@@ -219,6 +219,9 @@ pub struct NetworkWork {
     pub kink_mode: Vec<u8>,
     /// Switches of every controller so far.
     pub switches: Vec<usize>,
+    /// Time of every controller's last switch, s (−∞ before the first): the start of its
+    /// minimum on or off time.
+    pub last_switch: Vec<f64>,
 }
 
 /// The oil as the fluid of the rotating-disc correlation (Pr = μ·c_p/k).
@@ -600,6 +603,7 @@ impl ThermalScene {
                 .map(|c| c.initial_mode(self.initial[c.sensor]))
                 .collect(),
             switches: vec![0; self.controls.len()],
+            last_switch: vec![f64::NEG_INFINITY; self.controls.len()],
             kink_mode: self
                 .kinks
                 .iter()
@@ -749,16 +753,25 @@ impl ThermalScene {
         self.controls.len() * ROWS_PER_CONTROL
     }
 
-    /// Switching functions of every controller at node temperatures `temps` in the work area's
-    /// modes into `g` ([`EVENTS_PER_CONTROL`] each).
-    pub fn switching_functions(&self, temps: &[f64], work: &NetworkWork, g: &mut [f64]) {
-        let modes = work.mode.iter().chain(&work.kink_mode);
-        for ((c, &m), g) in self
+    /// Switching functions of every controller at time `time` (s) and node temperatures
+    /// `temps` in the work area's modes into `g` ([`EVENTS_PER_CONTROL`] each); `time` = +∞
+    /// leaves the minimum times aside.
+    pub fn switching_functions(&self, time: f64, temps: &[f64], work: &NetworkWork, g: &mut [f64]) {
+        let nc = self.controls.len();
+        let (gc, gk) = g.split_at_mut(nc * EVENTS_PER_CONTROL);
+        for (k, (c, g)) in self
             .controls
             .iter()
-            .chain(&self.kinks)
-            .zip(modes)
-            .zip(g.chunks_exact_mut(EVENTS_PER_CONTROL))
+            .zip(gc.chunks_exact_mut(EVENTS_PER_CONTROL))
+            .enumerate()
+        {
+            c.events_at(work.mode[k], time, work.last_switch[k], temps[c.sensor], g);
+        }
+        for ((c, &m), g) in self
+            .kinks
+            .iter()
+            .zip(&work.kink_mode)
+            .zip(gk.chunks_exact_mut(EVENTS_PER_CONTROL))
         {
             c.events(m, temps[c.sensor], g);
         }

@@ -77,9 +77,27 @@ impl Driver<'_> {
         }
     }
 
-    /// Settle the controllers at state `y` (the switches due there); true when one switched.
-    pub(crate) fn settle_controls(&self, y: &[f64]) -> bool {
-        self.scene.settle_controls(y, &mut self.work.borrow_mut())
+    /// Settle the controllers at time `t` and state `y` (the switches due there); true when one
+    /// switched.
+    pub(crate) fn settle_controls(&self, t: f64, y: &[f64]) -> bool {
+        self.scene.settle_controls_at(t, y, &mut self.work.borrow_mut())
+    }
+
+    /// Settle the controllers at time `t` and state `y`, logging each controller that switched.
+    pub(crate) fn settle_and_log(&self, t: f64, y: &[f64]) {
+        let before = self.work.borrow().net.switches.clone();
+        self.settle_controls(t, y);
+        self.log_changed(t, &before);
+    }
+
+    /// Log a switch at `t` of every controller whose switch count differs from `before`.
+    pub(crate) fn log_changed(&self, t: f64, before: &[usize]) {
+        let after = self.work.borrow().net.switches.clone();
+        for (k, (a, b)) in after.iter().zip(before).enumerate() {
+            if a != b {
+                self.log_event(t, k * crate::scene::controls::EVENTS_PER_CONTROL);
+            }
+        }
     }
 
     /// Forget a non-finite trial the integrator recovered from.

@@ -239,10 +239,10 @@ impl<M: JacobianMatrix> Op for SceneRoot<'_, '_, M> {
 }
 
 impl<M: JacobianMatrix> NonLinearOp for SceneRoot<'_, '_, M> {
-    fn call_inplace(&self, x: &M::V, _t: f64, y: &mut M::V) {
+    fn call_inplace(&self, x: &M::V, t: f64, y: &mut M::V) {
         let e = self.0;
         e.scene
-            .switching_functions(x.host(), &e.work.borrow(), y.host_mut());
+            .switching_functions_at(t, x.host(), &e.work.borrow(), y.host_mut());
     }
 }
 

@@ -83,7 +83,7 @@ impl Events {
         let turned = {
             let st = solver.state();
             d.scene
-                .switching_functions(st.y.host(), &d.work.borrow(), &mut self.g);
+                .switching_functions_at(st.t, st.y.host(), &d.work.borrow(), &mut self.g);
             self.g[idx] >= -SWITCH_SLACK
         };
         if turned {
@@ -146,13 +146,17 @@ impl Events {
         S: OdeSolverMethod<'a, Eqn>,
     {
         let t = solver.state().t;
+        let before = d.work.borrow().net.switches.clone();
         {
             let y = solver.state().y.host().to_vec();
             let mut w = d.work.borrow_mut();
-            d.scene.switch_control(idx, &mut w);
-            d.scene.settle_controls(&y, &mut w);
+            // The end of a minimum on or off time switches only when a switch is due then.
+            if !d.scene.is_dwell_event(t, idx, &w) {
+                d.scene.switch_control(t, idx, &mut w);
+            }
+            d.scene.settle_controls_at(t, &y, &mut w);
         }
-        d.log_event(t, idx);
+        d.log_changed(t, &before);
         self.resume(d, solver, t1)
     }
 

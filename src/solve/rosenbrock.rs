@@ -303,20 +303,14 @@ impl<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> Ros<'a, 'd, M, LS> {
         }
     }
 
-    /// Switch every controller whose switching function is positive at (t, y), logging each.
+    /// Switch every controller whose switch is due at (t, y), logging each that switched.
     fn log_switches(&mut self, t: f64) {
-        self.switch_margin(false);
-        for (i, g) in self.g.iter().enumerate() {
-            if *g > 0.0 {
-                self.d.log_event(t, i);
-            }
-        }
-        self.d.settle_controls(self.y.host());
+        self.d.settle_and_log(t, self.y.host());
     }
 
-    /// The largest switching function at state `y` in the current modes: positive once some
-    /// controller's switch is due (−∞ without controllers).
-    fn switch_margin(&mut self, y_is_trial: bool) -> f64 {
+    /// The largest switching function at time `time` and state `y` in the current modes:
+    /// positive once some controller's switch is due (−∞ without controllers).
+    fn switch_margin(&mut self, time: f64, y_is_trial: bool) -> f64 {
         if self.g.is_empty() {
             return f64::NEG_INFINITY;
         }
@@ -327,7 +321,7 @@ impl<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> Ros<'a, 'd, M, LS> {
         };
         self.d
             .scene
-            .switching_functions(y, &self.d.work.borrow(), &mut self.g);
+            .switching_functions_at(time, y, &self.d.work.borrow(), &mut self.g);
         self.g.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b))
     }
 
@@ -337,11 +331,11 @@ impl<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> Ros<'a, 'd, M, LS> {
     /// `tmp` then holds the step to that instant (just past the surface). None when no switch is
     /// due within the step.
     fn locate_event(&mut self, t: f64, h: f64) -> Option<f64> {
-        let fb0 = self.switch_margin(true);
+        let fb0 = self.switch_margin(t + h, true);
         if fb0 <= 0.0 {
             return None;
         }
-        let (mut a, mut fa) = (0.0, self.switch_margin(false).min(0.0));
+        let (mut a, mut fa) = (0.0, self.switch_margin(t, false).min(0.0));
         let (mut b, mut fb) = (h, fb0);
         let tol = EVENT_TIME_TOL * t.abs().max(1.0);
         let mut side = 0i8;
@@ -362,7 +356,7 @@ impl<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> Ros<'a, 'd, M, LS> {
             self.step(t, c);
             self.stats.event_trials += 1;
             last = c;
-            let fc = self.switch_margin(true);
+            let fc = self.switch_margin(t + c, true);
             if fc > 0.0 {
                 (b, fb) = (c, fc);
                 if side == -1 {
@@ -554,7 +548,7 @@ where
     let mut r = Ros::<M, LS>::new(d, eqn, y0);
     let segs = d.segments;
     let mut t = segs[0].t0;
-    d.settle_controls(r.y.host());
+    d.settle_controls(t, r.y.host());
     r.eval_f(t)?;
     d.record_evaluated(traj, t, r.y.host(), 0);
     let len0 = segs[0].t1 - segs[0].t0;

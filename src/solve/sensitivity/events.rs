@@ -210,7 +210,7 @@ impl Tangent<'_> {
         let dtau = self.switch_time_derivatives(y, idx, rate);
         {
             let e = &mut self.nominal;
-            e.scene.switch_control(idx, &mut e.work);
+            e.scene.switch_control(t, idx, &mut e.work);
         }
         self.sync_modes();
         let jump = &f_before - self.nominal_f(t, y);

@@ -12,8 +12,13 @@
 //!   cooler is `(T − closed_c)/(open_c − closed_c)` limited to `[min_share, max_share]`; it scales
 //!   the cooler's ε·C_min.
 //!
-//! Equal set points (no hysteresis) are refused: the controller would switch at every step (it
-//! chatters) and no step size could follow it.
+//!   Optional `min_on_s` and `min_off_s` (s, 0 to [`MIN_TIME_RANGE_S`]'s upper end): a switch
+//!   requested before the controller has been on (off) that long happens when that time ends.
+//!
+//! Equal set points (no hysteresis) are refused unless a minimum on or off time is given: the
+//! controller would switch at every step (it chatters) and no step size could follow it. With
+//! a minimum time, the switches are at least that far apart. A controller with equal set points
+//! cools when it acts on a cooler or link and heats when it is a heater.
 
 use serde::{Deserialize, Serialize};
 
@@ -41,6 +46,9 @@ choice!(ControlKind {
 /// (`solve::equilibrium::OIL_RANGE_C`); a set point outside it could never be reached.
 pub const SET_POINT_RANGE_C: (f64, f64) = (-60.0, 200.0);
 
+/// Minimum on or off times a two-point controller may take, s (a year at most).
+pub const MIN_TIME_RANGE_S: (f64, f64) = (0.0, 3.156e7);
+
 /// `[[thermal.controls]]` as written.
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -61,6 +69,14 @@ pub struct ControlSpec {
     /// temperature, off otherwise).
     #[serde(default)]
     pub initial_on: Option<bool>,
+    /// Two-point: shortest time on, s (default 0): a switch off requested earlier happens when it
+    /// ends.
+    #[serde(default)]
+    pub min_on_s: Option<f64>,
+    /// Two-point: shortest time off, s (default 0): a switch on requested earlier happens when it
+    /// ends.
+    #[serde(default)]
+    pub min_off_s: Option<f64>,
     /// Valve: temperature at which the cooler's share reaches 0 (full bypass), °C.
     #[serde(default)]
     pub closed_c: Option<f64>,
@@ -132,6 +148,10 @@ pub enum ControlLaw {
         off: f64,
         /// State at the start, when given.
         initial_on: Option<bool>,
+        /// Shortest time on, s (0: none).
+        min_on: f64,
+        /// Shortest time off, s (0: none).
+        min_off: f64,
     },
     /// Proportional valve: share `clamp((T − closed)/(open − closed), min, max)`.
     Valve {
@@ -191,6 +211,8 @@ fn refuse_keys(p: &str, c: &ControlSpec, keys: &[&str], problems: &mut Problems)
             "on_c" => c.on_c.is_some(),
             "off_c" => c.off_c.is_some(),
             "initial_on" => c.initial_on.is_some(),
+            "min_on_s" => c.min_on_s.is_some(),
+            "min_off_s" => c.min_off_s.is_some(),
             "closed_c" => c.closed_c.is_some(),
             "open_c" => c.open_c.is_some(),
             "min_share" => c.min_share.is_some(),
@@ -211,13 +233,22 @@ fn refuse_keys(p: &str, c: &ControlSpec, keys: &[&str], problems: &mut Problems)
     }
 }
 
-/// The two-point law: set points in range, distinct (hysteresis).
+/// A minimum on or off time in [`MIN_TIME_RANGE_S`] (default 0); None when out of range.
+fn min_time(problems: &mut Problems, path: &str, v: Option<f64>) -> Option<f64> {
+    let v = v.unwrap_or(0.0);
+    let (lo, hi) = MIN_TIME_RANGE_S;
+    problems.in_range(path, v, lo, hi, " s").then_some(v)
+}
+
+/// The two-point law: set points in range, distinct (hysteresis) unless a minimum time is given.
 fn two_point_law(p: &str, c: &ControlSpec, problems: &mut Problems) -> Option<ControlLaw> {
     refuse_keys(p, c, &["closed_c", "open_c", "min_share", "max_share"], problems);
     let on = set_point(problems, &format!("{p}.on_c"), c.on_c);
     let off = set_point(problems, &format!("{p}.off_c"), c.off_c);
-    let (on, off) = (on?, off?);
-    if on == off {
+    let min_on = min_time(problems, &format!("{p}.min_on_s"), c.min_on_s);
+    let min_off = min_time(problems, &format!("{p}.min_off_s"), c.min_off_s);
+    let (on, off, min_on, min_off) = (on?, off?, min_on?, min_off?);
+    if on == off && min_on == 0.0 && min_off == 0.0 {
         problems.push(
             format!("{p}.off_c"),
             c.off_c.unwrap_or(f64::NAN),
@@ -230,6 +261,8 @@ fn two_point_law(p: &str, c: &ControlSpec, problems: &mut Problems) -> Option<Co
         on,
         off,
         initial_on: c.initial_on,
+        min_on,
+        min_off,
     })
 }
 
@@ -242,6 +275,8 @@ fn valve_law(p: &str, c: &ControlSpec, problems: &mut Problems) -> Option<Contro
             "on_c",
             "off_c",
             "initial_on",
+            "min_on_s",
+            "min_off_s",
             "link",
             "heater_w",
             "heater_node",

@@ -1,0 +1,347 @@
+//! Two-point controllers with minimum on and off times (`min_on_s`, `min_off_s`): a two-node
+//! network with a thermostatic heater whose solution between switches is analytic (a 2×2 linear
+//! system with a constant source). A switch requested before the minimum time ends happens when
+//! it ends (a time event); the switching instants of ROS3, BDF and ESDIRK34 within 1e-6 s of the analytic
+//! ones, the recorded temperatures within 1e-6 K, the energy balance closed. Also a controller
+//! with equal set points, accepted with a minimum time.
+
+use geartherm::physics::oil::KELVIN_OFFSET;
+use geartherm::scene::{Inputs, Scene};
+use geartherm::solve::transient::{energy_balance, integrate, Method, Segment, Trajectory, TransientOptions};
+
+mod common;
+use common::{fzg_with, steady_inputs};
+
+const C1: f64 = 2000.0;
+const C2: f64 = 5000.0;
+const G1: f64 = 20.0;
+const G2: f64 = 10.0;
+const POWER: f64 = 1500.0;
+const AMBIENT_C: f64 = 20.0;
+const START_C: f64 = 30.0;
+
+/// The heater's law: set points (°C) and minimum times (s).
+#[derive(Clone, Copy)]
+struct Law {
+    on_c: f64,
+    off_c: f64,
+    min_on: f64,
+    min_off: f64,
+}
+
+/// Oil (C1) – casing (C2) – ambient, a heater of POWER W on the oil.
+fn network(l: Law) -> String {
+    format!(
+        r#"
+[thermal]
+oil_node = "oil"
+initial_temp_c = {START_C:e}
+[[thermal.nodes]]
+name = "oil"
+capacity_j_per_k = {C1:e}
+[[thermal.nodes]]
+name = "casing"
+capacity_j_per_k = {C2:e}
+[[thermal.boundaries]]
+name = "ambient"
+temp_c = {AMBIENT_C:e}
+[[thermal.links]]
+between = ["oil", "casing"]
+conductance_w_per_k = {G1:e}
+[[thermal.links]]
+between = ["casing", "ambient"]
+conductance_w_per_k = {G2:e}
+[[thermal.controls]]
+name = "heater"
+kind = "two_point"
+sensor = "oil"
+on_c = {:e}
+off_c = {:e}
+min_on_s = {:e}
+min_off_s = {:e}
+heater_w = {POWER:e}
+"#,
+        l.on_c, l.off_c, l.min_on, l.min_off
+    )
+}
+
+/// The scene at standstill with the oil properties frozen (the losses a constant source) and
+/// that source per node.
+fn scene(l: Law) -> (Scene, Inputs, [f64; 2]) {
+    let mut scene = fzg_with(&network(l));
+    scene.frozen_oil_temp = Some(40.0 + KELVIN_OFFSET);
+    let inputs = steady_inputs(0.0, 0.0);
+    let mut w = scene.work(inputs);
+    let y = scene.initial_state(None);
+    scene.evaluate_losses(&y, &mut w);
+    let mut src = [0.0; 2];
+    for (q, dest) in w.q.iter().zip(&scene.thermal.heat) {
+        for &(node, f) in dest {
+            src[node] += f * q;
+        }
+    }
+    (scene, inputs, src)
+}
+
+/// The exact solution of y' = A y + b (A 2×2 with real distinct eigenvalues).
+struct Linear {
+    a: [[f64; 2]; 2],
+    b: [f64; 2],
+}
+
+impl Linear {
+    fn new(src: [f64; 2], heater: f64) -> Linear {
+        let ta = AMBIENT_C + KELVIN_OFFSET;
+        Linear {
+            a: [[-G1 / C1, G1 / C1], [G1 / C2, -(G1 + G2) / C2]],
+            b: [(src[0] + heater) / C1, (src[1] + G2 * ta) / C2],
+        }
+    }
+
+    fn at(&self, y0: [f64; 2], t: f64) -> [f64; 2] {
+        let [[a, b], [c, d]] = self.a;
+        let det = a * d - b * c;
+        let ys = [
+            -(d * self.b[0] - b * self.b[1]) / det,
+            -(-c * self.b[0] + a * self.b[1]) / det,
+        ];
+        let tr = a + d;
+        let disc = (tr * tr / 4.0 - det).sqrt();
+        let (l1, l2) = (tr / 2.0 + disc, tr / 2.0 - disc);
+        let (e1, e2) = ((l1 * t).exp(), (l2 * t).exp());
+        let m = |i: usize, j: usize| {
+            let id = if i == j { 1.0 } else { 0.0 };
+            (e1 * (self.a[i][j] - l2 * id) - e2 * (self.a[i][j] - l1 * id)) / (l1 - l2)
+        };
+        let z = [y0[0] - ys[0], y0[1] - ys[1]];
+        [
+            ys[0] + m(0, 0) * z[0] + m(0, 1) * z[1],
+            ys[1] + m(1, 0) * z[0] + m(1, 1) * z[1],
+        ]
+    }
+
+    /// First time in (0, horizon] at which the oil reaches `target` from the side it starts
+    /// on (bisection on a bracket found by scanning), if any.
+    fn crossing(&self, y0: [f64; 2], target: f64, horizon: f64) -> Option<f64> {
+        let f = |t: f64| self.at(y0, t)[0] - target;
+        let s0 = f(0.0).signum();
+        let dt = 0.25;
+        let mut lo = 0.0;
+        while lo < horizon {
+            let hi = lo + dt;
+            if f(hi).signum() != s0 {
+                let (mut a, mut b) = (lo, hi);
+                for _ in 0..200 {
+                    let m = 0.5 * (a + b);
+                    if f(m).signum() == s0 {
+                        a = m;
+                    } else {
+                        b = m;
+                    }
+                }
+                return Some(0.5 * (a + b));
+            }
+            lo = hi;
+        }
+        None
+    }
+}
+
+/// The analytic switching instants (and which ended a minimum time with a switch already due),
+/// and the state at every multiple of `dt` up to `t_end`.
+struct Exact {
+    switches: Vec<f64>,
+    bound: usize,
+    rows: Vec<[f64; 2]>,
+}
+
+fn analytic(l: Law, src: [f64; 2], t_end: f64, dt: f64) -> Exact {
+    let sys = [Linear::new(src, 0.0), Linear::new(src, POWER)];
+    let k = KELVIN_OFFSET;
+    let mut y = [START_C + k, START_C + k];
+    let mut heating = START_C <= l.on_c;
+    let (mut t, mut last) = (0.0, f64::NEG_INFINITY);
+    let mut out = Exact {
+        switches: Vec::new(),
+        bound: 0,
+        rows: vec![y],
+    };
+    let mut next_row = dt;
+    while t < t_end {
+        let s = &sys[usize::from(heating)];
+        let target = if heating { l.off_c } else { l.on_c } + k;
+        let dwell_end = last + if heating { l.min_on } else { l.min_off };
+        // Within the minimum time: on to its end; a switch is due there when the oil lies
+        // beyond the target.
+        let (ts, by_dwell) = if dwell_end > t {
+            let ye = s.at(y, dwell_end - t);
+            let due = if heating { ye[0] >= target } else { ye[0] <= target };
+            if due {
+                (Some(dwell_end), true)
+            } else {
+                let c = s.crossing(ye, target, t_end - dwell_end + dt);
+                (c.map(|c| dwell_end + c), false)
+            }
+        } else {
+            (s.crossing(y, target, t_end - t + dt).map(|c| t + c), false)
+        };
+        while next_row <= t_end + 1e-9 && ts.map_or(true, |ts| next_row <= ts) {
+            out.rows.push(s.at(y, next_row - t));
+            next_row += dt;
+        }
+        let Some(ts) = ts.filter(|ts| *ts < t_end) else {
+            break;
+        };
+        y = s.at(y, ts - t);
+        if !by_dwell {
+            y[0] = target;
+        }
+        out.bound += usize::from(by_dwell);
+        t = ts;
+        last = ts;
+        out.switches.push(ts);
+        heating = !heating;
+    }
+    out
+}
+
+fn run(scene: &Scene, segs: &[Segment], method: Method, rtol: f64) -> Trajectory {
+    let o = TransientOptions {
+        method,
+        rtol,
+        atol: rtol,
+        ..TransientOptions::default()
+    };
+    integrate(scene, segs, &o, &mut |_, _| {}).unwrap()
+}
+
+fn uniform(inputs: Inputs, n: usize, dt: f64) -> Vec<Segment> {
+    (0..n)
+        .map(|k| Segment {
+            t0: k as f64 * dt,
+            t1: (k + 1) as f64 * dt,
+            inputs,
+        })
+        .collect()
+}
+
+/// Every method's switching instants and rows against the analytic ones.
+fn check(l: Law, t_end: f64, dt: f64) {
+    let (scene, inputs, src) = scene(l);
+    let exact = analytic(l, src, t_end, dt);
+    println!(
+        "analytic: {} switches, {} at the end of a minimum time; first {:?}",
+        exact.switches.len(),
+        exact.bound,
+        &exact.switches[..exact.switches.len().min(6)]
+    );
+    assert!(
+        exact.switches.len() >= 6,
+        "the network must cycle: {:?}",
+        exact.switches
+    );
+    assert!(exact.bound >= 3, "the minimum time must bind: {}", exact.bound);
+    let segs = uniform(inputs, (t_end / dt) as usize, dt);
+    let mut bad = Vec::new();
+    for (method, rtol) in [
+        (Method::Ros3, 1e-12),
+        (Method::Bdf, 1e-13),
+        (Method::Esdirk34, 1e-14),
+    ] {
+        let traj = run(&scene, &segs, method, rtol);
+        let times: Vec<f64> = traj.events.iter().map(|e| e.0).collect();
+        assert_eq!(
+            times.len(),
+            exact.switches.len(),
+            "{method:?}: {times:?} vs {:?}",
+            exact.switches
+        );
+        let dt_worst = times
+            .iter()
+            .zip(&exact.switches)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        let t_worst = traj
+            .states
+            .iter()
+            .zip(&exact.rows)
+            .map(|(y, e)| (y[0] - e[0]).abs().max((y[1] - e[1]).abs()))
+            .fold(0.0, f64::max);
+        let eb = energy_balance(&scene, &traj);
+        println!(
+            "{method:?}: {} switches, worst switching time {dt_worst:.3e} s, worst temperature \
+             {t_worst:.3e} K, energy balance {:.2e}, steps {}",
+            times.len(),
+            eb.relative,
+            traj.stats.steps
+        );
+        if !(dt_worst < 1e-6 && t_worst < 1e-6) {
+            bad.push(format!(
+                "{method:?}: switching time off by {dt_worst:e} s, temperature by {t_worst:e} K"
+            ));
+        }
+        assert!(eb.relative < 1e-9, "{method:?}: energy balance {:e}", eb.relative);
+        assert_eq!(traj.switches, vec![exact.switches.len()]);
+    }
+    assert!(bad.is_empty(), "{bad:?}");
+}
+
+/// Hysteresis 40–45 °C with minimum times longer than the free half-periods: the heater stays
+/// on past 45 °C and off below 40 °C until its minimum time ends.
+#[test]
+fn minimum_times_that_bind_match_the_analytic_switches() {
+    check(
+        Law {
+            on_c: 40.0,
+            off_c: 45.0,
+            min_on: 400.0,
+            min_off: 350.0,
+        },
+        5000.0,
+        50.0,
+    );
+}
+
+/// Equal set points (42 °C) with minimum times: accepted, and the switches are the minimum
+/// times apart or the crossing after them.
+#[test]
+fn equal_set_points_with_minimum_times_match_the_analytic_switches() {
+    check(
+        Law {
+            on_c: 42.0,
+            off_c: 42.0,
+            min_on: 120.0,
+            min_off: 90.0,
+        },
+        4000.0,
+        50.0,
+    );
+}
+
+/// The sensitivities do not carry switching instants across the end of a minimum time: a scene
+/// with one is refused by the tangent integrator, naming the controller and the keys.
+#[test]
+fn sensitivities_refuse_a_controller_with_a_minimum_time() {
+    use geartherm::solve::sensitivity::{integrate_sensitivities, SensitivityOptions};
+    let l = Law {
+        on_c: 40.0,
+        off_c: 45.0,
+        min_on: 400.0,
+        min_off: 350.0,
+    };
+    let (scene, inputs, _) = scene(l);
+    let opts = SensitivityOptions {
+        rtol: 1e-8,
+        atol: 1e-8,
+        max_steps: 1_000_000,
+        initial: None,
+    };
+    let err = integrate_sensitivities(&scene, &[], &uniform(inputs, 4, 50.0), &opts).unwrap_err();
+    assert!(
+        err.message
+            .contains("controller heater has a minimum on or off time"),
+        "{}",
+        err.message
+    );
+    assert!(err.message.contains("min_on_s"), "{}", err.message);
+}
