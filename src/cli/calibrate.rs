@@ -87,9 +87,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
     let text = std::fs::read_to_string(&args.source.model)
         .map_err(|e| io_failure(format!("{}: {e}", args.source.model.display())))?;
     let o = args.options();
-    let file = TraceFile::load(&args.trace, o.missing())
-        .map_err(|e| io_failure(format!("{}: {e}", args.trace.display())))?
-        .map_err(|e| invalid(e.to_string()))?;
+    let file = TraceFile::load(&args.trace, o.missing())?;
     let trace = file.select(o.segment).map_err(|e| invalid(e.to_string()))?;
     let prepared = calibrate::prepare(&m, &text, trace, &o)?;
     let dir = args
@@ -140,9 +138,7 @@ pub fn trace(args: &TraceArgs) -> Result<(), Failure> {
     } else {
         Missing::Drop
     };
-    let file = TraceFile::load(&args.trace, missing)
-        .map_err(|e| io_failure(format!("{}: {e}", args.trace.display())))?
-        .map_err(|e| invalid(e.to_string()))?;
+    let file = TraceFile::load(&args.trace, missing)?;
     let s = file.summary();
     if args.json {
         return emit_json(&s);

@@ -101,9 +101,8 @@ impl OilRange {
             short(v),
             self.allowed(),
             format!(
-                "{} ({}) = {} °C: must lie in {}",
+                "{} = {} °C: must lie in {}",
                 limit.name,
-                limit.flag,
                 short(v),
                 self.describe()
             ),
@@ -272,7 +271,7 @@ mod tests {
         let lim = super::super::limits::FROZEN_VISCOSITY_C;
         let e = r.check_option(&lim, -60.0).unwrap_err();
         assert_eq!(e.exit_code(), 1);
-        assert!(e.message.contains("--frozen-viscosity-c"), "{}", e.message);
+        assert!(e.message.starts_with("frozen_viscosity_c = "), "{}", e.message);
         assert!(e.message.contains(&r.allowed()), "{}", e.message);
         assert!(r.check_option(&lim, 40.0).is_ok());
     }

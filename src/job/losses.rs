@@ -54,7 +54,7 @@ pub fn losses(m: &Model, o: &LossesOptions) -> Result<LossReport, JobError> {
             short(o.oil_temp_c),
             "a temperature where the oil has a finite viscosity",
             format!(
-                "oil_temp_c (--oil-temp-c) = {}: the oil of {} has no finite viscosity there (ν = {} m²/s)",
+                "oil_temp_c = {}: the oil of {} has no finite viscosity there (ν = {} m²/s)",
                 short(o.oil_temp_c),
                 m.label(),
                 op.oil.nu

@@ -63,7 +63,7 @@ impl RatingOptions {
                 n,
                 format!("1 to {} speeds", limits::MAP_AXIS_POINTS.hi),
                 format!(
-                    "speed_rpm (--speed-rpm): {n} speeds; a rating takes 1 to {} speeds",
+                    "speed_rpm: {n} speeds; a rating takes 1 to {} speeds",
                     limits::MAP_AXIS_POINTS.hi
                 ),
             ));
@@ -80,7 +80,7 @@ impl RatingOptions {
                 short(hi),
                 format!("above torque_min_nm = {}", short(self.torque_min_nm)),
                 format!(
-                    "torque_max_nm (--torque-max-nm) = {} N m: must lie above torque_min_nm (--torque-min-nm) = {} N m",
+                    "torque_max_nm = {} N m: must lie above torque_min_nm = {} N m",
                     short(hi),
                     short(self.torque_min_nm)
                 ),

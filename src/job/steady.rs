@@ -151,10 +151,10 @@ pub(crate) fn point_scene(
     // Scene pruning: only this gear state's active items are compiled.
     let needs = Needs {
         states: Some(vec![state]),
+        ambient_k: m.ambient_k(ambient_c)?,
         ..Needs::default()
     };
-    let mut scene = m.compile(&needs)?;
-    m.set_ambient(&mut scene, ambient_c)?;
+    let scene = m.compile(&needs)?;
     Ok((scene, state))
 }
 

@@ -326,7 +326,7 @@ pub fn summary(
         nodes,
         oil_node: scene.thermal.names[scene.thermal.oil].clone(),
         skipped: scene.skipped.clone(),
-        frozen_viscosity: scene.frozen_oil_temp.is_some(),
+        frozen_viscosity: scene.frozen_oil_temp().is_some(),
         warnings: run_warnings(scene, traj, rows),
         launch: launch_summary(&traj.times, rows),
         controls: control_summaries(scene, traj),

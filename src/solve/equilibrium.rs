@@ -291,12 +291,11 @@ fn transient_fallback(
         initial_temp: None,
         ..TransientOptions::default()
     };
-    let mut scene_from = scene.clone();
-    scene_from.oil_temp_clamp = Some(sys.bounds(scene.thermal.oil));
+    let clamped = scene.clone().with_oil_temp_clamp(sys.bounds(scene.thermal.oil));
     let mut last = t0.to_vec();
     // One segment at a time, checking the limits between them.
     for seg in &segs {
-        scene_from.thermal.initial = last.clone();
+        let scene_from = clamped.clone().with_initial(last.clone());
         let traj = integrate(&scene_from, std::slice::from_ref(seg), &o, &mut |_, _| {})
             .map_err(|e| SteadyError::Model(format!("transient fallback failed: {e}")))?;
         let y = traj.states.last().map_or(&last[..], |v| &v[..n]).to_vec();
