@@ -153,8 +153,7 @@ on_c = 40.0
 off_c = 40.5
 heater_w = 1500.0
 "#;
-    let mut scene = common::fzg_with(net);
-    scene.frozen_oil_temp = Some(40.0 + geartherm::physics::oil::KELVIN_OFFSET);
+    let scene = common::fzg_frozen(net, 40.0);
     let inputs = common::steady_inputs(0.0, 0.0);
     let segs: Vec<_> = (0..60)
         .map(|k| geartherm::solve::transient::Segment {

@@ -12,15 +12,15 @@ use std::sync::atomic::AtomicBool;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use geartherm::job::{self, RunOptions};
-use geartherm::study::{runner, Study};
+use geartherm::study::{runner, Selection, Study};
 
 fn benches(c: &mut Criterion) {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let study = Study::from_file(&root.join("models/studies/at6_wltc_lhs.toml")).expect("bundled study");
-    let cases: Vec<_> = study.cases().into_iter().take(64).collect();
+    let cases = Selection::cases((0..64).collect()).expect("64 cases");
     let mut g = c.benchmark_group("study");
     g.sample_size(10);
-    g.throughput(Throughput::Elements(cases.len() as u64));
+    g.throughput(Throughput::Elements(64));
     g.bench_function("at6_wltc/64_cases", |b| {
         b.iter(|| {
             runner::run(&study, black_box(&cases), None, &AtomicBool::new(false), &|_| {}).expect("run")

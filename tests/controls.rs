@@ -9,7 +9,7 @@ use geartherm::scene::{Inputs, Scene};
 use geartherm::solve::transient::{energy_balance, integrate, Method, Segment, Trajectory, TransientOptions};
 
 mod common;
-use common::{fzg_with, steady_inputs};
+use common::{fzg_frozen, steady_inputs};
 
 const C1: f64 = 2000.0;
 const C2: f64 = 5000.0;
@@ -57,8 +57,7 @@ heater_w = {power:e}
 
 /// The scene at standstill with the oil properties frozen: the losses are a constant source.
 fn scene() -> (Scene, Inputs, [f64; 2]) {
-    let mut scene = fzg_with(&heater_network(ON_C, OFF_C, POWER, C1));
-    scene.frozen_oil_temp = Some(40.0 + KELVIN_OFFSET);
+    let scene = fzg_frozen(&heater_network(ON_C, OFF_C, POWER, C1), 40.0);
     let inputs = steady_inputs(0.0, 0.0);
     let mut w = scene.work(inputs);
     let y = scene.initial_state(None);
@@ -281,8 +280,7 @@ fn the_heater_rows_hold_its_energy_and_time_on() {
 /// step size collapsing (the run ends within its step budget), energy balance within 1e-9.
 #[test]
 fn ten_thousand_switches_keep_the_energy_balance() {
-    let mut scene = fzg_with(&heater_network(40.0, 40.5, 1500.0, 50.0));
-    scene.frozen_oil_temp = Some(40.0 + KELVIN_OFFSET);
+    let scene = fzg_frozen(&heater_network(40.0, 40.5, 1500.0, 50.0), 40.0);
     let segs = uniform(steady_inputs(0.0, 0.0), 60, 60.0);
     for method in [Method::Ros3, Method::Bdf] {
         let traj = run(&scene, &segs, method, 1e-6);
@@ -358,8 +356,7 @@ fn steady_state_reports_the_limit_cycle() {
 fn steady_state_with_a_consistent_mode_is_an_equilibrium() {
     use geartherm::solve::equilibrium::equilibrium;
     use geartherm::solve::steady::SteadyOptions;
-    let mut scene = fzg_with(&heater_network(5.0, 10.0, POWER, C1));
-    scene.frozen_oil_temp = Some(40.0 + KELVIN_OFFSET);
+    let scene = fzg_frozen(&heater_network(5.0, 10.0, POWER, C1), 40.0);
     let inputs = steady_inputs(0.0, 0.0);
     let eq = equilibrium(&scene, inputs, None, &SteadyOptions::default()).unwrap();
     assert!(eq.limit_cycle.is_none());
@@ -385,8 +382,7 @@ off_c = 140.0
 link = "casing-air"
 off_fraction = 0.4
 "#;
-    let mut scene = fzg_with(&text);
-    scene.frozen_oil_temp = Some(40.0 + KELVIN_OFFSET);
+    let scene = fzg_frozen(&text, 40.0);
     let segs = uniform(steady_inputs(0.0, 0.0), 40, 50.0);
     let traj = run(&scene, &segs, Method::Ros3, 1e-8);
     let fan = scene.control_row_index() + geartherm::scene::controls::ROWS_PER_CONTROL;

@@ -10,7 +10,7 @@ use geartherm::scene::{Inputs, Scene};
 use geartherm::solve::transient::{energy_balance, integrate, Method, Segment, Trajectory, TransientOptions};
 
 mod common;
-use common::{fzg_with, steady_inputs};
+use common::{fzg_frozen, steady_inputs};
 
 const C1: f64 = 2000.0;
 const C2: f64 = 5000.0;
@@ -68,8 +68,7 @@ heater_w = {POWER:e}
 /// The scene at standstill with the oil properties frozen (the losses a constant source) and
 /// that source per node.
 fn scene(l: Law) -> (Scene, Inputs, [f64; 2]) {
-    let mut scene = fzg_with(&network(l));
-    scene.frozen_oil_temp = Some(40.0 + KELVIN_OFFSET);
+    let scene = fzg_frozen(&network(l), 40.0);
     let inputs = steady_inputs(0.0, 0.0);
     let mut w = scene.work(inputs);
     let y = scene.initial_state(None);

@@ -1,14 +1,16 @@
 //! One pipeline, three front ends: every row of `tests/data/option_limits.toml` (inputs at and
 //! beyond every job option's limits) is sent through the CLI, a study case and the job layer
 //! that the Python binding calls (python/tests/test_drift.py sends it through Python itself);
-//! each must accept or refuse it alike, with the same message.
+//! each must accept or refuse it alike, with the same message. Every form of a case selection
+//! (`--shard I/N`, `--cases LIST`, both) is accepted or refused alike by the CLI and the study
+//! layer that Python and its Dask path call (python/tests/test_drift.py: Python and Dask).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use geartherm::job::{self, LossesOptions, RatingOptions, RunOptions, SteadyOptions};
 use geartherm::study::spec::{JobSpec, Meta, OutputSpec, ParamSpec, Sampling, StudySpec};
-use geartherm::study::{ParamValue, Study, StudyError};
+use geartherm::study::{ParamValue, Selection, Study};
 use toml::{Table, Value};
 
 const MODEL: &str = "models/fzg_c.toml";
@@ -62,6 +64,25 @@ fn flag(k: &str) -> String {
     format!("--{}", k.replace('_', "-"))
 }
 
+/// A CLI message as the job layer wrote it: the CLI adds the flag after an option named at
+/// the message's start (`speed_rpm (--speed-rpm) = …`); the other front ends name the option
+/// only. Every other word must be the same.
+fn unspelled(msg: &str, options: &Table) -> String {
+    let names: Vec<&str> = options.keys().map(String::as_str).collect();
+    unspelled_names(msg, &names)
+}
+
+/// [`unspelled`] for the options `names` (and the options named by the job layer itself).
+fn unspelled_names(msg: &str, names: &[&str]) -> String {
+    for k in names.iter().copied().chain(["gear", "solver", "solvers"]) {
+        let spelled = format!("{k} ({})", flag(k));
+        if let Some(rest) = msg.strip_prefix(&spelled) {
+            return format!("{k}{rest}");
+        }
+    }
+    msg.to_string()
+}
+
 fn cli(row: &Row, out: &Path) -> Outcome {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_geartherm"));
     cmd.current_dir(root()).arg(&row.job).arg(MODEL);
@@ -90,7 +111,7 @@ fn cli(row: &Row, out: &Path) -> Outcome {
         cmd.arg("--quiet").arg("--out").arg(out);
     }
     let o = cmd.output().unwrap();
-    let msg = String::from_utf8_lossy(&o.stderr).trim().to_string();
+    let msg = unspelled(String::from_utf8_lossy(&o.stderr).trim(), &row.options);
     match o.status.code() {
         Some(0) => Outcome::Ok,
         Some(1) => Outcome::Refused(msg),
@@ -161,7 +182,7 @@ fn study(row: &Row, text: &str) -> Option<Outcome> {
     };
     let s = match Study::new(spec, text.to_string(), root().join(MODEL)) {
         Ok(s) => s,
-        Err(StudyError::Job(e)) => {
+        Err(e) if e.is_invalid() => {
             let (_key, msg) = e.message.split_once(": ").unwrap();
             return Some(Outcome::Refused(msg.to_string()));
         }
@@ -212,4 +233,124 @@ fn every_front_end_accepts_and_refuses_alike() {
     }
     eprintln!("{accepted} rows accepted, {refused} refused alike by the CLI, a study case and the job layer");
     assert!(refused > 20 && accepted > 15);
+}
+
+/// A four-case steady study of the FZG C model (`tests/data/selection_study.toml`).
+const SELECTION_STUDY: &str = "tests/data/selection_study.toml";
+
+/// The shard and case-list forms of the drift tests, valid and not (python/tests/test_drift.py
+/// sends the numeric ones through Python and Dask).
+const SHARDS: &[&str] = &[
+    "0/2", "1/2", "3/4", "0/1", "2/2", "3/2", "0/0", "-1/2", "1/-2", "x/2", "1", "1/2/3",
+];
+const CASE_LISTS: &[&str] = &["0", "3,0", "0,1,2,3", "4", "-1", "1,1", "", "a", "2,-3"];
+
+/// The CLI's `study --list` with the selection flags: the case ids listed, or the refusal.
+fn cli_select(flags: &[(&str, &str)]) -> Result<Vec<String>, (i32, String)> {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_geartherm"));
+    cmd.current_dir(root()).args(["study", SELECTION_STUDY, "--list"]);
+    for (flag, value) in flags {
+        cmd.arg(format!("{flag}={value}"));
+    }
+    let o = cmd.output().unwrap();
+    match o.status.code() {
+        Some(0) => Ok(String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .map(|l| l.split('\t').next().unwrap().to_string())
+            .collect()),
+        Some(c) => Err((
+            c,
+            unspelled_names(String::from_utf8_lossy(&o.stderr).trim(), &["shard", "cases"]),
+        )),
+        None => panic!("killed"),
+    }
+}
+
+/// The study layer's selection (what Python and the Dask path call) from the same text.
+fn layer_select(s: &Study, cases: Option<&str>, shard: Option<&str>) -> Result<Vec<String>, (i32, String)> {
+    let picked = Selection::parse(cases, shard).and_then(|sel| s.select(&sel));
+    match picked {
+        Ok(list) => Ok(list.iter().map(|c| s.case_id(c)).collect()),
+        Err(e) => Err((e.exit_code(), e.message)),
+    }
+}
+
+#[test]
+fn every_case_selection_is_accepted_or_refused_alike() {
+    let s = Study::from_file(&root().join(SELECTION_STUDY)).unwrap();
+    assert_eq!(s.cases().len(), 4);
+    let mut forms: Vec<(Option<&str>, Option<&str>)> = Vec::new();
+    forms.extend(SHARDS.iter().map(|x| (None, Some(*x))));
+    forms.extend(CASE_LISTS.iter().map(|x| (Some(*x), None)));
+    forms.extend([(Some("0"), Some("0/2")), (Some("9"), Some("5/2"))]);
+    let (mut accepted, mut refused) = (0, 0);
+    for (cases, shard) in forms {
+        let mut flags = Vec::new();
+        flags.extend(cases.map(|c| ("--cases", c)));
+        flags.extend(shard.map(|x| ("--shard", x)));
+        let c = cli_select(&flags);
+        let l = layer_select(&s, cases, shard);
+        assert_eq!(c, l, "cases {cases:?}, shard {shard:?}");
+        match c {
+            Ok(ids) => {
+                assert!(!ids.is_empty() || shard.is_some(), "{cases:?} {shard:?}");
+                accepted += 1;
+            }
+            Err((code, msg)) => {
+                assert_eq!(code, 1, "{msg}");
+                refused += 1;
+            }
+        }
+    }
+    // The forms' outcomes, as the study layer defines them.
+    assert_eq!(
+        layer_select(&s, None, Some("1/2")).unwrap(),
+        ["000001-p0000", "000003-p0000"]
+    );
+    assert_eq!(
+        layer_select(&s, Some("3,0"), None).unwrap(),
+        ["000003-p0000", "000000-p0000"]
+    );
+    assert_eq!(
+        layer_select(&s, None, Some("3/2")).unwrap_err().1,
+        "shard = 3/2: expected I/N with 0 ≤ I < N"
+    );
+    assert_eq!(
+        layer_select(&s, Some("4"), None).unwrap_err().1,
+        "cases: 4: must lie in [0, 4) (the study has 4 cases)"
+    );
+    eprintln!("{accepted} selections accepted, {refused} refused alike by the CLI and the study layer");
+    assert!(accepted >= 6 && refused >= 12, "{accepted} {refused}");
+}
+
+/// A model, cycle, trace or study file that is read but is not UTF-8 text is bad input (exit 1,
+/// the file named), the same fault sorted the same way by every reader; a missing one is I/O.
+#[test]
+fn a_file_that_is_not_utf8_is_bad_input_for_every_reader() {
+    let tmp = tempfile::tempdir().unwrap();
+    let bad = tmp.path().join("bad.csv");
+    std::fs::write(&bad, b"time_s,speed_kmh\n0,0\n1,\xff\xfe\n").unwrap();
+    let b = bad.display().to_string();
+    let out = tmp.path().join("out").display().to_string();
+    let missing = tmp.path().join("missing.csv").display().to_string();
+    let runs: Vec<(Vec<&str>, i32)> = vec![
+        (vec!["check", &b], 1),
+        (vec!["run", MODEL, "--cycle", &b, "--quiet", "--out", &out], 1),
+        (vec!["trace", &b], 1),
+        (vec!["study", &b, "--quiet", "--out", &out], 1),
+        (vec!["trace", &missing], 3),
+        (vec!["study", &missing], 3),
+    ];
+    for (args, code) in runs {
+        let o = Command::new(env!("CARGO_BIN_EXE_geartherm"))
+            .current_dir(root())
+            .args(&args)
+            .output()
+            .unwrap();
+        let msg = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(code), "{args:?}: {msg}");
+        let file = if code == 1 { "bad.csv" } else { "missing.csv" };
+        assert!(msg.contains(file), "{args:?}: {msg}");
+    }
+    assert!(!tmp.path().join("out").exists(), "nothing written");
 }

@@ -125,10 +125,10 @@ fn bad_options_are_refused_with_their_range() {
     let bad = [
         (
             options("1", &[3000.0], 250.0),
-            "oil_limit_c (--oil-limit-c) = 250 °C: must lie in [-60, 200] °C",
+            "oil_limit_c = 250 °C: must lie in [-60, 200] °C",
         ),
         (options("1", &[], 90.0), "a rating takes 1 to 2000 speeds"),
-        (options("1", &[-5.0], 90.0), "speed_rpm (--speed-rpm) = -5 rpm"),
+        (options("1", &[-5.0], 90.0), "speed_rpm = -5 rpm"),
         (
             RatingOptions {
                 torque_min_nm: 50.0,

@@ -12,7 +12,7 @@ use geartherm::solve::transient::{
 use geartherm::solve::work_precision::{errors, reference};
 
 mod common;
-use common::{fzg_with, steady_inputs};
+use common::{fzg_frozen, steady_inputs};
 
 fn ros3(rtol: f64) -> TransientOptions {
     TransientOptions {
@@ -47,8 +47,7 @@ conductance_w_per_k = 20.0
 fn a_boundary_ramp_is_followed_to_its_analytic_solution() {
     // Measured without the γ_i h ∂f/∂t terms: 0.18 K at rtol 1e-4 and 2.1e-3 K at 1e-8 (25 708
     // steps); with them 1.7e-4 K and 5.4e-7 K.
-    let mut scene = fzg_with(RAMP);
-    scene.frozen_oil_temp = Some(60.0 + KELVIN_OFFSET);
+    let scene = fzg_frozen(RAMP, 60.0);
     let inputs = steady_inputs(0.0, 0.0);
     let segs: Vec<Segment> = (0..40)
         .map(|k| Segment {

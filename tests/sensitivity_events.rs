@@ -11,7 +11,7 @@ use geartherm::solve::sensitivity::{integrate_sensitivities, Direction, Sensitiv
 use geartherm::solve::transient::Segment;
 
 mod common;
-use common::{fzg_with, steady_inputs};
+use common::{fzg_frozen, steady_inputs};
 
 /// The parameters: heater on, off, power; fan on, off; the switched link's conductance.
 const NOMINAL: [f64; 6] = [40.0, 45.0, 1500.0, 38.0, 36.0, 10.0];
@@ -70,9 +70,7 @@ off_fraction = 0.3
 }
 
 fn scene(p: &[f64; 6]) -> Scene {
-    let mut s = fzg_with(&network(p));
-    s.frozen_oil_temp = Some(40.0 + KELVIN_OFFSET);
-    s
+    fzg_frozen(&network(p), 40.0)
 }
 
 fn segments(n: usize, dt: f64) -> Vec<Segment> {

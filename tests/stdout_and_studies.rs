@@ -162,7 +162,7 @@ fn a_study_with_a_bad_option_is_refused_before_it_runs() {
             .arg(&out),
     );
     assert_eq!(c, 1, "{e}");
-    assert!(e.contains("job.options: rtol (--rtol) = 0.5: must lie in"), "{e}");
+    assert!(e.contains("job.options: rtol = 0.5: must lie in"), "{e}");
     assert!(!out.exists());
 }
 

@@ -12,7 +12,7 @@ use geartherm::solve::transient::{
 use nalgebra::{DMatrix, DVector};
 
 mod common;
-use common::{film_network, fzg_with, jumpy, steady_inputs};
+use common::{film_network, fzg_frozen, fzg_with, jumpy, steady_inputs};
 
 const IMPLICIT: [Method; 4] = [Method::Bdf, Method::Esdirk34, Method::TrBdf2, Method::Ros3];
 
@@ -64,8 +64,7 @@ conductance_w_per_k = 5.0
 
 #[test]
 fn one_node_matches_the_exponential_approach() {
-    let mut scene = fzg_with(ONE_NODE);
-    scene.frozen_oil_temp = Some(60.0 + KELVIN_OFFSET);
+    let scene = fzg_frozen(ONE_NODE, 60.0);
     let inputs = steady_inputs(1450.0, 100.0);
     let q = frozen_loss(&scene, inputs);
     assert!(q > 50.0, "loss {q}");
@@ -123,8 +122,7 @@ area_m2 = 0.1
 
 #[test]
 fn three_node_network_matches_its_matrix_exponential() {
-    let mut scene = fzg_with(THREE_NODES);
-    scene.frozen_oil_temp = Some(50.0 + KELVIN_OFFSET);
+    let scene = fzg_frozen(THREE_NODES, 50.0);
     let inputs = steady_inputs(2000.0, 150.0);
     let q = frozen_loss(&scene, inputs);
     // C dT/dt = A T + b.
@@ -212,8 +210,11 @@ thermostat = { open_c = 40.0, full_c = 60.0 }
 
 fn at6_wltc(frozen: Option<f64>) -> (Scene, Trajectory) {
     let gb = model::load(std::path::Path::new("models/at6_lepelletier.toml")).unwrap();
-    let mut scene = Scene::compile(&gb).unwrap();
-    scene.frozen_oil_temp = frozen;
+    let needs = geartherm::scene::Needs {
+        frozen_oil_temp_k: frozen,
+        ..Default::default()
+    };
+    let scene = Scene::compile_for(&gb, &needs).unwrap();
     let cycle = geartherm::cycle::DriveCycle::resolve("wltc").unwrap();
     let (_, segs) = segments(&gb, &cycle).unwrap();
     let traj = run(&scene, &segs, &TransientOptions::default());

@@ -7,27 +7,22 @@
 mod calibrate;
 
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
 
 use geartherm::job::{
     self, ErrorKind, JobError, LossesOptions, MapOptions, RatingOptions, RunOptions, SteadyOptions,
 };
 use geartherm::model::Override;
-use geartherm::report::study::{study_csv, CaseRow};
-use geartherm::study::runner::{self, Output, RunnerError};
-use geartherm::study::spec::StudySpec;
-use geartherm::study::{Case, Study, StudyError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 use serde::{Deserialize, Serialize};
+
+mod study;
 
 /// The Python exception of a failure, built by `geartherm.errors._from_native` (the classes are
 /// plain Python classes there, so they import from `geartherm` and pickle with their fields).
 /// `kind`: `model`, `input`, `solve`, `io`, `not_found` or `error`; `problems`: (path, value,
 /// allowed) triples.
-fn py_error(
+pub(crate) fn py_error(
     kind: &str,
     message: String,
     problems: Vec<(String, String, String)>,
@@ -47,12 +42,9 @@ fn py_error(
 /// `ModelError`, another invalid input an `InputError` (both `ValueError`s, with `.path`,
 /// `.value`, `.allowed` and `.problems`), a numerical failure a `SolveError`, a missing file
 /// `FileNotFoundError`, other I/O `OSError`.
-fn job_error(e: JobError) -> PyErr {
-    job_error_in(e, None)
-}
-
-/// [`job_error`] for a model's own file: an invalid model names it (`.file`).
-fn job_error_in(e: JobError, file: Option<String>) -> PyErr {
+/// The exception class is chosen by the error's kind alone (one table, here); a file that
+/// cannot be read and an invalid model name their file (`.filename`, `.file`).
+pub(crate) fn job_error(e: JobError) -> PyErr {
     let problems: Vec<(String, String, String)> = e
         .problems
         .iter()
@@ -65,7 +57,10 @@ fn job_error_in(e: JobError, file: Option<String>) -> PyErr {
         ErrorKind::Model => "model",
         ErrorKind::Option | ErrorKind::Invalid => "input",
     };
-    let file = if kind == "model" { file } else { None };
+    let file = match kind {
+        "input" | "solve" => None,
+        _ => e.file.map(|f| f.display().to_string()),
+    };
     py_error(kind, e.message, problems, file)
 }
 
@@ -79,33 +74,11 @@ fn trace_error(message: &str) -> PyErr {
     py_error("input", message.to_string(), Vec::new(), None)
 }
 
-fn study_error(e: StudyError) -> PyErr {
-    match e {
-        StudyError::Io { ref source, ref file } => {
-            let kind = if source.kind() == std::io::ErrorKind::NotFound {
-                "not_found"
-            } else {
-                "io"
-            };
-            py_error(kind, e.to_string(), Vec::new(), Some(file.display().to_string()))
-        }
-        StudyError::Invalid(m) => input_error(m),
-        StudyError::Job(j) => job_error(j),
-    }
-}
-
-fn runner_error(e: RunnerError) -> PyErr {
-    match e {
-        RunnerError::Foreign(m) => input_error(m),
-        RunnerError::Io(m) => py_error("io", m, Vec::new(), None),
-    }
-}
-
-fn json_error(what: &str, e: serde_json::Error) -> PyErr {
+pub(crate) fn json_error(what: &str, e: serde_json::Error) -> PyErr {
     input_error(format!("{what}: {e}"))
 }
 
-fn to_json<T: Serialize>(v: &T) -> PyResult<String> {
+pub(crate) fn to_json<T: Serialize>(v: &T) -> PyResult<String> {
     serde_json::to_string(v).map_err(|e| py_error("error", e.to_string(), Vec::new(), None))
 }
 
@@ -147,8 +120,7 @@ fn build(state: State) -> PyResult<Model> {
         })?;
         ovs.push(o);
     }
-    let m = job::Model::from_text(&state.text, &file, &ovs)
-        .map_err(|e| job_error_in(e, Some(state.file.clone())))?;
+    let m = job::Model::from_text(&state.text, &file, &ovs).map_err(job_error)?;
     Ok(Model {
         state,
         m: Arc::new(m),
@@ -166,14 +138,7 @@ impl Model {
     /// Read and check a model file.
     #[staticmethod]
     fn load(path: PathBuf) -> PyResult<Model> {
-        let text = std::fs::read_to_string(&path).map_err(|e| {
-            let msg = format!("{}: cannot read: {e}", path.display());
-            let kind = match e.kind() {
-                std::io::ErrorKind::NotFound => "not_found",
-                _ => "io",
-            };
-            py_error(kind, msg, Vec::new(), Some(path.display().to_string()))
-        })?;
+        let text = job::read_text(&path).map_err(job_error)?;
         build(State {
             text,
             file: path.display().to_string(),
@@ -237,15 +202,7 @@ impl Model {
 
     /// Counts of the checked model (JSON).
     fn check(&self) -> PyResult<String> {
-        let gb = &self.m.gearbox;
-        to_json(&serde_json::json!({
-            "model": gb.name,
-            "gears": gb.gears.len(),
-            "meshes": gb.meshes.len(),
-            "gear_states": gb.gear_states.iter().map(|s| s.name.clone()).collect::<Vec<_>>(),
-            "thermal_nodes": gb.thermal.as_ref().map_or(0, |t| t.nodes.len()),
-            "vehicle": gb.vehicle.is_some(),
-        }))
+        to_json(&self.m.check_report())
     }
 
     /// The `geartherm info --json` report.
@@ -361,79 +318,6 @@ impl Model {
     }
 }
 
-fn load_study(spec: &str, text: String, file: &str) -> PyResult<Study> {
-    let spec: StudySpec = serde_json::from_str(spec).map_err(|e| json_error("study", e))?;
-    Study::new(spec, text, PathBuf::from(file)).map_err(study_error)
-}
-
-/// Read a study file: (the study as JSON, the base model's text, its file name).
-#[pyfunction]
-fn study_file(path: PathBuf) -> PyResult<(String, String, String)> {
-    let s = Study::from_file(&path).map_err(study_error)?;
-    Ok((
-        to_json(&s.spec)?,
-        s.model_text.clone(),
-        s.model_file.display().to_string(),
-    ))
-}
-
-/// Plan a study: (fingerprint, case ids in order, output columns).
-#[pyfunction]
-fn study_cases(spec: &str, text: String, file: &str) -> PyResult<(String, Vec<String>, Vec<String>)> {
-    let s = load_study(spec, text, file)?;
-    let ids = s.cases().iter().map(|c| s.case_id(c)).collect();
-    Ok((s.fingerprint.clone(), ids, s.outputs.clone()))
-}
-
-fn pick_cases(s: &Study, indices: Option<Vec<usize>>, shard: Option<(usize, usize)>) -> PyResult<Vec<Case>> {
-    let all = s.cases();
-    let Some(indices) = indices else {
-        return Ok(match shard {
-            Some((i, n)) => s.shard(i, n),
-            None => all,
-        });
-    };
-    let mut seen = std::collections::HashSet::with_capacity(indices.len());
-    if let Some(i) = indices.iter().find(|&&i| !seen.insert(i)) {
-        return Err(input_error(format!(
-            "cases: {i} is given more than once; each case runs once"
-        )));
-    }
-    indices
-        .iter()
-        .map(|&i| {
-            all.get(i).copied().ok_or_else(|| {
-                input_error(format!(
-                    "cases: {i}: must lie in [0, {n}) (the study has {n} cases)",
-                    n = all.len()
-                ))
-            })
-        })
-        .collect()
-}
-
-/// `threads` held to [`geartherm::job::limits::THREADS`] before any pool is built.
-fn check_threads(threads: Option<usize>) -> PyResult<()> {
-    match threads {
-        Some(n) => geartherm::job::limits::THREADS
-            .check(n as f64)
-            .map(|_| ())
-            .map_err(job_error),
-        None => Ok(()),
-    }
-}
-
-fn in_pool<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> Result<T, String> {
-    match threads {
-        Some(n) => Ok(rayon::ThreadPoolBuilder::new()
-            .num_threads(n.max(1))
-            .build()
-            .map_err(|e| e.to_string())?
-            .install(work)),
-        None => Ok(in_process_pool(work)),
-    }
-}
-
 /// This process's rayon pool. rayon's global pool does not survive a fork: a child forked (a
 /// `multiprocessing` pool's default on Linux) from a process whose global pool had started
 /// inherits a registry whose threads do not exist, and its first parallel call waits forever.
@@ -467,170 +351,11 @@ fn process_pool() -> Option<Arc<rayon::ThreadPool>> {
 }
 
 /// `work` in [`process_pool`] (on the calling thread when no pool can be built).
-fn in_process_pool<T: Send>(work: impl FnOnce() -> T + Send) -> T {
+pub(crate) fn in_process_pool<T: Send>(work: impl FnOnce() -> T + Send) -> T {
     match process_pool() {
         Some(pool) => pool.install(work),
         None => work(),
     }
-}
-
-/// Solve the cases at `indices` (positions in the study's case list) in parallel, GIL released;
-/// `threads` bounds the threads (default: all cores). Returns the rows as a JSON array, in the
-/// order of `indices` (a Dask task's work).
-#[pyfunction]
-#[pyo3(signature = (spec, text, file, indices, threads = None))]
-fn run_cases(
-    py: Python<'_>,
-    spec: &str,
-    text: String,
-    file: &str,
-    indices: Vec<usize>,
-    threads: Option<usize>,
-) -> PyResult<String> {
-    check_threads(threads)?;
-    let s = load_study(spec, text, file)?;
-    let cases = pick_cases(&s, Some(indices.clone()), None)?;
-    let rows = py.detach(|| {
-        in_pool(threads, || {
-            let done: Mutex<Vec<CaseRow>> = Mutex::new(Vec::with_capacity(cases.len()));
-            s.run(&cases, false, &|row, _| {
-                done.lock().unwrap_or_else(|e| e.into_inner()).push(row)
-            });
-            done.into_inner().unwrap_or_else(|e| e.into_inner())
-        })
-    });
-    let mut rows = rows.map_err(|e| py_error("error", e, Vec::new(), None))?;
-    let order: std::collections::HashMap<String, usize> =
-        cases.iter().enumerate().map(|(k, c)| (s.case_id(c), k)).collect();
-    rows.sort_by_key(|r| order.get(&r.case).copied().unwrap_or(usize::MAX));
-    to_json(&rows)
-}
-
-/// Run a study with the library's runner (as `geartherm study`): with `out`, resume from its
-/// journals, journal every case, and (`compact`) write study.csv, study.parquet and the figures
-/// at the end. `progress(done, total)` is called from this thread about ten times a second while
-/// the cases run (GIL released in between); a signal handler that raises (Ctrl-C:
-/// `KeyboardInterrupt`) stops the study cleanly: no new case starts, the running ones finish
-/// and are journaled, then the exception propagates. Returns (the `study.csv` text of every
-/// case done, a tally dict).
-#[pyfunction]
-#[pyo3(signature = (spec, text, file, out = None, shard = None, indices = None, threads = None, progress = None, compact = true))]
-#[allow(clippy::too_many_arguments)]
-fn run_study(
-    py: Python<'_>,
-    spec: &str,
-    text: String,
-    file: &str,
-    out: Option<PathBuf>,
-    shard: Option<(usize, usize)>,
-    indices: Option<Vec<usize>>,
-    threads: Option<usize>,
-    progress: Option<Py<PyAny>>,
-    compact: bool,
-) -> PyResult<(String, Py<PyDict>)> {
-    check_threads(threads)?;
-    let s = load_study(spec, text, file)?;
-    let cases = pick_cases(&s, indices, shard)?;
-    let output = out.as_ref().map(|dir| Output {
-        dir: dir.clone(),
-        shard,
-    });
-    let cancel = AtomicBool::new(false);
-    let done = AtomicUsize::new(0);
-    let mut interrupt: Option<PyErr> = None;
-    let result = std::thread::scope(|scope| {
-        let worker = scope.spawn(|| {
-            in_pool(threads, || {
-                runner::run(&s, &cases, output.as_ref(), &cancel, &|_| {
-                    done.fetch_add(1, Ordering::SeqCst);
-                })
-            })
-        });
-        loop {
-            let finished = py.detach(|| {
-                for _ in 0..10 {
-                    if worker.is_finished() {
-                        return true;
-                    }
-                    std::thread::sleep(Duration::from_millis(10));
-                }
-                worker.is_finished()
-            });
-            if let Some(p) = &progress {
-                if let Err(e) = p.call1(py, (done.load(Ordering::SeqCst), cases.len())) {
-                    interrupt.get_or_insert(e);
-                    cancel.store(true, Ordering::SeqCst);
-                }
-            }
-            if let Err(e) = py.check_signals() {
-                interrupt.get_or_insert(e);
-                cancel.store(true, Ordering::SeqCst);
-            }
-            if finished {
-                break;
-            }
-        }
-        worker.join()
-    });
-    let result = result.map_err(|_| py_error("error", "study runner panicked".into(), Vec::new(), None))?;
-    let (tally, rows) = result
-        .map_err(|e| py_error("error", e, Vec::new(), None))?
-        .map_err(runner_error)?;
-    if let Some(e) = interrupt {
-        return Err(e);
-    }
-    let table = match (&out, compact && shard.is_none()) {
-        (Some(dir), true) => {
-            py.detach(|| runner::compact(&s, dir))
-                .map_err(runner_error)?
-                .table
-        }
-        (Some(dir), false) => runner::journaled(&s, dir).map_err(runner_error)?,
-        (None, _) => runner::table(&s, rows),
-    };
-    let csv = study_csv(&table).map_err(|e| py_error("io", format!("study.csv: {e}"), Vec::new(), None))?;
-    let t = PyDict::new(py);
-    t.set_item("cases", tally.cases)?;
-    t.set_item("already_done", tally.already_done)?;
-    t.set_item("solved", tally.solved)?;
-    t.set_item("wall_s", tally.wall_s)?;
-    t.set_item("threads", tally.threads)?;
-    t.set_item("cancelled", tally.cancelled)?;
-    Ok((String::from_utf8_lossy(&csv).into_owned(), t.unbind()))
-}
-
-/// Journal rows solved elsewhere (a Dask task's JSON array) into `out`, as the runner does.
-#[pyfunction]
-fn study_record(spec: &str, text: String, file: &str, out: PathBuf, rows: &str) -> PyResult<()> {
-    let s = load_study(spec, text, file)?;
-    let rows: Vec<CaseRow> = serde_json::from_str(rows).map_err(|e| json_error("rows", e))?;
-    runner::record(&s, &out, &rows).map_err(runner_error)
-}
-
-/// Case ids already journaled in `out`.
-#[pyfunction]
-fn study_done(spec: &str, text: String, file: &str, out: PathBuf) -> PyResult<Vec<String>> {
-    let s = load_study(spec, text, file)?;
-    let t = runner::journaled(&s, &out).map_err(runner_error)?;
-    Ok(t.rows.into_iter().map(|r| r.case).collect())
-}
-
-/// Compact the journals of `out` (study.csv, study.parquet, figures); the `study.csv` text.
-#[pyfunction]
-fn study_compact(py: Python<'_>, spec: &str, text: String, file: &str, out: PathBuf) -> PyResult<String> {
-    let s = load_study(spec, text, file)?;
-    let c = py.detach(|| runner::compact(&s, &out)).map_err(runner_error)?;
-    Ok(String::from_utf8_lossy(&c.csv).into_owned())
-}
-
-/// The `study.csv` text of rows (a JSON array) in the study's case order.
-#[pyfunction]
-fn study_table(spec: &str, text: String, file: &str, rows: &str) -> PyResult<String> {
-    let s = load_study(spec, text, file)?;
-    let rows: Vec<CaseRow> = serde_json::from_str(rows).map_err(|e| json_error("rows", e))?;
-    let csv = study_csv(&runner::table(&s, rows))
-        .map_err(|e| py_error("io", format!("study.csv: {e}"), Vec::new(), None))?;
-    Ok(String::from_utf8_lossy(&csv).into_owned())
 }
 
 /// The oil catalogue as JSON (key, name, viscosities, density, base stock, sources).
@@ -673,13 +398,6 @@ fn cycles() -> PyResult<String> {
     to_json(&v)
 }
 
-/// The equivalent `geartherm` command line of every case (for job arrays without Python).
-#[pyfunction]
-fn study_commands(spec: &str, text: String, file: &str) -> PyResult<Vec<String>> {
-    let s = load_study(spec, text, file)?;
-    Ok(s.cases().iter().map(|c| s.command_line(c)).collect())
-}
-
 /// The loss sources in output order (the order of every per-source column and key).
 #[pyfunction]
 fn sources() -> Vec<&'static str> {
@@ -711,20 +429,6 @@ fn render_calibration(py: Python<'_>, dir: PathBuf) -> PyResult<()> {
         .map_err(|e| py_error("io", format!("calibration.png: {e}"), Vec::new(), None))
 }
 
-/// Case `index` of a study: (its overrides as `"path = toml value"` lines, its job as JSON:
-/// `{"kind": "run", "options": RunOptions}` or `{"kind": "steady", "options": SteadyOptions}`).
-#[pyfunction]
-fn study_case(spec: &str, text: String, file: &str, index: usize) -> PyResult<(Vec<String>, String)> {
-    let s = load_study(spec, text, file)?;
-    let c = pick_cases(&s, Some(vec![index]), None)?[0];
-    let (ovs, _) = s.overrides(c.sample).map_err(input_error)?;
-    let job = match &s.case_job(&c, s.spec.outputs.per_case) {
-        geartherm::study::Job::Run(o) => serde_json::json!({"kind": "run", "options": o}),
-        geartherm::study::Job::Steady(o) => serde_json::json!({"kind": "steady", "options": o}),
-    };
-    Ok((ovs.iter().map(|o| o.to_string()).collect(), to_json(&job)?))
-}
-
 /// The `geartherm` command line (the program's name first), run in this process exactly as the
 /// binary runs it, with the GIL released; returns the exit code (the console script exits with
 /// it).
@@ -745,22 +449,13 @@ mod fmu;
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Model>()?;
     m.add_function(wrap_pyfunction!(fmu::export_fmu, m)?)?;
-    m.add_function(wrap_pyfunction!(study_file, m)?)?;
-    m.add_function(wrap_pyfunction!(study_cases, m)?)?;
-    m.add_function(wrap_pyfunction!(run_cases, m)?)?;
-    m.add_function(wrap_pyfunction!(run_study, m)?)?;
-    m.add_function(wrap_pyfunction!(study_record, m)?)?;
-    m.add_function(wrap_pyfunction!(study_done, m)?)?;
-    m.add_function(wrap_pyfunction!(study_compact, m)?)?;
-    m.add_function(wrap_pyfunction!(study_table, m)?)?;
-    m.add_function(wrap_pyfunction!(study_commands, m)?)?;
+    study::register(m)?;
     m.add_function(wrap_pyfunction!(oils, m)?)?;
     m.add_function(wrap_pyfunction!(cycles, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     m.add_function(wrap_pyfunction!(cli, m)?)?;
     m.add_function(wrap_pyfunction!(read_trace, m)?)?;
     m.add_function(wrap_pyfunction!(render_calibration, m)?)?;
-    m.add_function(wrap_pyfunction!(study_case, m)?)?;
     m.add_function(wrap_pyfunction!(sources, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate::priors_from_file, m)?)?;
     Ok(())

@@ -116,20 +116,16 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
         .map_err(|e| io_failure(format!("{}: {e}", args.source.model.display())))?;
     let mut o = args.options();
     if let Some(path) = &args.priors {
-        let text =
-            std::fs::read_to_string(path).map_err(|e| io_failure(format!("{}: {e}", path.display())))?;
+        let text = crate::job::read_text(path)?;
         let mut from_file = calibrate::prior::from_file(&text, &path.display().to_string())?;
         from_file.append(&mut o.prior);
         o.prior = from_file;
     }
-    let file = TraceFile::load(&args.trace, o.missing())
-        .map_err(|e| io_failure(format!("{}: {e}", args.trace.display())))?
-        .map_err(|e| invalid(e.to_string()))?;
+    let file = TraceFile::load(&args.trace, o.missing())?;
     let trace = file.select(o.segment).map_err(|e| invalid(e.to_string()))?;
     let mut prepared = calibrate::prepare(&m, &text, trace, &o)?;
     if let Some(path) = &args.band_from {
-        let json =
-            std::fs::read_to_string(path).map_err(|e| io_failure(format!("{}: {e}", path.display())))?;
+        let json = crate::job::read_text(path)?;
         prepared.band_from(&json, &path.display().to_string())?;
     }
     let dir = args
@@ -180,9 +176,7 @@ pub fn trace(args: &TraceArgs) -> Result<(), Failure> {
     } else {
         Missing::Drop
     };
-    let file = TraceFile::load(&args.trace, missing)
-        .map_err(|e| io_failure(format!("{}: {e}", args.trace.display())))?
-        .map_err(|e| invalid(e.to_string()))?;
+    let file = TraceFile::load(&args.trace, missing)?;
     let s = file.summary();
     if args.json {
         return emit_json(&s);

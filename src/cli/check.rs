@@ -60,13 +60,13 @@ impl LossesArgs {
 /// Run `check`.
 pub fn check(a: &ModelArgs) -> Result<(), Failure> {
     let m = a.source.load()?;
-    let gb = &m.gearbox;
+    let r = m.check_report();
     emit(&format!(
         "{}: ok ({} gears, {} meshes, {} gear states)\n",
         m.label(),
-        gb.gears.len(),
-        gb.meshes.len(),
-        gb.gear_states.len()
+        r.gears,
+        r.meshes,
+        r.gear_states.len()
     ))
 }
 

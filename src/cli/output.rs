@@ -8,12 +8,10 @@
 
 use std::io::{ErrorKind, IsTerminal, Write};
 
-use crate::job::JobError;
+use crate::job::{ErrorKind as ErrorKindJob, JobError};
 
-/// Exit code: invalid input (nothing written).
-pub const EXIT_INVALID: i32 = 1;
-/// Exit code: I/O failure.
-pub const EXIT_IO: i32 = 3;
+/// Exit code: I/O failure (the code of [`crate::job::ErrorKind::Io`]).
+pub const EXIT_IO: i32 = crate::job::ErrorKind::Io.exit_code();
 /// Exit code: standard output closed by its reader (128 + SIGPIPE).
 pub const EXIT_BROKEN_PIPE: i32 = 141;
 
@@ -27,37 +25,34 @@ pub struct Failure {
 }
 
 impl From<JobError> for Failure {
+    /// The exit code of the error's kind; an option named at the message's start gets its
+    /// flag after it (the command line's spelling of the job layer's option names).
     fn from(e: JobError) -> Self {
+        let option = match e.kind {
+            ErrorKindJob::Option => e.problems.first().map(|p| p.path.as_str()),
+            _ => None,
+        };
         Failure {
             code: e.exit_code(),
-            message: e.message,
+            message: crate::job::options::spelled_for_cli(&e.message, option),
         }
     }
 }
 
 impl From<crate::report::files::OutputError> for Failure {
     fn from(e: crate::report::files::OutputError) -> Self {
-        Failure {
-            code: EXIT_IO,
-            message: format!("cannot write outputs: {e}"),
-        }
+        JobError::from(e).into()
     }
 }
 
-/// Invalid input described by a message.
+/// Invalid input described by a message (the exit code of [`crate::job::ErrorKind::Invalid`]).
 pub fn invalid(message: String) -> Failure {
-    Failure {
-        code: EXIT_INVALID,
-        message,
-    }
+    JobError::invalid(message).into()
 }
 
-/// I/O failure described by a message.
+/// I/O failure described by a message (the exit code of [`crate::job::ErrorKind::Io`]).
 pub fn io_failure(message: String) -> Failure {
-    Failure {
-        code: EXIT_IO,
-        message,
-    }
+    JobError::io(message, ErrorKind::Other).into()
 }
 
 /// The failure of a write to standard output.

@@ -4,10 +4,11 @@
 
 use std::path::PathBuf;
 
+use crate::job::JobError;
 use crate::report::files::OutputDir;
-use crate::report::plots::{self, PlotError};
+use crate::report::plots;
 
-use super::output::{emit, invalid, EXIT_INVALID, EXIT_IO};
+use super::output::{emit, invalid};
 use super::Failure;
 
 /// Arguments of `report`.
@@ -17,16 +18,9 @@ pub struct ReportArgs {
     pub dir: PathBuf,
 }
 
-fn failure(e: PlotError) -> Failure {
-    Failure {
-        // Unreadable or malformed inputs are invalid input; failing to write is I/O.
-        code: match &e {
-            PlotError::Csv { .. } | PlotError::Json { .. } | PlotError::Data { .. } => EXIT_INVALID,
-            PlotError::Io { source, .. } if source.kind() == std::io::ErrorKind::InvalidData => EXIT_INVALID,
-            _ => EXIT_IO,
-        },
-        message: format!("report: {e}"),
-    }
+/// A figure's failure with the exit code of its kind ([`JobError`]'s conversion).
+fn failure(e: plots::PlotError) -> Failure {
+    JobError::from(e).into()
 }
 
 /// Run `report`.

@@ -1,4 +1,4 @@
-//! `geartherm study STUDY.toml --out DIR [--shard I/N] [--list]`: parses, runs the study with
+//! `geartherm study STUDY.toml --out DIR [--shard I/N | --cases LIST] [--list]`: parses, runs the study with
 //! the library's runner (`crate::study::runner`: journal, resume, compaction) under a
 //! progress bar, stops cleanly on Ctrl-C (exit 130, resumable), prints the tally.
 
@@ -6,10 +6,10 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::report::study::CaseRow;
-use crate::study::runner::{self, Output, RunnerError};
-use crate::study::{Case, Study, StudyError};
+use crate::study::runner;
+use crate::study::{Case, Selection, Study};
 
-use super::output::{emit, invalid, progress_bar, warn, Failure, EXIT_IO};
+use super::output::{emit, progress_bar, warn, Failure, EXIT_IO};
 
 /// Arguments of `study`.
 #[derive(clap::Args, Debug)]
@@ -21,8 +21,11 @@ pub struct StudyArgs {
     pub out: Option<PathBuf>,
     /// Run only shard I of N (cases I, I+N, I+2N, …; I from 0), e.g. from a Slurm job array;
     /// a later run without --shard merges the shards' journals into study.csv.
-    #[arg(long, value_name = "I/N")]
+    #[arg(long, value_name = "I/N", allow_hyphen_values = true)]
     pub shard: Option<String>,
+    /// Run only these cases (positions in the case list, from 0, comma-separated), each once.
+    #[arg(long, value_name = "LIST", allow_hyphen_values = true)]
+    pub cases: Option<String>,
     /// Print each case's id and the equivalent stand-alone `geartherm run`/`steady` command
     /// line, then exit.
     #[arg(long)]
@@ -30,19 +33,6 @@ pub struct StudyArgs {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
-}
-
-fn parse_shard(s: &str) -> Result<(usize, usize), Failure> {
-    let bad = || invalid(format!("--shard {s}: expected I/N with 0 ≤ I < N"));
-    let (i, n) = s.split_once('/').ok_or_else(bad)?;
-    let (i, n): (usize, usize) = (
-        i.trim().parse().map_err(|_| bad())?,
-        n.trim().parse().map_err(|_| bad())?,
-    );
-    if n == 0 || i >= n {
-        return Err(bad());
-    }
-    Ok((i, n))
 }
 
 /// Each case's id and stand-alone command line, one per line, written as they are rendered (a
@@ -102,32 +92,11 @@ fn release_sigint() {
     }
 }
 
-fn runner_failure(e: RunnerError) -> Failure {
-    match e {
-        RunnerError::Foreign(m) => invalid(m),
-        RunnerError::Io(m) => Failure {
-            code: EXIT_IO,
-            message: m,
-        },
-    }
-}
-
 /// Run `study`.
 pub fn study(a: &StudyArgs) -> Result<(), Failure> {
-    let study = Study::from_file(&a.study).map_err(|e| match e {
-        // A study or model file that cannot be read is I/O, as for every other command.
-        StudyError::Io { .. } => Failure {
-            code: EXIT_IO,
-            message: e.to_string(),
-        },
-        StudyError::Invalid(m) => invalid(m),
-        StudyError::Job(j) => j.into(),
-    })?;
-    let shard = a.shard.as_deref().map(parse_shard).transpose()?;
-    let cases = match shard {
-        Some((i, n)) => study.shard(i, n),
-        None => study.cases(),
-    };
+    let study = Study::from_file(&a.study)?;
+    let selection = Selection::parse(a.cases.as_deref(), a.shard.as_deref())?;
+    let cases = study.select(&selection)?;
     if a.list {
         return list(&study, &cases);
     }
@@ -135,10 +104,6 @@ pub fn study(a: &StudyArgs) -> Result<(), Failure> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("studies").join(&study.spec.study.name));
-    let out = Output {
-        dir: dir.clone(),
-        shard,
-    };
     let b = progress_bar(
         cases.len(),
         "{msg} [{bar:40}] {pos}/{len} cases, {per_sec}, ETA {eta}",
@@ -146,13 +111,13 @@ pub fn study(a: &StudyArgs) -> Result<(), Failure> {
         a.quiet,
     );
     catch_sigint();
-    let solved = runner::run(&study, &cases, Some(&out), &INTERRUPTED, &|_| {
+    let solved = runner::run(&study, &selection, Some(&dir), &INTERRUPTED, &|_| {
         if let Some(b) = &b {
             b.inc(1);
         }
     });
     release_sigint();
-    let (tally, _) = solved.map_err(runner_failure)?;
+    let (tally, _) = solved?;
     if let Some(b) = &b {
         b.finish_and_clear();
     }
@@ -175,14 +140,14 @@ pub fn study(a: &StudyArgs) -> Result<(), Failure> {
             ),
         });
     }
-    if let Some((i, n)) = shard {
+    if let Some((i, n)) = selection.journal_shard() {
         return emit(&format!(
             "shard {i}/{n} done; run `geartherm study {} --out {}` once every shard finished to merge them\n",
             a.study.display(),
             dir.display()
         ));
     }
-    let c = runner::compact(&study, &dir).map_err(runner_failure)?;
+    let c = runner::compact(&study, &dir)?;
     let failed: Vec<&CaseRow> = c.table.rows.iter().filter(|r| r.status != "ok").collect();
     for r in failed.iter().take(20) {
         warn(&format!(

@@ -133,7 +133,12 @@ impl DriveCycle {
         let path = path.as_ref();
         let source = path.display().to_string();
         let text = std::fs::read_to_string(path).map_err(|e| {
-            CycleError::new(CycleErrorKind::Io, &source, format!("cannot read the file: {e}"))
+            // A file that is read but is not UTF-8 text is malformed input, as a model file.
+            let kind = match e.kind() {
+                std::io::ErrorKind::InvalidData => CycleErrorKind::Header,
+                _ => CycleErrorKind::Io,
+            };
+            CycleError::new(kind, &source, format!("cannot read the file: {e}"))
         })?;
         DriveCycle::parse(&text, &source)
     }

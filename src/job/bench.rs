@@ -52,7 +52,7 @@ impl BenchOptions {
                 "solvers",
                 "",
                 "one or more solver names",
-                "solvers (--solvers): none given".into(),
+                "solvers: none given".into(),
             ));
         }
         self.solvers.iter().map(|s| method(s.trim())).collect()

@@ -28,7 +28,7 @@ pub fn command_line<T: ToArgs>(model: &Path, overrides: &[Override], options: &T
     let mut words = vec!["geartherm".to_string(), T::COMMAND.to_string()];
     words.push(model.display().to_string());
     for o in overrides {
-        words.push("--set".into());
+        words.push(super::options::flag("set"));
         words.push(o.to_string());
     }
     words.extend(options.to_args());
@@ -85,8 +85,9 @@ fn num(x: f64) -> String {
     format!("{x}")
 }
 
+/// Option `name` with its value, spelled as a flag ([`super::options::flag`]).
 fn flag(out: &mut Vec<String>, name: &str, value: String) {
-    out.push(name.to_string());
+    out.push(super::options::flag(name));
     out.push(value);
 }
 
@@ -104,10 +105,10 @@ impl ToArgs for LossesOptions {
     const COMMAND: &'static str = "losses";
     fn to_args(&self) -> Vec<String> {
         let mut a = Vec::new();
-        flag(&mut a, "--gear", self.gear.clone());
-        flag(&mut a, "--speed-rpm", num(self.speed_rpm));
-        flag(&mut a, "--torque-nm", num(self.torque_nm));
-        flag(&mut a, "--oil-temp-c", num(self.oil_temp_c));
+        flag(&mut a, "gear", self.gear.clone());
+        flag(&mut a, "speed_rpm", num(self.speed_rpm));
+        flag(&mut a, "torque_nm", num(self.torque_nm));
+        flag(&mut a, "oil_temp_c", num(self.oil_temp_c));
         a
     }
 }
@@ -116,19 +117,19 @@ impl ToArgs for RunOptions {
     const COMMAND: &'static str = "run";
     fn to_args(&self) -> Vec<String> {
         let mut a = Vec::new();
-        flag(&mut a, "--cycle", self.cycle.clone());
-        flag(&mut a, "--solver", self.solver.clone());
-        flag(&mut a, "--rtol", num(self.rtol));
-        flag(&mut a, "--atol", num(self.atol));
-        opt(&mut a, "--initial-temp-c", self.initial_temp_c);
-        opt(&mut a, "--ambient-c", self.ambient_c);
-        opt(&mut a, "--frozen-viscosity-c", self.frozen_viscosity_c);
-        flag(&mut a, "--max-steps", self.max_steps.to_string());
+        flag(&mut a, "cycle", self.cycle.clone());
+        flag(&mut a, "solver", self.solver.clone());
+        flag(&mut a, "rtol", num(self.rtol));
+        flag(&mut a, "atol", num(self.atol));
+        opt(&mut a, "initial_temp_c", self.initial_temp_c);
+        opt(&mut a, "ambient_c", self.ambient_c);
+        opt(&mut a, "frozen_viscosity_c", self.frozen_viscosity_c);
+        flag(&mut a, "max_steps", self.max_steps.to_string());
         if self.summary_only {
-            a.push("--summary-only".into());
+            a.push(super::options::flag("summary_only"));
         }
         if self.evaluate_all {
-            a.push("--evaluate-all".into());
+            a.push(super::options::flag("evaluate_all"));
         }
         a
     }
@@ -138,11 +139,11 @@ impl ToArgs for SteadyOptions {
     const COMMAND: &'static str = "steady";
     fn to_args(&self) -> Vec<String> {
         let mut a = Vec::new();
-        flag(&mut a, "--gear", self.gear.clone());
-        flag(&mut a, "--speed-rpm", num(self.speed_rpm));
-        flag(&mut a, "--torque-nm", num(self.torque_nm));
-        flag(&mut a, "--vehicle-speed-kmh", num(self.vehicle_speed_kmh));
-        opt(&mut a, "--ambient-c", self.ambient_c);
+        flag(&mut a, "gear", self.gear.clone());
+        flag(&mut a, "speed_rpm", num(self.speed_rpm));
+        flag(&mut a, "torque_nm", num(self.torque_nm));
+        flag(&mut a, "vehicle_speed_kmh", num(self.vehicle_speed_kmh));
+        opt(&mut a, "ambient_c", self.ambient_c);
         a
     }
 }
@@ -151,11 +152,11 @@ impl ToArgs for MapOptions {
     const COMMAND: &'static str = "map";
     fn to_args(&self) -> Vec<String> {
         let mut a = Vec::new();
-        flag(&mut a, "--gear", self.gear.clone());
-        flag(&mut a, "--speed-rpm", list(&self.speed_rpm));
-        flag(&mut a, "--torque-nm", list(&self.torque_nm));
-        flag(&mut a, "--vehicle-speed-kmh", num(self.vehicle_speed_kmh));
-        opt(&mut a, "--ambient-c", self.ambient_c);
+        flag(&mut a, "gear", self.gear.clone());
+        flag(&mut a, "speed_rpm", list(&self.speed_rpm));
+        flag(&mut a, "torque_nm", list(&self.torque_nm));
+        flag(&mut a, "vehicle_speed_kmh", num(self.vehicle_speed_kmh));
+        opt(&mut a, "ambient_c", self.ambient_c);
         a
     }
 }
@@ -164,13 +165,13 @@ impl ToArgs for RatingOptions {
     const COMMAND: &'static str = "rating";
     fn to_args(&self) -> Vec<String> {
         let mut a = Vec::new();
-        flag(&mut a, "--gear", self.gear.clone());
-        flag(&mut a, "--speed-rpm", list(&self.speed_rpm));
-        flag(&mut a, "--oil-limit-c", num(self.oil_limit_c));
-        flag(&mut a, "--vehicle-speed-kmh", num(self.vehicle_speed_kmh));
-        opt(&mut a, "--ambient-c", self.ambient_c);
-        flag(&mut a, "--torque-min-nm", num(self.torque_min_nm));
-        opt(&mut a, "--torque-max-nm", self.torque_max_nm);
+        flag(&mut a, "gear", self.gear.clone());
+        flag(&mut a, "speed_rpm", list(&self.speed_rpm));
+        flag(&mut a, "oil_limit_c", num(self.oil_limit_c));
+        flag(&mut a, "vehicle_speed_kmh", num(self.vehicle_speed_kmh));
+        opt(&mut a, "ambient_c", self.ambient_c);
+        flag(&mut a, "torque_min_nm", num(self.torque_min_nm));
+        opt(&mut a, "torque_max_nm", self.torque_max_nm);
         a
     }
 }
@@ -179,11 +180,11 @@ impl ToArgs for BenchOptions {
     const COMMAND: &'static str = "bench";
     fn to_args(&self) -> Vec<String> {
         let mut a = Vec::new();
-        flag(&mut a, "--cycle", self.cycle.clone());
-        flag(&mut a, "--repeats", self.repeats.to_string());
-        flag(&mut a, "--min-rtol", num(self.min_rtol));
-        flag(&mut a, "--solvers", self.solvers.join(","));
-        flag(&mut a, "--max-steps", self.max_steps.to_string());
+        flag(&mut a, "cycle", self.cycle.clone());
+        flag(&mut a, "repeats", self.repeats.to_string());
+        flag(&mut a, "min_rtol", num(self.min_rtol));
+        flag(&mut a, "solvers", self.solvers.join(","));
+        flag(&mut a, "max_steps", self.max_steps.to_string());
         a
     }
 }

@@ -11,12 +11,13 @@
 //! a state that leaves the envelope fails the job (exit 2), naming the time, the node, its
 //! temperature and the model whose range it left.
 
-use crate::physics::oil::{Oil, KELVIN_OFFSET};
+use crate::physics::oil::Oil;
 use crate::scene::Scene;
 use crate::solve::transient::{Segment, Trajectory};
 
 use super::limits::{short, Limit};
 use super::JobError;
+use crate::physics::units::{c_to_k, k_to_c};
 
 pub use crate::solve::equilibrium::{NODE_RANGE_C, OIL_RANGE_C};
 
@@ -44,7 +45,7 @@ impl OilRange {
     /// μ = ρ ν falls monotonically with temperature), within [`OIL_RANGE_C`].
     pub fn of(oil: &Oil) -> OilRange {
         let (floor, top) = OIL_RANGE_C;
-        let mu = |c: f64| oil.dynamic_viscosity(c + KELVIN_OFFSET);
+        let mu = |c: f64| oil.dynamic_viscosity(c_to_k(c));
         let at_floor = mu(floor);
         let lo_c = if at_floor.is_finite() && at_floor <= MAX_OIL_VISCOSITY_PA_S {
             floor
@@ -101,9 +102,8 @@ impl OilRange {
             short(v),
             self.allowed(),
             format!(
-                "{} ({}) = {} °C: must lie in {}",
+                "{} = {} °C: must lie in {}",
                 limit.name,
-                limit.flag,
                 short(v),
                 self.describe()
             ),
@@ -160,7 +160,7 @@ impl Envelope {
     pub fn check(&self, temps_k: &[f64]) -> Result<(), Breach> {
         let (lo, hi) = NODE_RANGE_C;
         for (i, (name, t_k)) in self.names.iter().zip(temps_k).enumerate() {
-            let t = t_k - KELVIN_OFFSET;
+            let t = k_to_c(*t_k);
             let breach = |range: String| Breach {
                 node: name.clone(),
                 temp_c: t,
@@ -242,7 +242,7 @@ mod tests {
     fn the_cold_end_is_where_the_viscosity_reaches_the_j306_limit() {
         let oil = fva3a();
         let r = OilRange::of(&oil);
-        let mu = |c: f64| oil.dynamic_viscosity(c + KELVIN_OFFSET);
+        let mu = |c: f64| oil.dynamic_viscosity(c_to_k(c));
         assert!(r.lo_c > OIL_RANGE_C.0 && r.lo_c < 0.0, "{r:?}");
         assert!(mu(r.lo_c) <= MAX_OIL_VISCOSITY_PA_S, "{}", mu(r.lo_c));
         assert!(mu(r.lo_c - 0.1) > MAX_OIL_VISCOSITY_PA_S, "{}", mu(r.lo_c - 0.1));
@@ -272,7 +272,7 @@ mod tests {
         let lim = super::super::limits::FROZEN_VISCOSITY_C;
         let e = r.check_option(&lim, -60.0).unwrap_err();
         assert_eq!(e.exit_code(), 1);
-        assert!(e.message.contains("--frozen-viscosity-c"), "{}", e.message);
+        assert!(e.message.starts_with("frozen_viscosity_c = "), "{}", e.message);
         assert!(e.message.contains(&r.allowed()), "{}", e.message);
         assert!(r.check_option(&lim, 40.0).is_ok());
     }

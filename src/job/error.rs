@@ -22,7 +22,7 @@ pub enum ErrorKind {
 
 impl ErrorKind {
     /// The CLI's exit code of this kind.
-    pub fn exit_code(self) -> i32 {
+    pub const fn exit_code(self) -> i32 {
         match self {
             ErrorKind::Model | ErrorKind::Option | ErrorKind::Invalid => 1,
             ErrorKind::Numerical => 2,
@@ -43,6 +43,9 @@ pub struct JobError {
     pub problems: Vec<Problem>,
     /// The I/O error's kind, when `kind` is [`ErrorKind::Io`] (e.g. not found).
     pub io_kind: Option<std::io::ErrorKind>,
+    /// The file the error is about, where one is (a file that cannot be read, an invalid
+    /// model file).
+    pub file: Option<std::path::PathBuf>,
 }
 
 impl fmt::Display for JobError {
@@ -61,6 +64,7 @@ impl JobError {
             message: message.into(),
             problems: Vec::new(),
             io_kind: None,
+            file: None,
         }
     }
 
@@ -81,6 +85,7 @@ impl JobError {
                 allowed: allowed.into(),
             }],
             io_kind: None,
+            file: None,
         }
     }
 
@@ -91,6 +96,7 @@ impl JobError {
             message: message.into(),
             problems: Vec::new(),
             io_kind: None,
+            file: None,
         }
     }
 
@@ -101,6 +107,7 @@ impl JobError {
             message: message.into(),
             problems: Vec::new(),
             io_kind: Some(io_kind),
+            file: None,
         }
     }
 
@@ -112,6 +119,12 @@ impl JobError {
     /// True for invalid input of any kind (model, option, other).
     pub fn is_invalid(&self) -> bool {
         self.exit_code() == 1
+    }
+
+    /// The same error about `file`.
+    pub fn in_file(mut self, file: impl Into<std::path::PathBuf>) -> JobError {
+        self.file = Some(file.into());
+        self
     }
 
     /// The same error with `prefix: ` in front of its message (e.g. the model file).
@@ -127,15 +140,16 @@ impl From<ModelError> for JobError {
     fn from(e: ModelError) -> JobError {
         let message = e.report().trim_end().to_string();
         match e {
-            ModelError::Io { source, .. } if source.kind() != std::io::ErrorKind::InvalidData => {
-                JobError::io(message, source.kind())
+            ModelError::Io { source, file } if source.kind() != std::io::ErrorKind::InvalidData => {
+                JobError::io(message, source.kind()).in_file(file)
             }
-            ModelError::Io { .. } => JobError::invalid(message),
-            ModelError::Invalid { problems, .. } => JobError {
+            ModelError::Io { file, .. } => JobError::invalid(message).in_file(file),
+            ModelError::Invalid { problems, file } => JobError {
                 kind: ErrorKind::Model,
                 message,
                 problems,
                 io_kind: None,
+                file: Some(file),
             },
         }
     }
@@ -168,5 +182,59 @@ impl From<crate::report::files::OutputError> for JobError {
     /// An output that cannot be written is I/O.
     fn from(e: crate::report::files::OutputError) -> JobError {
         JobError::io(format!("cannot write outputs: {e}"), std::io::ErrorKind::Other)
+    }
+}
+
+impl From<crate::report::study::JournalError> for JobError {
+    /// A journal of another study in the output directory is a usage error (invalid input); a
+    /// journal that cannot be read is I/O.
+    fn from(e: crate::report::study::JournalError) -> JobError {
+        use crate::report::study::JournalError;
+        let message = e.to_string();
+        match e {
+            JournalError::Foreign(_) => JobError::invalid(message),
+            JournalError::Io { source, .. } => JobError::io(message, source.kind()),
+        }
+    }
+}
+
+/// A text input file (study, model, cycle, trace): one that cannot be read (missing, no
+/// permission, a directory) is I/O; one that is read but is not UTF-8 text is invalid input,
+/// as for a model file. The message is `FILE: cannot read: CAUSE`.
+pub fn read_text(path: &std::path::Path) -> Result<String, JobError> {
+    std::fs::read_to_string(path).map_err(|e| {
+        let message = format!("{}: cannot read: {e}", path.display());
+        match e.kind() {
+            std::io::ErrorKind::InvalidData => JobError::invalid(message),
+            kind => JobError::io(message, kind),
+        }
+        .in_file(path)
+    })
+}
+
+impl From<crate::report::plots::PlotError> for JobError {
+    /// A figure's input that cannot be parsed or lacks what the figure needs (or is not UTF-8
+    /// text) is invalid input; a file that cannot be read or written, or a drawing that fails,
+    /// is I/O.
+    fn from(e: crate::report::plots::PlotError) -> JobError {
+        use crate::report::plots::PlotError;
+        let message = format!("report: {e}");
+        match &e {
+            PlotError::Csv { .. } | PlotError::Json { .. } | PlotError::Data { .. } => {
+                JobError::invalid(message)
+            }
+            PlotError::Io { source, .. } if source.kind() == std::io::ErrorKind::InvalidData => {
+                JobError::invalid(message)
+            }
+            PlotError::Io { source, .. } => JobError::io(message, source.kind()),
+            _ => JobError::io(message, std::io::ErrorKind::Other),
+        }
+    }
+}
+
+impl From<super::calibrate::trace::TraceError> for JobError {
+    /// A trace that does not parse is invalid input (the message names file, line and column).
+    fn from(e: super::calibrate::trace::TraceError) -> JobError {
+        JobError::invalid(e.0)
     }
 }

@@ -1,6 +1,6 @@
-//! The allowed range of every numeric job option, written once. Each front end names an option
-//! differently (`--speed-rpm` on the command line, `speed_rpm` in a study file and in Python);
-//! the message names both, so that it reads the same from each.
+//! The allowed range of every numeric job option, written once. A message names the option as
+//! study files and Python do (`speed_rpm`); the command line adds its flag
+//! ([`super::options::spelled_for_cli`]).
 
 use super::JobError;
 use crate::solve::equilibrium::OIL_RANGE_C;
@@ -10,8 +10,6 @@ use crate::solve::equilibrium::OIL_RANGE_C;
 pub struct Limit {
     /// The option's name in study files and Python (`speed_rpm`).
     pub name: &'static str,
-    /// The command-line flag (`--speed-rpm`).
-    pub flag: &'static str,
     /// Least allowed value.
     pub lo: f64,
     /// Greatest allowed value.
@@ -44,9 +42,8 @@ impl Limit {
             short(v),
             self.allowed(),
             format!(
-                "{} ({}) = {}{}: must lie in {}",
+                "{} = {}{}: must lie in {}",
                 self.name,
-                self.flag,
                 short(v),
                 self.unit_suffix(),
                 self.allowed()
@@ -73,7 +70,6 @@ pub fn short(x: f64) -> String {
 /// Input shaft speed, rpm (the cycle parser holds input speeds to the same bound).
 pub const SPEED_RPM: Limit = Limit {
     name: "speed_rpm",
-    flag: "--speed-rpm",
     lo: 0.0,
     hi: 50_000.0,
     unit: "rpm",
@@ -82,7 +78,6 @@ pub const SPEED_RPM: Limit = Limit {
 /// Input torque of an equilibrium, N·m (negative: overrun).
 pub const TORQUE_NM: Limit = Limit {
     name: "torque_nm",
-    flag: "--torque-nm",
     lo: -1e6,
     hi: 1e6,
     unit: "N m",
@@ -92,7 +87,6 @@ pub const TORQUE_NM: Limit = Limit {
 /// power flows from input to output).
 pub const DRIVE_TORQUE_NM: Limit = Limit {
     name: "torque_nm",
-    flag: "--torque-nm",
     lo: 0.0,
     hi: 1e6,
     unit: "N m",
@@ -103,7 +97,6 @@ pub const DRIVE_TORQUE_NM: Limit = Limit {
 /// ([`super::envelope::OilRange`]), where the Walther fit holds.
 pub const OIL_TEMP_C: Limit = Limit {
     name: "oil_temp_c",
-    flag: "--oil-temp-c",
     lo: OIL_RANGE_C.0,
     hi: OIL_RANGE_C.1,
     unit: "°C",
@@ -112,7 +105,6 @@ pub const OIL_TEMP_C: Limit = Limit {
 /// Initial temperature of every node (the oil's among them), °C: as [`OIL_TEMP_C`].
 pub const INITIAL_TEMP_C: Limit = Limit {
     name: "initial_temp_c",
-    flag: "--initial-temp-c",
     lo: OIL_RANGE_C.0,
     hi: OIL_RANGE_C.1,
     unit: "°C",
@@ -121,7 +113,6 @@ pub const INITIAL_TEMP_C: Limit = Limit {
 /// Ambient temperature, °C: arctic cold to an engine bay's hottest air.
 pub const AMBIENT_C: Limit = Limit {
     name: "ambient_c",
-    flag: "--ambient-c",
     lo: -60.0,
     hi: 150.0,
     unit: "°C",
@@ -130,7 +121,6 @@ pub const AMBIENT_C: Limit = Limit {
 /// Temperature at which the oil properties are frozen, °C: as [`OIL_TEMP_C`].
 pub const FROZEN_VISCOSITY_C: Limit = Limit {
     name: "frozen_viscosity_c",
-    flag: "--frozen-viscosity-c",
     lo: OIL_RANGE_C.0,
     hi: OIL_RANGE_C.1,
     unit: "°C",
@@ -139,7 +129,6 @@ pub const FROZEN_VISCOSITY_C: Limit = Limit {
 /// Relative tolerance of the transient solvers.
 pub const RTOL: Limit = Limit {
     name: "rtol",
-    flag: "--rtol",
     lo: 1e-14,
     hi: 1e-1,
     unit: "",
@@ -148,7 +137,6 @@ pub const RTOL: Limit = Limit {
 /// Absolute tolerance on temperatures, K.
 pub const ATOL: Limit = Limit {
     name: "atol",
-    flag: "--atol",
     lo: 1e-14,
     hi: 1.0,
     unit: "K",
@@ -157,7 +145,6 @@ pub const ATOL: Limit = Limit {
 /// Vehicle speed for h(v) links at an equilibrium, km/h.
 pub const VEHICLE_SPEED_KMH: Limit = Limit {
     name: "vehicle_speed_kmh",
-    flag: "--vehicle-speed-kmh",
     lo: 0.0,
     hi: 400.0,
     unit: "km/h",
@@ -166,7 +153,6 @@ pub const VEHICLE_SPEED_KMH: Limit = Limit {
 /// Step budget of a transient run.
 pub const MAX_STEPS: Limit = Limit {
     name: "max_steps",
-    flag: "--max-steps",
     lo: 1.0,
     hi: 1e9,
     unit: "",
@@ -175,7 +161,6 @@ pub const MAX_STEPS: Limit = Limit {
 /// Tightest tolerance of the work-precision sweep.
 pub const MIN_RTOL: Limit = Limit {
     name: "min_rtol",
-    flag: "--min-rtol",
     lo: 1e-13,
     hi: 1e-3,
     unit: "",
@@ -184,7 +169,6 @@ pub const MIN_RTOL: Limit = Limit {
 /// Repeats per work-precision point (the median wall time is kept).
 pub const REPEATS: Limit = Limit {
     name: "repeats",
-    flag: "--repeats",
     lo: 1.0,
     hi: 1000.0,
     unit: "",
@@ -194,7 +178,6 @@ pub const REPEATS: Limit = Limit {
 /// (`solve::equilibrium::OIL_RANGE_C`; above it an equilibrium is not sought).
 pub const OIL_LIMIT_C: Limit = Limit {
     name: "oil_limit_c",
-    flag: "--oil-limit-c",
     lo: -60.0,
     hi: 200.0,
     unit: "°C",
@@ -203,7 +186,6 @@ pub const OIL_LIMIT_C: Limit = Limit {
 /// Lowest input torque a thermal rating searches, N·m (drive only).
 pub const RATING_TORQUE_MIN_NM: Limit = Limit {
     name: "torque_min_nm",
-    flag: "--torque-min-nm",
     lo: 0.0,
     hi: 1e6,
     unit: "N m",
@@ -212,7 +194,6 @@ pub const RATING_TORQUE_MIN_NM: Limit = Limit {
 /// Highest input torque a thermal rating searches (its ceiling), N·m.
 pub const RATING_TORQUE_MAX_NM: Limit = Limit {
     name: "torque_max_nm",
-    flag: "--torque-max-nm",
     lo: 0.0,
     hi: 1e6,
     unit: "N m",
@@ -245,7 +226,6 @@ pub const ALL: [Limit; 18] = [
 /// largest machines; a million would each be started before the first case runs.
 pub const THREADS: Limit = Limit {
     name: "threads_per_task",
-    flag: "threads_per_task",
     lo: 1.0,
     hi: 1024.0,
     unit: "",
@@ -254,7 +234,6 @@ pub const THREADS: Limit = Limit {
 /// Points per map axis.
 pub const MAP_AXIS_POINTS: Limit = Limit {
     name: "map_axis_points",
-    flag: "--speed-rpm/--torque-nm",
     lo: 1.0,
     hi: 2000.0,
     unit: "",

@@ -3,13 +3,13 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::physics::oil::KELVIN_OFFSET;
 use crate::report::losses::{losses as report, LossReport};
 use crate::scene::{LossScene, OperatingPoint};
 
 use super::envelope::OilRange;
 use super::limits::{self, short};
 use super::{JobError, Model};
+use crate::physics::units::{c_to_k, rpm_to_rad_s};
 
 /// Options of a loss evaluation (`geartherm losses`, `Model.losses`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -44,9 +44,9 @@ pub fn losses(m: &Model, o: &LossesOptions) -> Result<LossReport, JobError> {
         LossScene::compile(&m.gearbox).map_err(|e| JobError::invalid(format!("{}: {e}", m.label())))?;
     let op = OperatingPoint {
         state,
-        input_speed: o.speed_rpm * std::f64::consts::PI / 30.0,
+        input_speed: rpm_to_rad_s(o.speed_rpm),
         input_torque: o.torque_nm,
-        oil: m.gearbox.oil.properties(o.oil_temp_c + KELVIN_OFFSET),
+        oil: m.gearbox.oil.properties(c_to_k(o.oil_temp_c)),
     };
     if !(op.oil.nu.is_finite() && op.oil.nu > 0.0 && op.oil.rho.is_finite() && op.oil.rho > 0.0) {
         return Err(JobError::option(
@@ -54,7 +54,7 @@ pub fn losses(m: &Model, o: &LossesOptions) -> Result<LossReport, JobError> {
             short(o.oil_temp_c),
             "a temperature where the oil has a finite viscosity",
             format!(
-                "oil_temp_c (--oil-temp-c) = {}: the oil of {} has no finite viscosity there (ν = {} m²/s)",
+                "oil_temp_c = {}: the oil of {} has no finite viscosity there (ν = {} m²/s)",
                 short(o.oil_temp_c),
                 m.label(),
                 op.oil.nu

@@ -10,6 +10,7 @@ use super::envelope::Envelope;
 use super::limits::{self, short, MAX_MAP_POINTS};
 use super::steady::{check_envelope, check_equilibrium, point_scene};
 use super::{JobError, Model};
+use crate::physics::units::{kmh_to_m_s, rpm_to_rad_s};
 
 /// Options of a map (`geartherm map`, `Model.map`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -178,7 +179,7 @@ pub fn solve(
         state,
         &o.speed_rpm,
         &o.torque_nm,
-        o.vehicle_speed_kmh / 3.6,
+        kmh_to_m_s(o.vehicle_speed_kmh),
         &NewtonOptions::default(),
         tick,
     );
@@ -229,7 +230,7 @@ fn warnings(
                 &scene.losses,
                 &crate::scene::OperatingPoint {
                     state,
-                    input_speed: p.speed_rpm * std::f64::consts::PI / 30.0,
+                    input_speed: rpm_to_rad_s(p.speed_rpm),
                     input_torque: p.torque_nm,
                     oil: scene
                         .thermal

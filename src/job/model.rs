@@ -5,9 +5,28 @@
 use std::path::{Path, PathBuf};
 
 use crate::model::{self, Gearbox, Override};
+use crate::physics::units::c_to_k;
 use crate::scene::{Needs, Scene};
 
 use super::JobError;
+
+/// What `check` reports of a checked model (the CLI prints it as one line, Python returns it
+/// as a dict).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct CheckReport {
+    /// The model's name.
+    pub model: String,
+    /// Number of gears.
+    pub gears: usize,
+    /// Number of meshes.
+    pub meshes: usize,
+    /// The gear states' names.
+    pub gear_states: Vec<String>,
+    /// Number of thermal nodes.
+    pub thermal_nodes: usize,
+    /// Whether the model has a vehicle.
+    pub vehicle: bool,
+}
 
 /// A checked model: the gearbox, its file (as named in messages) and its overrides.
 #[derive(Debug, Clone)]
@@ -51,6 +70,19 @@ impl Model {
         })
     }
 
+    /// What `check` reports: the counts of the checked model.
+    pub fn check_report(&self) -> CheckReport {
+        let gb = &self.gearbox;
+        CheckReport {
+            model: gb.name.clone(),
+            gears: gb.gears.len(),
+            meshes: gb.meshes.len(),
+            gear_states: gb.gear_states.iter().map(|s| s.name.clone()).collect(),
+            thermal_nodes: gb.thermal.as_ref().map_or(0, |t| t.nodes.len()),
+            vehicle: gb.vehicle.is_some(),
+        }
+    }
+
     /// The file as shown in messages.
     pub fn label(&self) -> String {
         self.file.display().to_string()
@@ -72,7 +104,7 @@ impl Model {
                 gear,
                 names.join(", "),
                 format!(
-                    "gear (--gear) = {gear}: unknown gear state; {} has: {}",
+                    "gear = {gear}: unknown gear state; {} has: {}",
                     self.label(),
                     names.join(", ")
                 ),
@@ -86,25 +118,26 @@ impl Model {
             .map_err(|e| JobError::invalid(format!("{}: {e}", self.label())))
     }
 
-    /// Set the ambient boundary to `ambient_c` (°C, already range-checked) when given.
-    pub fn set_ambient(&self, scene: &mut Scene, ambient_c: Option<f64>) -> Result<(), JobError> {
+    /// The scenario's ambient in K for [`Needs::ambient_k`] (`ambient_c`, °C, already
+    /// range-checked); a model whose network has no ambient boundary is refused.
+    pub fn ambient_k(&self, ambient_c: Option<f64>) -> Result<Option<f64>, JobError> {
         let Some(a) = ambient_c else {
-            return Ok(());
+            return Ok(None);
         };
-        let idx = scene.thermal.ambient.ok_or_else(|| {
+        // A model without a network: the compile names that.
+        let Some(net) = &self.gearbox.thermal else {
+            return Ok(Some(c_to_k(a)));
+        };
+        net.ambient().map(|_| Some(c_to_k(a))).ok_or_else(|| {
             JobError::option(
                 "ambient_c",
                 a,
                 "no value: the model has no ambient boundary",
                 format!(
-                    "ambient_c (--ambient-c) = {a}: {} has no ambient boundary (name one `ambient` or set ambient = true)",
+                    "ambient_c = {a}: {} has no ambient boundary (name one `ambient` or set ambient = true)",
                     self.label()
                 ),
             )
-        })?;
-        scene
-            .thermal
-            .set_boundary_fixed(idx, a + crate::physics::oil::KELVIN_OFFSET);
-        Ok(())
+        })
     }
 }

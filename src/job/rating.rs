@@ -7,7 +7,6 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::physics::oil::KELVIN_OFFSET;
 use crate::scene::{OperatingPoint, RangeLog, RangeWarning, Scene};
 use crate::solve::equilibrium::Equilibrium;
 
@@ -15,6 +14,7 @@ use super::envelope::{Envelope, OilRange};
 use super::limits::{self, short};
 use super::steady::{self, point_scene, SteadyOptions, SteadyResult};
 use super::{JobError, Model};
+use crate::physics::units::{c_to_k, k_to_c, kmh_to_m_s, rpm_to_rad_s};
 
 mod search;
 
@@ -63,7 +63,7 @@ impl RatingOptions {
                 n,
                 format!("1 to {} speeds", limits::MAP_AXIS_POINTS.hi),
                 format!(
-                    "speed_rpm (--speed-rpm): {n} speeds; a rating takes 1 to {} speeds",
+                    "speed_rpm: {n} speeds; a rating takes 1 to {} speeds",
                     limits::MAP_AXIS_POINTS.hi
                 ),
             ));
@@ -80,7 +80,7 @@ impl RatingOptions {
                 short(hi),
                 format!("above torque_min_nm = {}", short(self.torque_min_nm)),
                 format!(
-                    "torque_max_nm (--torque-max-nm) = {} N m: must lie above torque_min_nm (--torque-min-nm) = {} N m",
+                    "torque_max_nm = {} N m: must lie above torque_min_nm = {} N m",
                     short(hi),
                     short(self.torque_min_nm)
                 ),
@@ -244,7 +244,7 @@ pub fn solve(
     tick: &(dyn Fn() + Sync),
 ) -> Result<RatingResult, JobError> {
     let start = std::time::Instant::now();
-    let limit_k = o.oil_limit_c + KELVIN_OFFSET;
+    let limit_k = c_to_k(o.oil_limit_c);
     let (t_min, t_max) = (o.torque_min_nm, o.ceiling());
     let found: Vec<Result<search::Outcome<Equilibrium>, (f64, f64, String)>> = o
         .speed_rpm
@@ -253,8 +253,8 @@ pub fn solve(
             let point = search::Point {
                 scene: &p.scene,
                 state: p.state,
-                speed: rpm * std::f64::consts::PI / 30.0,
-                vehicle_speed: o.vehicle_speed_kmh / 3.6,
+                speed: rpm_to_rad_s(rpm),
+                vehicle_speed: kmh_to_m_s(o.vehicle_speed_kmh),
                 limit_k,
             };
             let r = search::search(&point, t_min, t_max).map_err(|(t, why)| (rpm, t, why));
@@ -315,7 +315,7 @@ fn point(
         speed_rpm: rpm,
         rated_torque_nm: s.torque,
         rated_power_w: s.payload.power,
-        oil_temp_c: s.payload.solution.temperatures[p.scene.thermal.oil] - KELVIN_OFFSET,
+        oil_temp_c: k_to_c(s.payload.solution.temperatures[p.scene.thermal.oil]),
         total_loss_w: eq.total_loss_w,
         efficiency: eq.efficiency,
         status: s.status,
@@ -334,9 +334,9 @@ fn warnings(p: &Prepared, points: &[RatingPoint]) -> Vec<RangeWarning> {
             losses,
             &OperatingPoint {
                 state: p.state,
-                input_speed: r.speed_rpm * std::f64::consts::PI / 30.0,
+                input_speed: rpm_to_rad_s(r.speed_rpm),
                 input_torque: r.rated_torque_nm,
-                oil: p.scene.thermal.oil_properties(r.oil_temp_c + KELVIN_OFFSET),
+                oil: p.scene.thermal.oil_properties(c_to_k(r.oil_temp_c)),
             },
         );
     }

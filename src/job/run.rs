@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::cycle::{DriveCycle, Schedule};
-use crate::physics::oil::KELVIN_OFFSET;
+use crate::physics::units::c_to_k;
 use crate::report::run::{check_finite, summary, timeseries_csv, Summary};
 use crate::scene::{Needs, Scene};
 use crate::solve::drive::{row_inputs, segments};
@@ -83,7 +83,7 @@ pub fn method(name: &str) -> Result<Method, JobError> {
             "solver",
             name,
             allowed.clone(),
-            format!("solver (--solver) = {name}: unknown; allowed: {allowed}"),
+            format!("solver = {name}: unknown; allowed: {allowed}"),
         )
     })
 }
@@ -109,7 +109,7 @@ impl RunOptions {
             atol: self.atol,
             restart: Restart::AtJumps,
             max_steps: self.max_steps,
-            initial_temp: self.initial_temp_c.map(|c| c + KELVIN_OFFSET),
+            initial_temp: self.initial_temp_c.map(c_to_k),
             record_losses: !self.summary_only,
             ..TransientOptions::default()
         }
@@ -148,10 +148,10 @@ pub fn prepare(m: &Model, o: &RunOptions) -> Result<Prepared, JobError> {
         states: Some(segs.iter().map(|s| s.inputs.state).collect()),
         evaluate_all: o.evaluate_all,
         energy_per_source_only: o.summary_only,
+        ambient_k: m.ambient_k(o.ambient_c)?,
+        frozen_oil_temp_k: o.frozen_viscosity_c.map(c_to_k),
     };
-    let mut scene = m.compile(&needs)?;
-    m.set_ambient(&mut scene, o.ambient_c)?;
-    scene.frozen_oil_temp = o.frozen_viscosity_c.map(|c| c + KELVIN_OFFSET);
+    let scene = m.compile(&needs)?;
     let opts = o.transient(method);
     let start = scene.initial_state(opts.initial_temp);
     Envelope::of(&scene).check(&start[..scene.nodes()]).map_err(|b| {

@@ -13,6 +13,7 @@ use crate::solve::steady::{SteadyError, SteadyOptions as NewtonOptions};
 use super::envelope::Envelope;
 use super::limits::{self, short};
 use super::{JobError, Model};
+use crate::physics::units::{k_to_c, kmh_to_m_s, rpm_to_rad_s};
 
 /// Largest residual of an equilibrium relative to its total loss (the solver converges to about
 /// 1e-12; a larger residual is not an equilibrium, whatever the step criterion said).
@@ -127,7 +128,7 @@ fn cycle_report(scene: &Scene, c: &crate::solve::limit_cycle::LimitCycle) -> Lim
             .names
             .iter()
             .zip(v)
-            .map(|(n, t)| (n.clone(), t - KELVIN_OFFSET))
+            .map(|(n, t)| (n.clone(), k_to_c(*t)))
             .collect()
     };
     LimitCycleReport {
@@ -151,10 +152,10 @@ pub(crate) fn point_scene(
     // Scene pruning: only this gear state's active items are compiled.
     let needs = Needs {
         states: Some(vec![state]),
+        ambient_k: m.ambient_k(ambient_c)?,
         ..Needs::default()
     };
-    let mut scene = m.compile(&needs)?;
-    m.set_ambient(&mut scene, ambient_c)?;
+    let scene = m.compile(&needs)?;
     Ok((scene, state))
 }
 
@@ -162,9 +163,9 @@ pub(crate) fn point_scene(
 pub(crate) fn inputs(state: usize, speed_rpm: f64, torque_nm: f64, vehicle_speed_kmh: f64) -> Inputs {
     Inputs {
         state,
-        input_speed: speed_rpm * std::f64::consts::PI / 30.0,
+        input_speed: rpm_to_rad_s(speed_rpm),
         input_torque: torque_nm,
-        vehicle_speed: vehicle_speed_kmh / 3.6,
+        vehicle_speed: kmh_to_m_s(vehicle_speed_kmh),
     }
 }
 
@@ -200,7 +201,7 @@ pub(crate) fn result(
         .names
         .iter()
         .zip(&eq.solution.temperatures)
-        .map(|(n, t)| (n.clone(), t - KELVIN_OFFSET))
+        .map(|(n, t)| (n.clone(), k_to_c(*t)))
         .collect();
     let losses_w = scene
         .losses
@@ -215,7 +216,7 @@ pub(crate) fn result(
         &scene.losses,
         &OperatingPoint {
             state,
-            input_speed: o.speed_rpm * std::f64::consts::PI / 30.0,
+            input_speed: rpm_to_rad_s(o.speed_rpm),
             input_torque: o.torque_nm,
             oil: scene.thermal.oil_properties(t_oil),
         },
@@ -291,7 +292,7 @@ pub fn describe(scene: &Scene, e: &SteadyError) -> String {
             "node {} is driven past its {which} limit {:.1} °C (toward {:.1} °C): the losses grow faster with \
              temperature than the cooling removes heat",
             name(*node),
-            bound_k - KELVIN_OFFSET,
+            k_to_c(*bound_k),
             temperature_k - KELVIN_OFFSET
         ),
         SteadyError::Singular { nodes } => format!(

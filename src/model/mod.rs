@@ -140,6 +140,22 @@ pub fn from_document_with(
     }
 }
 
+/// Whether the model schema takes `ov` on `doc`: the override finds its place (every table
+/// and named entry on its path exists) and the document still has the schema's shape (no
+/// unknown key, every value of its type). Values are not validated: a value out of its range
+/// fits the schema. The problems when it does not.
+pub fn schema_takes(mut doc: toml::Table, ov: &Override) -> Result<(), Vec<Problem>> {
+    let mut problems = Problems::default();
+    if let Err(msg) = overrides::apply(&mut doc, ov) {
+        problems.push(ov.path.to_string(), &ov.value, msg);
+        return Err(problems.into_vec());
+    }
+    match parse::parse_table(doc, &mut problems) {
+        Some(_) if problems.is_empty() => Ok(()),
+        _ => Err(problems.into_vec()),
+    }
+}
+
 /// Name the override behind each problem it concerns; when none does, list every override.
 fn annotate(problems: Problems, applied: &[(String, String)]) -> Problems {
     let mut list = problems.into_vec();

@@ -6,3 +6,4 @@ pub mod losses;
 pub mod lubrication;
 pub mod oil;
 pub mod thermal;
+pub mod units;

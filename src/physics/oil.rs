@@ -11,8 +11,8 @@
 //! Units: the public API is SI (K for absolute temperature, m²/s, kg/m³, Pa·s); cSt appears only
 //! inside the Walther fit, where the equation is defined in cSt.
 
-/// Temperature of 0 °C in kelvin.
-pub const KELVIN_OFFSET: f64 = 273.15;
+/// Temperature of 0 °C in kelvin ([`super::units::KELVIN_OFFSET`]).
+pub use super::units::KELVIN_OFFSET;
 /// 40 °C in kelvin (first ASTM D341 reference point).
 pub const T40_K: f64 = 313.15;
 /// 100 °C in kelvin (second ASTM D341 reference point).

@@ -20,7 +20,7 @@ pub use case::{Case, Kind, Quantity, RangePoint, TrendCheck};
 pub use stats::{summarise, SummaryRow};
 
 use crate::model::{self, Gearbox};
-use crate::physics::oil::KELVIN_OFFSET;
+use crate::physics::units::{c_to_k, rpm_to_rad_s};
 use crate::scene::{LossScene, OperatingPoint, RangeLog, RangeWarning, Source};
 
 /// One row of `validation.csv`.
@@ -227,9 +227,9 @@ fn value(
         .ok_or_else(|| format!("gear state \"{gear}\" not in the model"))?;
     let op = OperatingPoint {
         state,
-        input_speed: rpm * std::f64::consts::PI / 30.0,
+        input_speed: rpm_to_rad_s(rpm),
         input_torque: torque,
-        oil: gb.oil.properties(temp_c + KELVIN_OFFSET),
+        oil: gb.oil.properties(c_to_k(temp_c)),
     };
     let mut out = vec![0.0; scene.len()];
     scene.evaluate(&op, &mut out);

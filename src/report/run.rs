@@ -8,12 +8,12 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
-use crate::physics::oil::KELVIN_OFFSET;
 use crate::scene::{
     sum_by_source, OperatingPoint, RangeLog, RangeWarning, Scene, Skipped, Source, N_SOURCES,
 };
 
 use super::sources::{csv_columns, SourceValues};
+use crate::physics::units::{k_to_c, rpm_to_rad_s};
 use crate::solve::transient::{energy_balance, Stats, Trajectory};
 
 pub use crate::solve::drive::RowInputs;
@@ -211,7 +211,7 @@ pub fn run_warnings(scene: &Scene, traj: &Trajectory, rows: &[RowInputs]) -> Vec
         };
         let op = OperatingPoint {
             state,
-            input_speed: r.input_speed_rpm * std::f64::consts::PI / 30.0,
+            input_speed: rpm_to_rad_s(r.input_speed_rpm),
             input_torque: r.input_torque_nm,
             oil: scene.thermal.oil_properties(scene.oil_temp(y)),
         };
@@ -276,7 +276,7 @@ pub fn summary(
 
     let mut temps = BTreeMap::new();
     for i in 0..n {
-        let series = traj.states.iter().map(|y| y[i] - KELVIN_OFFSET);
+        let series = traj.states.iter().map(|y| k_to_c(y[i]));
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
         for v in series {
             lo = lo.min(v);
@@ -287,7 +287,7 @@ pub fn summary(
             TempStats {
                 min: lo,
                 max: hi,
-                r#final: last.get(i).map_or(f64::NAN, |t| t - KELVIN_OFFSET),
+                r#final: last.get(i).map_or(f64::NAN, |t| k_to_c(*t)),
             },
         );
     }
@@ -326,7 +326,7 @@ pub fn summary(
         nodes,
         oil_node: scene.thermal.names[scene.thermal.oil].clone(),
         skipped: scene.skipped.clone(),
-        frozen_viscosity: scene.frozen_oil_temp.is_some(),
+        frozen_viscosity: scene.frozen_oil_temp().is_some(),
         warnings: run_warnings(scene, traj, rows),
         launch: launch_summary(&traj.times, rows),
         controls: control_summaries(scene, traj),
@@ -394,11 +394,11 @@ pub fn timeseries_csv(
         }
         for v in y.iter().take(n) {
             s.push(',');
-            num(&mut s, v - KELVIN_OFFSET);
+            num(&mut s, k_to_c(*v));
         }
         for v in boundary_temps(*t) {
             s.push(',');
-            num(&mut s, v - KELVIN_OFFSET);
+            num(&mut s, k_to_c(v));
         }
         for q in &traj.losses[k] {
             s.push(',');
@@ -450,7 +450,7 @@ pub fn skipped_items(scene: &Scene) -> Vec<(Source, String)> {
 /// pump are paid ahead of it (the engine columns show that side). The loss items themselves are
 /// evaluated at the loss-free torque (docs/physics.md §10, "Mesh loads").
 fn input_shaft_torque(scene: &Scene, r: &RowInputs, losses: &[f64]) -> f64 {
-    let w_in = r.input_speed_rpm * std::f64::consts::PI / 30.0;
+    let w_in = rpm_to_rad_s(r.input_speed_rpm);
     let shaft_loss: f64 = scene
         .losses
         .items

@@ -51,9 +51,29 @@ pub fn journal_name(shard: Option<(usize, usize)>) -> String {
     }
 }
 
+/// Why the journals of a directory cannot be read.
+#[derive(Debug, thiserror::Error)]
+pub enum JournalError {
+    /// A journal of another study (different fingerprint): the directory belongs to it.
+    #[error("{}: belongs to a different study (another study file or model); choose another output directory", .0.display())]
+    Foreign(PathBuf),
+    /// A journal could not be read.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The journal or directory.
+        path: PathBuf,
+        /// Cause.
+        source: std::io::Error,
+    },
+}
+
 /// Rows already in every journal of `dir` (all shards), by case id. Journals of another study
 /// (different fingerprint) are an error: the directory belongs to a different study.
-pub fn read_journals(dir: &Path, fingerprint: &str) -> std::io::Result<BTreeMap<String, CaseRow>> {
+pub fn read_journals(dir: &Path, fingerprint: &str) -> Result<BTreeMap<String, CaseRow>, JournalError> {
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| JournalError::Io { path, source }
+    };
     let mut done = BTreeMap::new();
     let Ok(entries) = std::fs::read_dir(dir) else {
         return Ok(done);
@@ -68,7 +88,7 @@ pub fn read_journals(dir: &Path, fingerprint: &str) -> std::io::Result<BTreeMap<
         .collect();
     files.sort();
     for f in files {
-        let mut reader = BufReader::new(File::open(&f)?);
+        let mut reader = BufReader::new(File::open(&f).map_err(io(&f))?);
         let mut head = String::new();
         // A header without its newline is being written by a writer that has just created
         // the journal (another shard starting at the same time): it holds no rows yet.
@@ -78,17 +98,11 @@ pub fn read_journals(dir: &Path, fingerprint: &str) -> std::io::Result<BTreeMap<
         let lines = reader.lines();
         let head: serde_json::Value = serde_json::from_str(&head).unwrap_or_default();
         if head.get("study").and_then(|s| s.as_str()) != Some(fingerprint) {
-            return Err(std::io::Error::new(
-                std::io::ErrorKind::InvalidInput,
-                format!(
-                    "{} belongs to a different study (another study file or model); use another --out",
-                    f.display()
-                ),
-            ));
+            return Err(JournalError::Foreign(f));
         }
         for line in lines {
             // A torn last line (killed mid-write) does not parse and is skipped.
-            if let Ok(row) = serde_json::from_str::<CaseRow>(&line?) {
+            if let Ok(row) = serde_json::from_str::<CaseRow>(&line.map_err(io(&f))?) {
                 done.insert(row.case.clone(), row);
             }
         }

@@ -59,8 +59,9 @@ pub struct Scene {
     /// What the compile step left out and why.
     pub skipped: Vec<Skipped>,
     /// Oil temperature used for the oil properties instead of the oil node's (K); `None` for the
-    /// normal coupled model. Used to measure the viscosity feedback.
-    pub frozen_oil_temp: Option<f64>,
+    /// normal coupled model. Used to measure the viscosity feedback. Set by the compile
+    /// ([`Needs::frozen_oil_temp_k`]).
+    frozen_oil_temp: Option<f64>,
     /// Energy quadrature (offset after the nodes) each loss item adds to.
     pub energy_slot: Vec<usize>,
     /// Number of energy quadratures (items, or 3 sources).
@@ -70,7 +71,7 @@ pub struct Scene {
     /// Clamp of the oil temperature used for the oil properties (K), if any: lets a runaway be
     /// followed past the oil's valid range without the property laws breaking down (used by the
     /// steady-state fallback to prove that no equilibrium exists in range).
-    pub oil_temp_clamp: Option<(f64, f64)>,
+    oil_temp_clamp: Option<(f64, f64)>,
 }
 
 /// Mutable work area of one solve: current inputs, sample values and buffers. No allocation after
@@ -132,6 +133,24 @@ impl Scene {
         Self::compile_for(gb, &Needs::default())
     }
 
+    /// This scene with the oil temperature seen by the oil properties held within `bounds` (K):
+    /// the steady solver's transient fallback.
+    pub fn with_oil_temp_clamp(mut self, bounds: (f64, f64)) -> Scene {
+        self.oil_temp_clamp = Some(bounds);
+        self
+    }
+
+    /// This scene starting from the state `initial` (K per node).
+    pub fn with_initial(mut self, initial: Vec<f64>) -> Scene {
+        self.thermal.initial = initial;
+        self
+    }
+
+    /// The temperature the oil properties are frozen at (K), when the scenario freezes them.
+    pub fn frozen_oil_temp(&self) -> Option<f64> {
+        self.frozen_oil_temp
+    }
+
     /// Compile only what `needs` asks for (scene pruning): see [`LossScene::compile_for`].
     pub fn compile_for(gb: &Gearbox, needs: &Needs) -> Result<Scene, SceneError> {
         let net = gb.thermal.as_ref().ok_or_else(|| SceneError {
@@ -139,7 +158,14 @@ impl Scene {
             why: "the model has no [thermal] section; a transient or steady run needs one".into(),
         })?;
         let losses = LossScene::compile_for(gb, needs)?;
-        let thermal = ThermalScene::compile(gb, net, &losses.items);
+        let mut thermal = ThermalScene::compile(gb, net, &losses.items);
+        if let Some(t) = needs.ambient_k {
+            let idx = thermal.ambient.ok_or_else(|| SceneError {
+                what: "ambient temperature".into(),
+                why: "the model has no ambient boundary (name one `ambient` or set ambient = true)".into(),
+            })?;
+            thermal.set_boundary_fixed(idx, t)?;
+        }
         let mut skipped = losses.skipped.clone();
         let (energy_slot, energies) = if needs.energy_per_source_only {
             skipped.push(Skipped {
@@ -160,7 +186,7 @@ impl Scene {
             energy_slot,
             energies,
             item_energies: !needs.energy_per_source_only,
-            frozen_oil_temp: None,
+            frozen_oil_temp: needs.frozen_oil_temp_k,
             oil_temp_clamp: None,
         })
     }

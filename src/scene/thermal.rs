@@ -612,12 +612,16 @@ impl ThermalScene {
         }
     }
 
-    /// Replace the boundary temperatures by one constant (the ambient for `--ambient-c`) for the
-    /// boundary `index`.
-    pub fn set_boundary_fixed(&mut self, index: usize, temp: f64) {
-        if let Some(b) = self.boundaries.get_mut(index) {
-            *b = BoundaryTemp::Fixed(temp);
-        }
+    /// Hold boundary `index` at one constant temperature, K (the scenario's ambient, applied by
+    /// the compile); an index beyond the boundaries is an error.
+    pub(crate) fn set_boundary_fixed(&mut self, index: usize, temp: f64) -> Result<(), super::SceneError> {
+        let n = self.boundaries.len();
+        let b = self.boundaries.get_mut(index).ok_or_else(|| super::SceneError {
+            what: format!("boundary {index}"),
+            why: format!("the network has {n} boundaries"),
+        })?;
+        *b = BoundaryTemp::Fixed(temp);
+        Ok(())
     }
 
     /// Temperature of boundary `index` at time `t`, K (None: no such boundary).

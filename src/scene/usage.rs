@@ -18,6 +18,12 @@ pub struct Needs {
     /// Loss energy per source only (three quadratures) instead of per item: for runs whose
     /// outputs do not include the energy of each item (the work-precision benchmark).
     pub energy_per_source_only: bool,
+    /// The ambient boundary held at this temperature, K (the scenario's ambient; the model's
+    /// own boundary temperatures otherwise). The model must have an ambient boundary.
+    pub ambient_k: Option<f64>,
+    /// Oil properties frozen at this temperature, K (the scenario's frozen viscosity; they
+    /// follow the oil node otherwise).
+    pub frozen_oil_temp_k: Option<f64>,
 }
 
 /// Kinematics of every gear state and which states a run needs.

@@ -6,11 +6,11 @@ use std::cell::RefCell;
 
 use nalgebra::DMatrix;
 
-use crate::physics::oil::KELVIN_OFFSET;
 use crate::scene::{Inputs, Scene, Work};
 
 use super::steady::{solve_steady, BoundSide, HeatBalance, SteadyError, SteadyOptions, SteadySolution};
 use super::transient::{integrate, Method, Segment, TransientOptions};
+use crate::physics::units::{c_to_k, k_to_c};
 
 /// Time at which time-series boundaries are evaluated for a steady state: their final value.
 pub const STEADY_TIME: f64 = 1e12;
@@ -60,7 +60,7 @@ impl HeatBalance for SceneBalance<'_> {
                 "loss item {}:{} is not finite at oil temperature {:.2} °C",
                 it.source.as_str(),
                 it.name,
-                self.scene.oil_temp(&y) - KELVIN_OFFSET
+                k_to_c(self.scene.oil_temp(&y))
             ));
         }
         Ok(())
@@ -98,7 +98,7 @@ impl HeatBalance for SceneBalance<'_> {
         } else {
             NODE_RANGE_C
         };
-        (lo + KELVIN_OFFSET, hi + KELVIN_OFFSET)
+        (c_to_k(lo), c_to_k(hi))
     }
 }
 
@@ -291,12 +291,11 @@ fn transient_fallback(
         initial_temp: None,
         ..TransientOptions::default()
     };
-    let mut scene_from = scene.clone();
-    scene_from.oil_temp_clamp = Some(sys.bounds(scene.thermal.oil));
+    let clamped = scene.clone().with_oil_temp_clamp(sys.bounds(scene.thermal.oil));
     let mut last = t0.to_vec();
     // One segment at a time, checking the limits between them.
     for seg in &segs {
-        scene_from.thermal.initial = last.clone();
+        let scene_from = clamped.clone().with_initial(last.clone());
         let traj = integrate(&scene_from, std::slice::from_ref(seg), &o, &mut |_, _| {})
             .map_err(|e| SteadyError::Model(format!("transient fallback failed: {e}")))?;
         let y = traj.states.last().map_or(&last[..], |v| &v[..n]).to_vec();

@@ -7,6 +7,7 @@ use crate::scene::{Inputs, Scene};
 
 use super::equilibrium::{equilibrium, Equilibrium};
 use super::steady::SteadyOptions;
+use crate::physics::units::rpm_to_rad_s;
 
 /// One grid point and its equilibrium (None: no equilibrium found, from the warm start nor from
 /// ambient).
@@ -33,7 +34,7 @@ pub fn map(
 ) -> Vec<MapPoint> {
     let inputs = |rpm: f64, tq: f64| Inputs {
         state,
-        input_speed: rpm * std::f64::consts::PI / 30.0,
+        input_speed: rpm_to_rad_s(rpm),
         input_torque: tq,
         vehicle_speed,
     };

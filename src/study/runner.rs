@@ -7,38 +7,22 @@
 //! running finish and are journaled, and [`run`] returns with [`Tally::cancelled`] set. A rerun
 //! into the same directory solves only the cases not journaled.
 
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
-use crate::report::files::{lock_in_place, write_all_atomic};
+use rayon::prelude::*;
+
+use crate::job::JobError;
+use crate::report::files::{lock_in_place, write_all_atomic, DirLock};
 use crate::report::study::{journal_name, read_journals, study_csv, study_parquet, CaseRow, Journal, Table};
 
-use super::{Case, Study};
+use super::{Case, CaseFiles, Selection, Study};
 
-/// Why the runner stopped before its work was done.
-#[derive(Debug, thiserror::Error)]
-pub enum RunnerError {
-    /// The output directory holds the journal of another study (a usage error).
-    #[error("{0}")]
-    Foreign(String),
-    /// The directory is locked by another writer, or a file could not be read or written.
-    #[error("{0}")]
-    Io(String),
-}
-
-impl RunnerError {
-    fn io(dir: &Path) -> impl Fn(std::io::Error) -> RunnerError + '_ {
-        move |e| {
-            let m = format!("{}: {e}", dir.display());
-            if e.kind() == std::io::ErrorKind::InvalidInput {
-                RunnerError::Foreign(m)
-            } else {
-                RunnerError::Io(m)
-            }
-        }
-    }
+fn io_error(what: &Path) -> impl Fn(std::io::Error) -> JobError + '_ {
+    move |e| JobError::io(format!("{}: {e}", what.display()), e.kind())
 }
 
 /// What a run did.
@@ -65,97 +49,146 @@ impl Tally {
     }
 }
 
-/// Where a run writes: the output directory and the shard (its journal's name).
-#[derive(Debug, Clone)]
-pub struct Output {
-    /// Output directory (journals, `cases/<id>/`, the compacted table and figures).
-    pub dir: PathBuf,
-    /// Shard `(i, n)`: the journal is `journal.shard-i-of-n.jsonl`.
-    pub shard: Option<(usize, usize)>,
+/// The journal side of a run into an output directory: its lock, the journal, and the case ids
+/// journaled there.
+struct Journaled {
+    dir: PathBuf,
+    _lock: DirLock,
+    journal: Journal,
+    done: Mutex<HashSet<String>>,
 }
 
-/// Solve `cases` of `study`. With `out`, cases already journaled there are skipped, every
-/// finished case is journaled (after its files when per-case files are asked for), and one
-/// writer at a time holds the journal. `on_done` receives every case solved by this run (from
-/// worker threads, in completion order). Returns the tally and the rows solved by this run.
-pub fn run(
-    study: &Study,
-    cases: &[Case],
-    out: Option<&Output>,
-    cancel: &AtomicBool,
-    on_done: &(dyn Fn(&CaseRow) + Sync),
-) -> Result<(Tally, Vec<CaseRow>), RunnerError> {
-    let per_case = study.spec.outputs.per_case && out.is_some();
-    let mut tally = Tally {
-        cases: cases.len(),
-        already_done: 0,
-        solved: 0,
-        wall_s: 0.0,
-        threads: rayon::current_num_threads(),
-        cancelled: false,
-    };
-    let (_lock, journal, todo) = match out {
-        Some(o) => {
-            let lock =
-                lock_in_place(&o.dir, &journal_name(o.shard)).map_err(|e| RunnerError::Io(e.to_string()))?;
-            let done = read_journals(&o.dir, &study.fingerprint).map_err(RunnerError::io(&o.dir))?;
-            let todo: Vec<Case> = cases
-                .iter()
-                .filter(|c| !done.contains_key(&study.case_id(c)))
-                .copied()
-                .collect();
-            let journal = Journal::open(&o.dir, &journal_name(o.shard), &study.fingerprint)
-                .map_err(RunnerError::io(&o.dir))?;
-            (Some(lock), Some(journal), todo)
-        }
-        None => (None, None, cases.to_vec()),
-    };
-    tally.already_done = cases.len() - todo.len();
-    let rows: Mutex<Vec<CaseRow>> = Mutex::new(Vec::with_capacity(todo.len()));
-    let write_error: Mutex<Option<String>> = Mutex::new(None);
-    let start = Instant::now();
-    study.run_until(&todo, per_case, cancel, &|row: CaseRow, files| {
-        if let (Some(o), Some(j)) = (out, &journal) {
-            let mut result = Ok(());
+/// One run of a selection of a study's cases, whoever solves them: this process
+/// ([`run`]) or remote workers (the Python package's Dask path solves [`Session::todo`]
+/// elsewhere and hands each row to [`Session::record`]). With an output directory, the cases
+/// already journaled there are not in `todo`, every recorded case is journaled (after its files)
+/// once, and one writer at a time holds the journal.
+pub struct Session {
+    cases: usize,
+    todo: Vec<Case>,
+    journal: Option<Journaled>,
+    rows: Mutex<Vec<CaseRow>>,
+    start: Instant,
+}
+
+impl Session {
+    /// Select the cases, take the output directory's lock and read its journals (resume).
+    pub fn open(study: &Study, selection: &Selection, out: Option<&Path>) -> Result<Session, JobError> {
+        let cases = study.select(selection)?;
+        let (journal, todo) = match out {
+            Some(dir) => {
+                let name = journal_name(selection.journal_shard());
+                let lock = lock_in_place(dir, &name)?;
+                let done = read_journals(dir, &study.fingerprint)?;
+                let todo: Vec<Case> = cases
+                    .iter()
+                    .filter(|c| !done.contains_key(&study.case_id(c)))
+                    .copied()
+                    .collect();
+                let journal = Journal::open(dir, &name, &study.fingerprint).map_err(io_error(dir))?;
+                let done = Mutex::new(done.into_keys().collect());
+                let dir = dir.to_path_buf();
+                (
+                    Some(Journaled {
+                        dir,
+                        _lock: lock,
+                        journal,
+                        done,
+                    }),
+                    todo,
+                )
+            }
+            None => (None, cases.clone()),
+        };
+        Ok(Session {
+            cases: cases.len(),
+            rows: Mutex::new(Vec::with_capacity(todo.len())),
+            todo,
+            journal,
+            start: Instant::now(),
+        })
+    }
+
+    /// The cases still to solve, in case order.
+    pub fn todo(&self) -> &[Case] {
+        &self.todo
+    }
+
+    /// A solved case: its files written under `cases/<id>/`, then its row journaled (a
+    /// journaled case is complete). A case already recorded or journaled is not recorded
+    /// again (a task rerun after a lost worker); returns whether this call recorded it.
+    pub fn record(&self, row: CaseRow, files: &CaseFiles) -> Result<bool, JobError> {
+        if let Some(j) = &self.journal {
+            let mut done = j.done.lock().unwrap_or_else(|e| e.into_inner());
+            if !done.insert(row.case.clone()) {
+                return Ok(false);
+            }
             if !files.is_empty() {
                 let named: Vec<(&str, &[u8])> =
                     files.iter().map(|(n, b)| (n.as_str(), b.as_slice())).collect();
-                result = write_all_atomic(&o.dir.join("cases").join(&row.case), &named).map(|_| ());
+                let dir = j.dir.join("cases").join(&row.case);
+                write_all_atomic(&dir, &named).map_err(io_error(&dir))?;
             }
-            // The row is journaled only after its files are in place: a journaled case is
-            // complete.
-            if let Err(e) = result.and_then(|_| j.append(&row)) {
-                let mut w = write_error.lock().unwrap_or_else(|e| e.into_inner());
-                w.get_or_insert_with(|| format!("{}: {e}", j.path().display()));
-                // A study that cannot journal stops: nothing it solves could be kept.
-                cancel.store(true, Ordering::SeqCst);
-                return;
-            }
+            j.journal.append(&row).map_err(io_error(j.journal.path()))?;
         }
-        on_done(&row);
-        rows.lock().unwrap_or_else(|e| e.into_inner()).push(row);
-    });
-    tally.wall_s = start.elapsed().as_secs_f64();
-    if let Some(e) = write_error.into_inner().unwrap_or_else(|e| e.into_inner()) {
-        return Err(RunnerError::Io(e));
+        self.rows.lock().unwrap_or_else(|e| e.into_inner()).push(row);
+        Ok(true)
     }
-    let rows = rows.into_inner().unwrap_or_else(|e| e.into_inner());
-    tally.solved = rows.len();
-    tally.cancelled = tally.already_done + tally.solved < cases.len();
-    Ok((tally, rows))
+
+    /// The tally and the rows recorded by this session (in the order recorded).
+    pub fn finish(self) -> (Tally, Vec<CaseRow>) {
+        let rows = self.rows.into_inner().unwrap_or_else(|e| e.into_inner());
+        let already_done = self.cases - self.todo.len();
+        let tally = Tally {
+            cases: self.cases,
+            already_done,
+            solved: rows.len(),
+            wall_s: self.start.elapsed().as_secs_f64(),
+            threads: rayon::current_num_threads(),
+            cancelled: already_done + rows.len() < self.cases,
+        };
+        (tally, rows)
+    }
 }
 
-/// Journal rows solved elsewhere (e.g. by remote workers) into `dir`, skipping the cases
-/// already journaled there, under the same lock as [`run`].
-pub fn record(study: &Study, dir: &Path, rows: &[CaseRow]) -> Result<(), RunnerError> {
-    let name = journal_name(None);
-    let _lock = lock_in_place(dir, &name).map_err(|e| RunnerError::Io(e.to_string()))?;
-    let done = read_journals(dir, &study.fingerprint).map_err(RunnerError::io(dir))?;
-    let journal = Journal::open(dir, &name, &study.fingerprint).map_err(RunnerError::io(dir))?;
-    for r in rows.iter().filter(|r| !done.contains_key(&r.case)) {
-        journal.append(r).map_err(RunnerError::io(dir))?;
+/// Solve the `selection` of `study` in parallel (rayon): the one entry point of `geartherm
+/// study`, Python's local run and a Dask task. With `out`, cases already journaled there are
+/// skipped, every finished case is journaled (after its files when per-case files are asked
+/// for). No new case starts once `cancel` is set. `on_done` receives every case solved by this
+/// run (from worker threads, in completion order). Returns the tally and the rows solved by
+/// this run.
+pub fn run(
+    study: &Study,
+    selection: &Selection,
+    out: Option<&Path>,
+    cancel: &AtomicBool,
+    on_done: &(dyn Fn(&CaseRow) + Sync),
+) -> Result<(Tally, Vec<CaseRow>), JobError> {
+    let per_case = study.spec.outputs.per_case && out.is_some();
+    let session = Session::open(study, selection, out)?;
+    let write_error: Mutex<Option<JobError>> = Mutex::new(None);
+    session.todo().par_iter().with_max_len(1).for_each(|c| {
+        if cancel.load(Ordering::SeqCst) {
+            return;
+        }
+        let (row, files) = study.run_case(c, per_case);
+        let shown = row.clone();
+        match session.record(row, &files) {
+            Ok(_) => on_done(&shown),
+            Err(e) => {
+                write_error
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .get_or_insert(e);
+                // A study that cannot journal stops: nothing it solves could be kept.
+                cancel.store(true, Ordering::SeqCst);
+            }
+        }
+    });
+    if let Some(e) = write_error.into_inner().unwrap_or_else(|e| e.into_inner()) {
+        return Err(e);
     }
-    Ok(())
+    Ok(session.finish())
 }
 
 /// The table of `rows` in the study's case order (every case of the study that has a row).
@@ -173,8 +206,8 @@ pub fn table(study: &Study, rows: impl IntoIterator<Item = CaseRow>) -> Table {
 }
 
 /// The journaled rows of `dir` as the study table (all shards merged, case order).
-pub fn journaled(study: &Study, dir: &Path) -> Result<Table, RunnerError> {
-    let done = read_journals(dir, &study.fingerprint).map_err(RunnerError::io(dir))?;
+pub fn journaled(study: &Study, dir: &Path) -> Result<Table, JobError> {
+    let done = read_journals(dir, &study.fingerprint)?;
     Ok(table(study, done.into_values()))
 }
 
@@ -190,11 +223,12 @@ pub struct Compacted {
 
 /// Merge every journal of `dir` into `study.csv`, `study.parquet` and the figures
 /// (`main_effects.png`; `pareto.png` when two outputs are named or found).
-pub fn compact(study: &Study, dir: &Path) -> Result<Compacted, RunnerError> {
+pub fn compact(study: &Study, dir: &Path) -> Result<Compacted, JobError> {
     let table = journaled(study, dir)?;
-    let csv = study_csv(&table).map_err(|e| RunnerError::Io(format!("study.csv: {e}")))?;
-    let pq = study_parquet(&table).map_err(|e| RunnerError::Io(format!("study.parquet: {e}")))?;
-    write_all_atomic(dir, &[("study.csv", &csv), ("study.parquet", &pq)]).map_err(RunnerError::io(dir))?;
+    let other = std::io::ErrorKind::Other;
+    let csv = study_csv(&table).map_err(|e| JobError::io(format!("study.csv: {e}"), other))?;
+    let pq = study_parquet(&table).map_err(|e| JobError::io(format!("study.parquet: {e}"), other))?;
+    write_all_atomic(dir, &[("study.csv", &csv), ("study.parquet", &pq)]).map_err(io_error(dir))?;
     let effects = study
         .spec
         .outputs
@@ -212,7 +246,7 @@ pub fn compact(study: &Study, dir: &Path) -> Result<Compacted, RunnerError> {
         &effects,
         pareto.as_ref().map(|[a, b]| (a.as_str(), b.as_str())),
     )
-    .map_err(|e| RunnerError::Io(format!("study figures: {e}")))?;
+    .map_err(|e| JobError::io(format!("study figures: {e}"), other))?;
     let mut files = vec![
         "study.csv".to_string(),
         "study.parquet".into(),
@@ -266,16 +300,13 @@ values = [40, 50, 60, 70]
     fn a_cancelled_run_journals_what_it_solved_and_the_rerun_does_the_rest() {
         let d = tempfile::tempdir().unwrap();
         let s = study(d.path());
-        let out = Output {
-            dir: d.path().join("out"),
-            shard: None,
-        };
+        let out = d.path().join("out");
         let cancel = AtomicBool::new(false);
         let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
         // Cancel after the first case: with one thread no other case starts.
         let (t, rows) = pool
             .install(|| {
-                run(&s, &s.cases(), Some(&out), &cancel, &|_| {
+                run(&s, &Selection::All, Some(&out), &cancel, &|_| {
                     cancel.store(true, Ordering::SeqCst)
                 })
             })
@@ -283,17 +314,17 @@ values = [40, 50, 60, 70]
         assert!(t.cancelled);
         assert_eq!((t.solved, rows.len()), (1, 1));
         let cancel = AtomicBool::new(false);
-        let (t, rows) = run(&s, &s.cases(), Some(&out), &cancel, &|_| {}).unwrap();
+        let (t, rows) = run(&s, &Selection::All, Some(&out), &cancel, &|_| {}).unwrap();
         assert!(!t.cancelled);
         assert_eq!((t.already_done, t.solved), (1, 3));
         assert!(rows.iter().all(|r| r.case != "000000-p0000"));
-        let c = compact(&s, &out.dir).unwrap();
+        let c = compact(&s, &out).unwrap();
         assert_eq!(c.table.rows.len(), 4);
         let ids: Vec<&str> = c.table.rows.iter().map(|r| r.case.as_str()).collect();
         assert_eq!(
             ids,
             ["000000-p0000", "000001-p0000", "000002-p0000", "000003-p0000"]
         );
-        assert!(out.dir.join("study.parquet").is_file());
+        assert!(out.join("study.parquet").is_file());
     }
 }

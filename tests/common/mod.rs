@@ -3,7 +3,8 @@
 #![allow(dead_code)]
 
 use geartherm::model;
-use geartherm::scene::{Inputs, Scene};
+use geartherm::physics::units::c_to_k;
+use geartherm::scene::{Inputs, Needs, Scene};
 use geartherm::solve::transient::Segment;
 
 /// The FZG C gear data without its thermal network and vehicle, plus `thermal`.
@@ -13,6 +14,19 @@ pub fn fzg_with(thermal: &str) -> Scene {
     let full = format!("{}\n{thermal}", &text[..cut]);
     let gb = model::from_str(&full, std::path::Path::new("test.toml")).unwrap();
     Scene::compile(&gb).unwrap()
+}
+
+/// [`fzg_with`] compiled with the oil properties frozen at `oil_c` (°C).
+pub fn fzg_frozen(thermal: &str, oil_c: f64) -> Scene {
+    let text = std::fs::read_to_string("models/fzg_c.toml").unwrap();
+    let cut = text.find("# ------").unwrap();
+    let full = format!("{}\n{thermal}", &text[..cut]);
+    let gb = model::from_str(&full, std::path::Path::new("test.toml")).unwrap();
+    let needs = Needs {
+        frozen_oil_temp_k: Some(c_to_k(oil_c)),
+        ..Needs::default()
+    };
+    Scene::compile_for(&gb, &needs).unwrap()
 }
 
 /// A scene from a model file.

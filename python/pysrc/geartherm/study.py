@@ -90,21 +90,9 @@ class _Bar:
             sys.stderr.write("\n")
 
 
-def _case_indices(cases: Sequence[int], n: int) -> List[int]:
-    """``cases`` as distinct positions in [0, n), each once (a case run twice would be two rows)."""
-    import operator
-
-    todo = [operator.index(i) for i in cases]
-    for i in todo:
-        if not 0 <= i < n:
-            raise InputError(f"cases: {i}: must lie in [0, {n}) (the study has {n} cases)")
-    if len(set(todo)) != len(todo):
-        raise InputError("cases: a case is given more than once; each case runs once")
-    return todo
-
-
 def _batch(spec_json: str, text: str, file: str, indices: List[int], threads: Optional[int]) -> str:
-    """One Dask task: solve a batch of cases from the shipped study and model text."""
+    """One Dask task: the study runner on a batch of cases of the shipped study and model text
+    (nothing written; the rows as JSON)."""
     return _native.run_cases(spec_json, text, file, indices, threads)
 
 
@@ -186,14 +174,14 @@ class Study:
         writes them in). Running it with :meth:`job`'s options gives the case's row."""
         from . import Model
 
-        overrides, _ = _native.study_case(self._spec_json, self._text, self._file, _case_indices([case], len(self.cases))[0])
+        overrides, _ = _native.study_case(self._spec_json, self._text, self._file, case)
         return Model(_native.Model.from_text(self._text, self._file).with_overrides(overrides))
 
     def job(self, case: int) -> Dict[str, Json]:
         """The job of case ``case``: ``{"kind": "run", "options": {...}}`` (the options of
         :meth:`Model.run`: ``cycle``, ``solver``, ``rtol``, ``atol``, ``summary_only``, …) or
         ``{"kind": "steady", "options": {...}}`` (those of :meth:`Model.steady`)."""
-        _, job = _native.study_case(self._spec_json, self._text, self._file, _case_indices([case], len(self.cases))[0])
+        _, job = _native.study_case(self._spec_json, self._text, self._file, case)
         out: Dict[str, Json] = json.loads(job)
         return out
 
@@ -262,10 +250,13 @@ class Study:
         threads : int, optional
             Threads of a local run, 1 … 1024 (default: every core).
         cases : sequence of int, optional
-            Only these positions in the case list.
+            Only these positions in the case list, each once (the CLI's ``--cases``).
         shard : (i, n), optional
-            Only shard ``i`` of ``n`` (cases i, i+n, …), journaled as ``journal.shard-i-of-n``;
-            a later run without ``shard`` merges the shards.
+            Only shard ``i`` of ``n`` (cases i, i+n, …; ``0 ≤ i < n``), journaled as
+            ``journal.shard-i-of-n``; a later run without ``shard`` merges the shards (the
+            CLI's ``--shard I/N``). ``cases`` and ``shard`` are checked by the study layer, as
+            for the CLI: an invalid one, or both at once, is an :class:`InputError` with the
+            CLI's message.
         batch_size, threads_per_task : int, optional
             Dask batching and the threads one task uses (1 … 1024; also the threads of a local
             run when ``threads`` is not given).
@@ -285,51 +276,48 @@ class Study:
         Ctrl-C (``KeyboardInterrupt``) stops the study cleanly: no new case starts, the running
         ones finish and are journaled, then the exception propagates; the same call resumes.
         """
-        indices = None if cases is None else _case_indices(cases, len(self.cases))
+        # The selection is built and checked by the study layer (the CLI's --cases/--shard).
+        picked = None if cases is None else list(cases)
+        args = (self._spec_json, self._text, self._file)
+        total = len(_native.study_select(*args, picked, shard))
         if client is None and threads is None:
             threads = threads_per_task
         outdir = None if out is None else os.fspath(out)
-        bar = _Bar(len(self.cases) if indices is None else len(indices), self.name, progress)
+        bar = _Bar(total, self.name, progress)
         try:
             if client is None:
-                csv, self.tally = _native.run_study(
-                    self._spec_json, self._text, self._file, outdir, shard, indices, threads, bar, True
-                )
+                csv, self.tally = _native.run_study(*args, outdir, shard, picked, threads, bar, True)
             else:
-                csv = self._run_dask(client, outdir, indices, shard, bar, batch_size, threads_per_task)
+                csv = self._run_dask(client, outdir, picked, shard, bar, batch_size, threads_per_task)
         finally:
             bar.close()
         return _study_frame(csv, self.spec, backend)
 
-    def _run_dask(self, client, outdir, indices, shard, bar, batch_size, threads_per_task) -> str:
+    def _run_dask(self, client, outdir, picked, shard, bar, batch_size, threads_per_task) -> str:
+        """The runner's session here (selection, lock, resume, journal, compaction), its cases
+        solved by Dask tasks that each run the runner on a batch (nothing written there)."""
         from distributed import as_completed
 
         args = (self._spec_json, self._text, self._file)
-        todo = list(range(len(self.cases))) if indices is None else indices
-        if shard is not None:
-            todo = [i for i in todo if i % shard[1] == shard[0]]
-        done_ids = set(_native.study_done(*args, outdir)) if outdir else set()
-        todo = [i for i in todo if self.cases[i] not in done_ids]
-        n = len(todo)
-        if batch_size is None:
-            workers = sum(client.nthreads().values()) or 1
-            batch_size = max(1, math.ceil(n / (4 * workers)))
-        batches = [todo[i : i + batch_size] for i in range(0, n, batch_size)]
-        futures = [client.submit(_batch, *args, b, threads_per_task, pure=False) for b in batches]
-        rows: List[Dict[str, Any]] = []
+        session = _native.StudySession(*args, outdir, picked, shard)
         try:
-            for f in as_completed(futures):
-                part = f.result()
-                if outdir:
-                    _native.study_record(*args, outdir, part)
-                rows.extend(json.loads(part))
-                bar(len(rows), n)
-        except BaseException:
-            client.cancel(futures)
-            raise
-        if outdir and shard is None:
-            return _native.study_compact(*args, outdir)
-        return _native.study_table(*args, json.dumps(rows))
+            todo = session.todo()
+            n = len(todo)
+            if batch_size is None:
+                workers = sum(client.nthreads().values()) or 1
+                batch_size = max(1, math.ceil(n / (4 * workers)))
+            batches = [todo[i : i + batch_size] for i in range(0, n, batch_size)]
+            futures = [client.submit(_batch, *args, b, threads_per_task, pure=False) for b in batches]
+            try:
+                for f in as_completed(futures):
+                    bar(session.record(f.result()), n)
+            except BaseException:
+                client.cancel(futures)
+                raise
+            csv, self.tally = session.finish()
+        finally:
+            session.close()
+        return csv
 
     def _repr_html_(self) -> str:
         s = self.spec

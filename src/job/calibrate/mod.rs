@@ -67,7 +67,6 @@ pub const WEAK_EIGENVALUE: f64 = 1e-2;
 /// Most evaluations with sensitivities.
 pub const MAX_ITERATIONS: Limit = Limit {
     name: "max_iterations",
-    flag: "--max-iterations",
     lo: 1.0,
     hi: 1000.0,
     unit: "",

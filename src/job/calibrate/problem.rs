@@ -177,6 +177,7 @@ impl<'a> Problem<'a> {
             states: Some(segs.iter().map(|s| s.inputs.state).collect()),
             evaluate_all: false,
             energy_per_source_only: true,
+            ..Needs::default()
         };
         let doc = base_document(text, &base).map_err(|e| invalid(&label, e))?;
         Ok(Problem {

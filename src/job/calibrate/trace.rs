@@ -207,10 +207,11 @@ impl Trace {
         })
     }
 
-    /// Read and parse a trace file (an unreadable file is an I/O error).
-    pub fn load(path: &std::path::Path) -> Result<Result<Trace, TraceError>, std::io::Error> {
-        let text = std::fs::read_to_string(path)?;
-        Ok(Trace::parse(&text, &path.display().to_string()))
+    /// Read and parse a trace file (one that cannot be read is I/O; one that is not UTF-8
+    /// text or does not parse is invalid input: [`crate::job::read_text`]).
+    pub fn load(path: &std::path::Path) -> Result<Trace, crate::job::JobError> {
+        let text = crate::job::read_text(path)?;
+        Ok(Trace::parse(&text, &path.display().to_string())?)
     }
 
     /// Number of rows.

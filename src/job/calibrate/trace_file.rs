@@ -329,13 +329,11 @@ impl TraceFile {
         }
     }
 
-    /// Read and cut a trace file (an unreadable file is an I/O error).
-    pub fn load(
-        path: &std::path::Path,
-        missing: Missing,
-    ) -> Result<Result<TraceFile, TraceError>, std::io::Error> {
-        let text = std::fs::read_to_string(path)?;
-        Ok(read(&text, &path.display().to_string(), missing))
+    /// Read and cut a trace file (one that cannot be read is I/O; one that is not UTF-8 text
+    /// or does not parse is invalid input: [`crate::job::read_text`]).
+    pub fn load(path: &std::path::Path, missing: Missing) -> Result<TraceFile, crate::job::JobError> {
+        let text = crate::job::read_text(path)?;
+        Ok(read(&text, &path.display().to_string(), missing)?)
     }
 }
 

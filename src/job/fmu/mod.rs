@@ -80,6 +80,7 @@ fn needs() -> Needs {
         states: None,
         evaluate_all: false,
         energy_per_source_only: false,
+        ..Needs::default()
     }
 }
 
