@@ -319,3 +319,44 @@ fn hermite(a: &Ahead, yb: &[f64], t: f64, out: &mut [f64]) {
         *o = h00 * a.ya[i] + h10 * a.fa[i] + h01 * yb[i] + h11 * a.fb[i];
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cubic Hermite interpolant reproduces a cubic exactly (from its values and slopes at
+    /// both ends), and its ends are the step's ends.
+    #[test]
+    fn hermite_is_exact_on_cubics() {
+        let p = |t: f64| 2.0 - 3.0 * t + 0.5 * t * t - 0.25 * t * t * t;
+        let dp = |t: f64| -3.0 + t - 0.75 * t * t;
+        let (ta, tb) = (1.5, 4.0);
+        let a = Ahead {
+            ta,
+            tb,
+            ya: vec![p(ta)],
+            fa: vec![dp(ta)],
+            fb: vec![dp(tb)],
+        };
+        let mut out = [0.0];
+        for t in [ta, 2.0, 2.75, 3.9, tb] {
+            hermite(&a, &[p(tb)], t, &mut out);
+            assert!(
+                (out[0] - p(t)).abs() <= 1e-12 * p(t).abs().max(1.0),
+                "{t}: {}",
+                out[0]
+            );
+        }
+        // Not exact on a quartic: the test could fail.
+        let q = |t: f64| t.powi(4);
+        let a = Ahead {
+            ta,
+            tb,
+            ya: vec![q(ta)],
+            fa: vec![4.0 * ta.powi(3)],
+            fb: vec![4.0 * tb.powi(3)],
+        };
+        hermite(&a, &[q(tb)], 2.75, &mut out);
+        assert!((out[0] - q(2.75)).abs() > 1e-3);
+    }
+}
