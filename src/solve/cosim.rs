@@ -178,19 +178,23 @@ impl Stepper {
     /// which the caller did not change since the last call unless it called
     /// [`Stepper::restart`]: the integrator keeps its own steps, each at most up to
     /// `t_max`, and the state at `t1` comes from the cubic Hermite interpolant of the step
-    /// containing it, from the states and derivatives f at both ends (Hairer, Nørsett & Wanner,
-    /// Solving ODEs I, 2nd ed., Section II.6, dense output: the Hermite interpolation of a step, of order 3
-    /// as ROS3 itself). The FATODE `Ros3` tableau (see [`super::rosenbrock`]) has no continuous
-    /// extension of its own. The interpolant's error is O(h⁴), below the step's embedded
-    /// error estimate O(h³), which the step-size control keeps under the tolerance. Being linear
+    /// containing it, from the states and derivatives f at both ends: the cubic Hermite
+    /// interpolation of a step, the dense output of order 3 Hairer, Nørsett & Wanner (Solving
+    /// ODEs I, Section II.6) give for any one-step method; that book was not read here, the
+    /// formula is checked by `hermite_is_exact_on_cubics`. No continuous extension of ROS3's
+    /// own is used (none was read with its coefficients, [`super::rosenbrock`]; a continuous
+    /// extension would need its stages). The interpolant's error is O(h⁴), below the step's
+    /// embedded error estimate O(h³), which the step-size control keeps under the tolerance.
+    /// Being linear
     /// in the end states and their f, the interpolant keeps every linear invariant of the
     /// states, so the energy balance (loss energies against node and boundary energies) closes
     /// at the interpolated point as at the step ends.
     ///
     /// Used only for communication steps shorter than [`LOOKAHEAD_MAX_STEP`] and at most
-    /// 1/[`LOOKAHEAD_RATIO`] of the step-size proposal; else this is [`Stepper::step`]. A step taken ahead in which a
-    /// controller or thermostat switched (f or its slope jumps there, which the interpolant
-    /// cannot follow) is undone, and the integrator lands on `t1` from the step's start.
+    /// 1/[`LOOKAHEAD_RATIO`] of the step-size proposal; else this is [`Stepper::step`]. A step
+    /// taken ahead in which a controller or thermostat switched (f or its slope jumps there,
+    /// which the interpolant cannot follow) is undone, and the integrator lands on `t1` from the
+    /// step's start.
     pub fn step_ahead(&mut self, scene: &Scene, t1: f64, t_max: f64) -> Result<(), NumericalFailure> {
         let h_comm = t1 - self.t;
         let proposal = self.carry.h.unwrap_or(0.0);
@@ -305,8 +309,9 @@ impl Stepper {
     }
 }
 
-/// The cubic Hermite interpolant of step `a` (end state `yb`) at `t` into `out` (Hairer, Nørsett
-/// & Wanner I, Section II.6).
+/// The cubic Hermite interpolant of step `a` (end state `yb`) at `t` into `out`: the basis
+/// 2s³ − 3s² + 1, (s³ − 2s² + s)h, −2s³ + 3s², (s³ − s²)h of the values and slopes at both ends
+/// (s = (t − ta)/h).
 fn hermite(a: &Ahead, yb: &[f64], t: f64, out: &mut [f64]) {
     let h = a.tb - a.ta;
     let s = ((t - a.ta) / h).clamp(0.0, 1.0);
