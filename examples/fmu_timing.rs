@@ -2,7 +2,8 @@
 //! `fmi2DoStep` calls; no importer overhead) on the AT6 over the WLTC, inputs from the run's
 //! segments (held), boundaries as lines, at communication steps of 1 s and 0.01 s, against the
 //! run itself (`job::run::solve`: the integration and its outputs, as `geartherm run` does it
-//! after reading the model).
+//! after reading the model). The importer's values (inputs, boundary values and derivatives at
+//! each communication point) are computed before the clock starts.
 //!
 //! `cargo run --release --example fmu_timing` — CPU time of this thread (the 2-core machine is
 //! shared), median of `FMU_REPEATS` (default 3) repeats. Prints µs per doStep and the ratio of the
@@ -18,12 +19,41 @@ use std::sync::Arc;
 use geartherm::job::fmu::instance::Instance;
 use geartherm::job::fmu::{FmuModel, Payload, Role};
 use geartherm::job::{run, Model, RunOptions};
+use geartherm::scene::Inputs;
 
 const AT6: &str = "models/at6_lepelletier.toml";
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
+}
+
+/// The communication points of one segment: (start, end, (value, derivative) per boundary).
+type Points = Vec<(f64, f64, Vec<(f64, f64)>)>;
+
+/// The importer's side of a WLTC co-simulation at communication step `step`, computed before the
+/// clock starts (the boundary values are read from the run's series): per segment its inputs
+/// and communication points.
+fn plan(p: &run::Prepared, step: f64) -> Vec<(Inputs, Points)> {
+    let nb = p.scene.thermal.boundary_names.len();
+    let at = |k, t| p.scene.thermal.boundary_temperature_at(k, t).unwrap();
+    p.segs
+        .iter()
+        .map(|seg| {
+            let n = ((seg.t1 - seg.t0) / step).round().max(1.0) as usize;
+            let points = (0..n)
+                .map(|j| {
+                    let a = seg.t0 + (seg.t1 - seg.t0) * j as f64 / n as f64;
+                    let b = seg.t0 + (seg.t1 - seg.t0) * (j + 1) as f64 / n as f64;
+                    let lines = (0..nb)
+                        .map(|k| (at(k, a), (at(k, b) - at(k, a)) / (b - a)))
+                        .collect();
+                    (a, b, lines)
+                })
+                .collect();
+            (seg.inputs, points)
+        })
+        .collect()
 }
 
 /// One WLTC co-simulation at communication step `step`: (CPU seconds, doSteps).
@@ -35,30 +65,26 @@ fn cosim(fm: &Arc<FmuModel>, p: &run::Prepared, step: f64) -> (f64, usize) {
         vr(Role::VehicleSpeed),
         vr(Role::Gear),
     );
-    let boundaries: Vec<(usize, u32)> = (0..p.scene.thermal.boundary_names.len())
-        .map(|b| (b, vr(Role::Boundary(b))))
+    let boundaries: Vec<u32> = (0..p.scene.thermal.boundary_names.len())
+        .map(|b| vr(Role::Boundary(b)))
         .collect();
+    let plan = plan(p, step);
     let t0 = cpu_time();
     let mut inst = Instance::new(fm.clone());
     inst.enter_initialization().unwrap();
     inst.exit_initialization().unwrap();
     let mut steps = 0;
-    for seg in &p.segs {
-        let i = seg.inputs;
+    for (i, points) in &plan {
         inst.set(speed, i.input_speed).unwrap();
         inst.set(torque, i.input_torque).unwrap();
         inst.set(vehicle, i.vehicle_speed).unwrap();
         inst.set(gear, i.state as f64).unwrap();
-        let n = ((seg.t1 - seg.t0) / step).round().max(1.0) as usize;
-        for j in 0..n {
-            let a = seg.t0 + (seg.t1 - seg.t0) * j as f64 / n as f64;
-            let b = seg.t0 + (seg.t1 - seg.t0) * (j + 1) as f64 / n as f64;
-            for &(k, r) in &boundaries {
-                let at = |t| p.scene.thermal.boundary_temperature_at(k, t).unwrap();
-                inst.set(r, at(a)).unwrap();
-                inst.set_derivative(r, 1, (at(b) - at(a)) / (b - a)).unwrap();
+        for (a, b, lines) in points {
+            for (&r, &(x, d)) in boundaries.iter().zip(lines) {
+                inst.set(r, x).unwrap();
+                inst.set_derivative(r, 1, d).unwrap();
             }
-            inst.do_step(a, b - a).unwrap();
+            inst.do_step(*a, b - a).unwrap();
             steps += 1;
         }
         // An importer reads the outputs at every communication point; here once per sample.

@@ -194,6 +194,7 @@ impl IterationLu<NalgebraMat<f64>> for SmallDenseLu {
 }
 
 /// What the integrator knows of ∂q_k/∂T_oil.
+#[derive(Clone)]
 struct Slopes {
     /// Slopes the next Jacobian uses, W/K.
     dq_dt: Vec<f64>,
@@ -209,7 +210,7 @@ struct Slopes {
 }
 
 /// Counters of a run.
-#[derive(Default)]
+#[derive(Default, Clone)]
 pub(crate) struct RosStats {
     pub steps: usize,
     pub rejected: usize,
@@ -575,6 +576,7 @@ where
 /// piece by piece (co-simulation, [`super::cosim`]): the state, the step-size proposal, the
 /// learnt loss slopes and the counters. Between calls the integrator is exactly where
 /// [`run`] is between two segments.
+#[derive(Clone)]
 pub(crate) struct Carry {
     /// State (temperatures K, energies J).
     pub y: Vec<f64>,

@@ -64,6 +64,52 @@ struct Run {
     envelope: Envelope,
     /// (value, derivative) of each boundary input as last applied to the scene.
     applied: Vec<(f64, f64)>,
+    /// The scene's boundary lines start at `.0` and end at `.1`, s.
+    line_span: (f64, f64),
+}
+
+/// A boundary line is applied to the scene over this span beyond its communication point (or
+/// the communication step, when longer), s: how far the stepper may step past the point while
+/// the importer continues the line (`Stepper::step_ahead`).
+const LINE_SPAN: f64 = 10.0;
+
+/// A boundary input continues the line applied before when its value and its derivative over
+/// the span agree with it to this, relative to the value (rounding of the importer's
+/// difference quotients; far below any tolerance on temperatures).
+const LINE_TOL: f64 = 1e-10;
+
+impl Run {
+    /// Whether the inputs `lines` at `now` continue the boundary lines applied, up to `t1`.
+    fn lines_continue(&self, now: f64, t1: f64, lines: &[(f64, f64)]) -> bool {
+        let (t0, t_end) = self.line_span;
+        t1 <= t_end
+            && lines.iter().zip(&self.applied).all(|(&(x, d), &(x0, d0))| {
+                let tol = LINE_TOL * x.abs().max(1.0);
+                (x - (x0 + d0 * (now - t0))).abs() <= tol && (d - d0).abs() * (t_end - now) <= tol
+            })
+    }
+}
+
+/// Every boundary from its input `lines` (value, derivative, in the order of the variables) over
+/// [t, t + span] (a line with the input's derivative).
+fn apply_lines(fm: &FmuModel, lines: &[(f64, f64)], scene: &mut Scene, t: f64, span: f64) {
+    let boundaries = fm.vars.iter().filter_map(|v| match v.role {
+        Role::Boundary(b) => Some(b),
+        _ => None,
+    });
+    for (b, &(x, d)) in boundaries.zip(lines) {
+        scene
+            .thermal
+            .set_boundary_ramp(b, (t, x), (t + span, x + d * span));
+    }
+}
+
+/// Variable `vr` of `fm` (value references count from 1).
+fn var_of(fm: &FmuModel, vr: u32) -> Result<&Variable, Message> {
+    (vr as usize)
+        .checked_sub(1)
+        .and_then(|k| fm.vars.get(k))
+        .ok_or_else(|| format!("value reference {vr} does not exist"))
 }
 
 /// A message for the importer's logger.
@@ -126,13 +172,6 @@ impl Instance {
     fn fail<T>(&mut self, m: Message) -> Result<T, Message> {
         self.phase = Phase::Error;
         Err(m)
-    }
-
-    fn var(&self, vr: u32) -> Result<&Variable, Message> {
-        (vr as usize)
-            .checked_sub(1)
-            .and_then(|k| self.fm.vars.get(k))
-            .ok_or_else(|| format!("value reference {vr} does not exist"))
     }
 
     /// `fmi2SetupExperiment`.
@@ -222,7 +261,13 @@ impl Instance {
         Envelope::of(&scene)
             .check(&y0[..scene.nodes()])
             .map_err(|b| format!("initial temperatures (T_initial.*): {b}"))?;
-        self.apply_boundaries(&mut scene, self.start_time, 0.0);
+        apply_lines(
+            &self.fm,
+            &self.boundary_inputs(),
+            &mut scene,
+            self.start_time,
+            0.0,
+        );
         let opts = TransientOptions {
             method: Method::Ros3,
             rtol,
@@ -234,6 +279,7 @@ impl Instance {
         Ok(Run {
             envelope: Envelope::of(&scene),
             applied: self.boundary_inputs(),
+            line_span: (self.start_time, self.start_time),
             model,
             scene,
             stepper,
@@ -249,16 +295,6 @@ impl Instance {
             .filter(|(_, v)| matches!(v.role, Role::Boundary(_)))
             .map(|(k, _)| (self.values[k], self.deriv[k]))
             .collect()
-    }
-
-    /// Every boundary from its input over [t, t + h] (a line with the input's derivative).
-    fn apply_boundaries(&self, scene: &mut Scene, t: f64, h: f64) {
-        for (k, v) in self.fm.vars.iter().enumerate() {
-            if let Role::Boundary(b) = v.role {
-                let (x, d) = (self.values[k], self.deriv[k]);
-                scene.thermal.set_boundary_ramp(b, (t, x), (t + h, x + d * h));
-            }
-        }
     }
 
     /// Check a value set for `v`.
@@ -291,7 +327,8 @@ impl Instance {
     /// `fmi2SetReal` / `fmi2SetInteger` of one variable. A bad value is an error (the
     /// instance then needs a reset).
     pub fn set(&mut self, vr: u32, x: f64) -> Result<(), Message> {
-        let v = self.var(vr)?.clone();
+        let fm = Arc::clone(&self.fm);
+        let v = var_of(&fm, vr)?;
         let settable = match v.causality {
             Causality::Input => self.phase != Phase::Terminated && self.phase != Phase::Error,
             Causality::Parameter => matches!(self.phase, Phase::Instantiated | Phase::Initialization),
@@ -301,7 +338,7 @@ impl Instance {
             return Err(format!("{} cannot be set now ({:?})", v.name, self.phase));
         }
         let time = self.run.as_ref().map_or(self.start_time, |r| r.stepper.time());
-        if let Err(m) = self.check_value(&v, x) {
+        if let Err(m) = self.check_value(v, x) {
             return self.fail(format!("t = {time} s: {m}"));
         }
         if v.role == Role::Rtol {
@@ -315,7 +352,8 @@ impl Instance {
     /// `fmi2SetRealInputDerivatives` of one variable (order 1; boundaries follow it, the other
     /// inputs are held and ignore it).
     pub fn set_derivative(&mut self, vr: u32, order: i32, d: f64) -> Result<(), Message> {
-        let v = self.var(vr)?.clone();
+        let fm = Arc::clone(&self.fm);
+        let v = var_of(&fm, vr)?;
         if v.causality != Causality::Input || v.integer {
             return Err(format!("{}: derivatives only of real inputs", v.name));
         }
@@ -335,28 +373,34 @@ impl Instance {
             return Err(format!("doStep is allowed only in step mode ({:?})", self.phase));
         }
         let inputs = self.inputs();
-        let mut run = self.run.take().ok_or("no run")?;
+        let lines = self.boundary_inputs();
+        let Some(run) = self.run.as_mut() else {
+            return Err("no run".into());
+        };
         let now = run.stepper.time();
         if !(h.is_finite() && h > 0.0) || (t - now).abs() > 1e-9 * now.abs().max(1.0) {
-            self.run = Some(run);
             return self.fail(format!(
                 "doStep from t = {t} s over {h} s: the instance is at t = {now} s and needs h > 0"
             ));
         }
-        // Boundaries held at their last values need no new line (nor a fresh work area).
-        let lines = self.boundary_inputs();
-        if lines != run.applied || lines.iter().any(|b| b.1 != 0.0) {
-            self.apply_boundaries(&mut run.scene, now, h);
-            run.stepper.refresh(&run.scene);
-        }
-        run.stepper.set_inputs(&run.scene, inputs);
         let t1 = now + h;
-        let r = run.stepper.step(&run.scene, t1);
+        // Unchanged inputs: the stepper may go on with a step it took past `now`; else it restarts
+        // from its state at `now` with the new inputs.
+        if run.stepper.inputs() != inputs || !run.lines_continue(now, t1, &lines) {
+            run.stepper.restart();
+            // Boundaries held at their last values need no new line (nor a fresh work area).
+            let span = h.max(LINE_SPAN);
+            if lines != run.applied || lines.iter().any(|b| b.1 != 0.0) {
+                apply_lines(&self.fm, &lines, &mut run.scene, now, span);
+                run.stepper.refresh(&run.scene);
+            }
+            run.applied = lines;
+            run.line_span = (now, now + span);
+            run.stepper.set_inputs(&run.scene, inputs);
+        }
+        let r = run.stepper.step_ahead(&run.scene, t1, run.line_span.1);
         let breach = run.envelope.check(&run.stepper.state()[..run.scene.nodes()]);
         self.deriv.iter_mut().for_each(|d| *d = 0.0);
-        // A line's boundary stays at its end value after t1 (`set_boundary_ramp`).
-        run.applied = self.boundary_inputs();
-        self.run = Some(run);
         self.outputs_fresh = false;
         match (r, breach) {
             (Err(e), _) => self.fail(e.to_string()),
@@ -369,7 +413,8 @@ impl Instance {
 
     /// `fmi2GetReal` / `fmi2GetInteger` of one variable.
     pub fn get(&mut self, vr: u32) -> Result<f64, Message> {
-        let v = self.var(vr)?.clone();
+        let fm = Arc::clone(&self.fm);
+        let v = var_of(&fm, vr)?;
         if v.causality == Causality::Output && !self.outputs_fresh {
             self.compute_outputs()?;
         }
