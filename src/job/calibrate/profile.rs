@@ -92,6 +92,7 @@ impl Objective<'_> {
         };
         let at = self.eval(th)?;
         let r = lm::minimise(|x| self.eval(x), th, at, &bounds, free, &lmo)?;
+        super::singular(self.p, &r)?;
         Ok((r.theta.clone(), r.at.r.norm_squared(), r.evaluations))
     }
 }
