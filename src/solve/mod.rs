@@ -1,4 +1,5 @@
 //! Solvers: the transient driver (diffsol) and the steady-state equilibrium search.
+pub(crate) mod bracket;
 pub mod cosim;
 pub mod dense_lu;
 pub mod drive;

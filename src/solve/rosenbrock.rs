@@ -44,6 +44,7 @@ use diffsol_la::{LinearOp, LinearSolver};
 
 use diffsol::{FaerSparseMat, NalgebraMat, NalgebraVec};
 
+use super::bracket::{Bracket, EVENT_MAX_ITER, EVENT_TIME_TOL};
 use super::dense_lu::SmallDenseLu;
 use super::driver::Driver;
 use super::equations::{HostVector, JacobianMatrix, SceneEquations};
@@ -219,13 +220,6 @@ pub(crate) struct RosStats {
     pub event_trials: usize,
 }
 
-/// Width of the bracket on a switching instant, relative to max(1, |t|): the event is located to
-/// this in time (well below the 1e-6 s the analytic check asks).
-const EVENT_TIME_TOL: f64 = 1e-13;
-
-/// Regula-falsi iterations per event at most (Illinois: superlinear; a dozen is typical).
-const EVENT_MAX_ITER: usize = 100;
-
 /// The integrator's state over a run.
 struct Ros<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> {
     tab: &'static Tableau,
@@ -336,42 +330,23 @@ impl<'a, 'd, M: JacobianMatrix, LS: IterationLu<M>> Ros<'a, 'd, M, LS> {
         if fb0 <= 0.0 {
             return None;
         }
-        let (mut a, mut fa) = (0.0, self.switch_margin(t, false).min(0.0));
-        let (mut b, mut fb) = (h, fb0);
+        let fa = self.switch_margin(t, false).min(0.0);
+        let mut br = Bracket::new(0.0, fa, h, fb0);
         let tol = EVENT_TIME_TOL * t.abs().max(1.0);
-        let mut side = 0i8;
         let mut last = h;
         for _ in 0..EVENT_MAX_ITER {
-            if b - a <= tol {
+            if br.b - br.a <= tol {
                 break;
             }
-            let mut c = if fb != fa {
-                b - fb * (b - a) / (fb - fa)
-            } else {
-                0.5 * (a + b)
-            };
-            if !(c > a && c < b) {
-                c = 0.5 * (a + b);
-            }
+            let c = br.trial();
             self.factorise(t, c);
             self.step(t, c);
             self.stats.event_trials += 1;
             last = c;
             let fc = self.switch_margin(t + c, true);
-            if fc > 0.0 {
-                (b, fb) = (c, fc);
-                if side == -1 {
-                    fa *= 0.5;
-                }
-                side = -1;
-            } else {
-                (a, fa) = (c, fc);
-                if side == 1 {
-                    fb *= 0.5;
-                }
-                side = 1;
-            }
+            br.update(c, fc);
         }
+        let b = br.b;
         if last != b {
             self.factorise(t, b);
             self.step(t, b);

@@ -25,12 +25,7 @@ use nalgebra::DVector;
 use super::{start_step, NumericalFailure, SensitivityOptions, StepStages, Tangent, ROS3};
 use crate::scene::controls::EVENTS_PER_CONTROL;
 use crate::scene::Scene;
-
-/// Width of the bracket on a switching instant, relative to max(1, |t|).
-const EVENT_TIME_TOL: f64 = 1e-13;
-
-/// Regula-falsi iterations per event at most.
-const EVENT_MAX_ITER: usize = 100;
+use crate::solve::bracket::{Bracket, EVENT_MAX_ITER, EVENT_TIME_TOL};
 
 /// |∇g·f⁻| below this (K/s) is a grazing switch: the surface is touched, not crossed, and
 /// dτ/dθ is unbounded.
@@ -127,38 +122,19 @@ impl Tangent<'_> {
             return None;
         }
         let y0 = self.y.clone();
-        let (mut a, mut fa) = (0.0, self.margin(&y0).1.min(0.0));
-        let (mut b, mut fb) = (st.h, fb0);
+        let fa = self.margin(&y0).1.min(0.0);
+        let mut br = Bracket::new(0.0, fa, st.h, fb0);
         let tol = EVENT_TIME_TOL * t.abs().max(1.0);
-        let mut side = 0i8;
         for _ in 0..EVENT_MAX_ITER {
-            if b - a <= tol {
+            if br.b - br.a <= tol {
                 break;
             }
-            let mut c = if fb != fa {
-                b - fb * (b - a) / (fb - fa)
-            } else {
-                0.5 * (a + b)
-            };
-            if !(c > a && c < b) {
-                c = 0.5 * (a + b);
-            }
+            let c = br.trial();
             let (trial, _) = self.step(t, c, opts.rtol, opts.atol);
             let fc = self.margin(&self.step_end(&trial)).1;
-            if fc > 0.0 {
-                (b, fb) = (c, fc);
-                if side == -1 {
-                    fa *= 0.5;
-                }
-                side = -1;
-            } else {
-                (a, fa) = (c, fc);
-                if side == 1 {
-                    fb *= 0.5;
-                }
-                side = 1;
-            }
+            br.update(c, fc);
         }
+        let b = br.b;
         // The stages (and the LU of W) of the step of size b, just past the surface.
         let stages = self.step(t, b, opts.rtol, opts.atol).0;
         self.ev.due = true;
