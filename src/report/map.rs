@@ -1,6 +1,6 @@
 //! `map.csv`: one row per grid point of an operating map (the contract `report::plots` reads).
 
-use crate::physics::oil::KELVIN_OFFSET;
+use crate::physics::units::k_to_c;
 use crate::scene::N_SOURCES;
 use crate::solve::sweep::MapPoint;
 
@@ -33,15 +33,15 @@ pub fn map_csv(points: &[MapPoint], oil: usize) -> String {
                 }
                 csv.push_str(&format!(
                     "{},{},true,",
-                    e.solution.temperatures[oil] - KELVIN_OFFSET,
+                    k_to_c(e.solution.temperatures[oil]),
                     e.solution.iterations + e.solution.ptc_iterations
                 ));
                 match &e.limit_cycle {
                     Some(c) => csv.push_str(&format!(
                         "{},{},{}\n",
                         c.period_s,
-                        c.min_k[oil] - KELVIN_OFFSET,
-                        c.max_k[oil] - KELVIN_OFFSET
+                        k_to_c(c.min_k[oil]),
+                        k_to_c(c.max_k[oil])
                     )),
                     None => csv.push_str(",,\n"),
                 }

@@ -521,7 +521,7 @@ impl Scene {
                 what: format!(
                     "loss is {} at oil temperature {:.3} °C",
                     q[k],
-                    self.oil_temp(y) - crate::physics::oil::KELVIN_OFFSET
+                    crate::physics::units::k_to_c(self.oil_temp(y))
                 ),
             };
         }

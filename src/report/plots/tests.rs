@@ -354,7 +354,7 @@ fn write_map(dir: &Path, nx: usize, ny: usize, shuffle: bool) {
             let n = 500.0 + 5500.0 * i as f64 / (nx.max(2) - 1) as f64;
             let t = 20.0 * j as f64 / (ny.max(2) - 1) as f64 * 10.0;
             let loss = 20.0 + 0.01 * n + 0.002 * n * t.sqrt();
-            let p_in = n * std::f64::consts::PI / 30.0 * t;
+            let p_in = crate::physics::units::rpm_to_rad_s(n) * t;
             let eff = if p_in > 0.0 {
                 format!("{}", (p_in - loss).max(0.0) / p_in)
             } else {
