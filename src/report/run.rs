@@ -325,7 +325,7 @@ pub fn summary(
         temperatures_c: temps,
         nodes,
         oil_node: scene.thermal.names[scene.thermal.oil].clone(),
-        skipped: scene.skipped.clone(),
+        skipped: scene.skipped().to_vec(),
         frozen_viscosity: scene.frozen_oil_temp().is_some(),
         warnings: run_warnings(scene, traj, rows),
         launch: launch_summary(&traj.times, rows),
@@ -429,7 +429,7 @@ pub fn timeseries_csv(
 /// the model's whatever the overrides (an oil level that leaves a gear dry keeps its column).
 pub fn skipped_items(scene: &Scene) -> Vec<(Source, String)> {
     scene
-        .skipped
+        .skipped()
         .iter()
         .filter_map(|sk| {
             let (src, rest) = sk.what.split_once(" of ")?;
