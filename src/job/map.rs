@@ -103,8 +103,10 @@ impl MapOptions {
     }
 }
 
-/// What a map found besides its table (`map.json`).
-#[derive(Debug, Clone, Serialize)]
+/// What a map found besides its table (`map.json`); `report DIR` reads it back with this type
+/// (a key an earlier version did not write reads as its default).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(default)]
 pub struct MapMeta {
     /// Model name.
     pub model: String,
