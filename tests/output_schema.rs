@@ -6,7 +6,7 @@
 //!   value; `timeseries.csv` read as `report::timeseries::Timeseries` and written again gives
 //!   the same bytes; `report DIR` draws the same PNGs and `report.md` as `run --report` drew from
 //!   the results in memory.
-//! - map: `map.json` read as `job::map::MapMeta` gives the same JSON value; `report DIR` draws the
+//! - map: `map.json` read as `report::map::MapMeta` gives the same JSON value; `report DIR` draws the
 //!   same heat maps and `report.md` as `map` did.
 //! - bench: `bench.csv` read into `solve::work_precision::BenchRow`s; `report DIR` draws the same
 //!   `work_precision.png` as `bench` did.
@@ -17,7 +17,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use geartherm::job::map::MapMeta;
+use geartherm::report::map::MapMeta;
 use geartherm::report::plots::data::{read_bench, read_json, read_run};
 use geartherm::report::run::Summary;
 

@@ -9,7 +9,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::plots::PlotError;
+use super::plots::error::PlotError;
 
 /// The one text column of `timeseries.csv` (the gear-state name).
 pub const TEXT_COLUMN: &str = "gear";

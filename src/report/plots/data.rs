@@ -1,6 +1,6 @@
 //! What the figures draw from run, map and bench outputs, read with the writers' types: a run's
 //! [`Summary`] and [`Timeseries`] (`report::run`, `report::timeseries`), a map's
-//! [`MapMeta`] (`job::map`), a bench's [`BenchRow`]s (`solve::work_precision`).
+//! [`MapMeta`] (`report::map`), a bench's [`BenchRow`]s (`solve::work_precision`).
 //!
 //! Missing numeric values (empty fields) become `f64::NAN` and are skipped by the plots;
 //! anything that is not a number, a wrong field count or a missing required column is an error
@@ -13,7 +13,7 @@ use serde::Deserialize;
 
 use super::style::Source;
 use super::PlotError;
-pub use crate::job::map::MapMeta;
+pub use crate::report::map::MapMeta;
 pub use crate::report::run::Summary;
 use crate::report::timeseries::{parse_num, Timeseries};
 use crate::scene::N_SOURCES;
