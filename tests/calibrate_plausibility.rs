@@ -88,9 +88,9 @@ fn an_unknown_kind_or_a_bad_rated_point_is_refused() {
     let m = Model::from_text(&text, Path::new(MODEL), &[]).unwrap();
     let t = Trace::parse(&trace(), "warm.csv").unwrap();
     for (kind, rated, want) in [
-        (Some("ship"), None, "gearbox_kind (--gearbox-kind) = ship"),
-        (None, Some("0:100"), "rated (--rated) = 0:100"),
-        (None, Some("4000"), "rated (--rated) = 4000"),
+        (Some("ship"), None, "gearbox_kind = ship"),
+        (None, Some("0:100"), "rated = 0:100"),
+        (None, Some("4000"), "rated = 4000"),
     ] {
         let o = CalibrateOptions {
             fit: vec![H.into()],

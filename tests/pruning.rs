@@ -146,14 +146,14 @@ fn pruned_scene_gives_the_full_scenes_temperatures_and_energies() {
     // What gear 3 leaves idle: all four RAV sliding meshes, the three external RAV pockets (fed by
     // the circuit, above the ATF), the two Ravigneaux planet-pin bearings (the locked set's
     // pinions do not spin) and the drag of the engaged clutches A and B.
-    assert_eq!(all.items() - pruned.items(), 11, "{:?}", pruned.skipped);
+    assert_eq!(all.items() - pruned.items(), 11, "{:?}", pruned.skipped());
     for mesh in ["RAV:large_sun/long_pinion", "RAV:short_pinion/long_pinion"] {
         let what = format!("sliding of mesh {mesh}");
-        let s = pruned.skipped.iter().find(|s| s.what == what);
+        let s = pruned.skipped().iter().find(|s| s.what == what);
         assert!(
             s.is_some_and(|s| s.why.contains("gear state the run uses (3)")),
             "{what}: {:?}",
-            pruned.skipped
+            pruned.skipped()
         );
     }
     let opts = TransientOptions {
@@ -222,7 +222,10 @@ fn per_source_energies_equal_the_sum_of_item_energies() {
     let full = Scene::compile(&gb).unwrap();
     assert_eq!(lean.n_states(), lean.nodes() + geartherm::scene::N_SOURCES + 1);
     assert_eq!(full.n_states(), full.nodes() + full.items() + 1);
-    assert!(lean.skipped.iter().any(|s| s.what == "energy of each loss item"));
+    assert!(lean
+        .skipped()
+        .iter()
+        .any(|s| s.what == "energy of each loss item"));
     let opts = TransientOptions {
         rtol: 1e-10,
         atol: 1e-10,

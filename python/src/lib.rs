@@ -421,6 +421,28 @@ fn read_trace(text: &str, name: &str, refuse: bool) -> PyResult<(String, Vec<(f6
     Ok((to_json(&f.summary())?, segs))
 }
 
+/// A run directory read with the writer's types (`summary.json` as `report::run::Summary`,
+/// `timeseries.csv` as `report::timeseries::Timeseries`, keys and columns of earlier versions
+/// under their present names): (the summary JSON, the time series' CSV text or None when the
+/// directory has none).
+#[pyfunction]
+fn read_run(py: Python<'_>, dir: PathBuf) -> PyResult<(String, Option<String>)> {
+    use geartherm::report::{plots::data::read_json, run::Summary, timeseries::Timeseries};
+    py.detach(|| -> Result<(String, Option<String>), JobError> {
+        let summary: Summary = read_json(&dir.join("summary.json"))?;
+        let ts = dir.join("timeseries.csv");
+        let csv = if ts.exists() {
+            Some(Timeseries::read(&ts)?.to_csv())
+        } else {
+            None
+        };
+        let json = serde_json::to_string(&summary)
+            .map_err(|e| JobError::numerical(format!("cannot serialise the summary: {e}")))?;
+        Ok((json, csv))
+    })
+    .map_err(job_error)
+}
+
 /// Draw `calibration.png` into a directory holding a calibration's `fit.csv` (as the CLI does).
 #[pyfunction]
 fn render_calibration(py: Python<'_>, dir: PathBuf) -> PyResult<()> {
@@ -455,6 +477,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(version, m)?)?;
     m.add_function(wrap_pyfunction!(cli, m)?)?;
     m.add_function(wrap_pyfunction!(read_trace, m)?)?;
+    m.add_function(wrap_pyfunction!(read_run, m)?)?;
     m.add_function(wrap_pyfunction!(render_calibration, m)?)?;
     m.add_function(wrap_pyfunction!(sources, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate::priors_from_file, m)?)?;

@@ -334,6 +334,24 @@ def test_read_run_equals_the_run_that_wrote_it(tmp_path):
     pd.testing.assert_frame_equal(back.timeseries, r.timeseries, check_exact=True)
 
 
+def test_read_run_reads_directories_of_earlier_versions_with_todays_keys():
+    # tests/fixtures/README.md: a run directory of 9d79de0 reads back as written; one of d379aa5
+    # (mean_efficiency, per-source columns churning_w … total_loss_w) with today's keys.
+    fx = ROOT / "tests" / "fixtures"
+    now = geartherm.read_run(fx / "run_main_9d79de0")
+    assert now.summary == json.loads((fx / "run_main_9d79de0" / "summary.json").read_text())
+    old_file = json.loads((fx / "run_d379aa5" / "summary.json").read_text())
+    old = geartherm.read_run(fx / "run_d379aa5")
+    assert "mean_efficiency" not in old.summary
+    assert old.summary["cycle_efficiency"] == old_file["mean_efficiency"]
+    assert old.summary["energy_efficiency"] is None and old.summary["warnings"] == []
+    assert old.summary["energy_lost_j"]["churning"] == old_file["energy_lost_j"]["churning"]
+    assert old.summary["energy_lost_j"]["bearing"] == 0.0
+    assert list(old.timeseries["churning_w"]) == list(pd.read_csv(fx / "run_d379aa5" / "timeseries.csv")["churning_w"])
+    with pytest.raises(FileNotFoundError):
+        geartherm.read_run(fx / "no_such_run")
+
+
 def test_a_cycle_as_a_dataframe_runs_like_its_file():
     at6 = geartherm.Model.load(AT6)
     df = pd.read_csv(ROOT / "models" / "cycles" / "hwfet.csv")

@@ -44,7 +44,7 @@ pub fn report(a: &ReportArgs) -> Result<(), Failure> {
     ])?;
     let mut written = Vec::new();
     if out.path().join("timeseries.csv").is_file() {
-        written.extend(plots::render_run(out.path()).map_err(failure)?);
+        written.extend(plots::render_run_dir(out.path()).map_err(failure)?);
     }
     if out.path().join("map.csv").is_file() {
         written.extend(plots::render_map(out.path()).map_err(failure)?);

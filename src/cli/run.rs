@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use crate::job::run::{prepare, solve, RunOptions, DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL};
 use crate::job::{self, RunResult};
 use crate::report::files::OutputDir;
+use crate::report::timeseries::Timeseries;
 
 use super::output::{emit, emit_json, io_failure, progress_bar, warnings};
 use super::{Failure, ModelSource};
@@ -117,7 +118,12 @@ pub fn run(args: &RunArgs) -> Result<(), Failure> {
         out.write(name, &bytes)?;
     }
     if args.report {
-        crate::report::plots::render_run(out.path()).map_err(|e| io_failure(format!("report: {e}")))?;
+        // The figures from the results in memory (the table parsed from the run's own text, not
+        // re-read from the file just written).
+        let fail = |e: crate::report::plots::PlotError| io_failure(format!("report: {e}"));
+        let csv = result.timeseries_csv.as_deref().unwrap_or_default();
+        let table = Timeseries::parse(csv.as_bytes(), &out.path().join("timeseries.csv")).map_err(fail)?;
+        crate::report::plots::render_run(out.path(), &result.summary, &table).map_err(fail)?;
     }
     warnings(&result.summary.warnings);
     if args.json {

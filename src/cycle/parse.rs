@@ -14,7 +14,7 @@ use std::path::Path;
 /// km/h → m/s.
 pub const KMH: f64 = 1.0 / 3.6;
 /// rpm → rad/s.
-pub const RPM: f64 = std::f64::consts::PI / 30.0;
+pub const RPM: f64 = crate::physics::units::RAD_S_PER_RPM;
 
 /// Which kind of cycle a file holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -425,7 +425,7 @@ mod tests {
         assert_eq!(c.kind, CycleKind::Rig);
         assert_relative_eq!(
             c.rows[1].input_speed,
-            3000.0 * std::f64::consts::PI / 30.0,
+            crate::physics::units::rpm_to_rad_s(3000.0),
             epsilon = 1e-12
         );
         assert_relative_eq!(c.rows[1].input_torque, -50.0);

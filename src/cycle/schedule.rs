@@ -418,7 +418,7 @@ mod tests {
         assert!(s.intervals.iter().all(|i| i.gear < 6));
         // input speed stays in an engine-like band while moving above 20 km/h
         for i in s.intervals.iter().filter(|i| i.vehicle_speed > 20.0 / 3.6) {
-            let rpm = i.input_speed * 30.0 / std::f64::consts::PI;
+            let rpm = crate::physics::units::rad_s_to_rpm(i.input_speed);
             assert!((900.0..3500.0).contains(&rpm), "{rpm} rpm at t = {}", i.t0);
         }
         // 6th gear at the 131 km/h top speed
@@ -445,7 +445,7 @@ mod tests {
         // upshift speeds follow the thresholds: 1→2 where the mean input speed first exceeds 2200 rpm
         let first2 = s.intervals.iter().find(|i| i.gear == 1).unwrap();
         let v = at6();
-        let rpm_in_1st = v.output_speed(first2.vehicle_speed) * 4.171 * 30.0 / std::f64::consts::PI;
+        let rpm_in_1st = crate::physics::units::rad_s_to_rpm(v.output_speed(first2.vehicle_speed) * 4.171);
         assert!(rpm_in_1st > 2200.0 && rpm_in_1st - 2200.0 < 200.0, "{rpm_in_1st}");
     }
 
@@ -521,7 +521,7 @@ mod tests {
         .unwrap();
         let s = schedule(&c, None, &at6_gears()).unwrap();
         assert_eq!(s.intervals.len(), 4);
-        let w = 1000.0 * std::f64::consts::PI / 30.0;
+        let w = crate::physics::units::rpm_to_rad_s(1000.0);
         let i = s.intervals[1];
         assert_eq!((i.t0, i.t1, i.gear, i.standstill), (10.0, 20.0, 0, false));
         assert_relative_eq!(i.input_speed, w);

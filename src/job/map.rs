@@ -103,26 +103,7 @@ impl MapOptions {
     }
 }
 
-/// What a map found besides its table (`map.json`).
-#[derive(Debug, Clone, Serialize)]
-pub struct MapMeta {
-    /// Model name.
-    pub model: String,
-    /// Gear-state name.
-    pub gear: String,
-    /// Grid points.
-    pub points: usize,
-    /// Points with an equilibrium (all of them in a returned map).
-    pub converged: usize,
-    /// Newton + pseudo-transient iterations per point.
-    pub mean_iterations: f64,
-    /// Wall time of the sweep, s.
-    pub wall_time_s: f64,
-    /// Worker threads.
-    pub threads: usize,
-    /// Loss models used outside their fitted range at the map's equilibria.
-    pub warnings: Vec<crate::scene::RangeWarning>,
-}
+pub use crate::report::map::MapMeta;
 
 /// A finished map: `map.csv` text and `map.json` contents.
 #[derive(Debug, Clone)]

@@ -485,7 +485,7 @@ mod tests {
         let b = fva3a(WaltherVariant::C08);
         let mut prev = f64::INFINITY;
         for tc in (-30..=150).step_by(10) {
-            let t = tc as f64 + KELVIN_OFFSET;
+            let t = crate::physics::units::c_to_k(tc as f64);
             let nu = a.nu(t);
             assert!(nu < prev, "monotone at {tc} °C");
             prev = nu;
@@ -500,7 +500,7 @@ mod tests {
     fn derivative_matches_finite_difference() {
         let oil = fva3a(WaltherVariant::AstmD341);
         for tc in [-20.0, 23.0, 80.0, 140.0] {
-            let t = tc + KELVIN_OFFSET;
+            let t = crate::physics::units::c_to_k(tc);
             let h = 1e-4;
             let fd = (oil.nu(t + h) - oil.nu(t - h)) / (2.0 * h);
             let an = oil.walther.dnu_dt(t);

@@ -32,6 +32,11 @@ pub fn rpm_to_rad_s(rpm: f64) -> f64 {
     rpm * PI / 30.0
 }
 
+/// rad/s → rpm (`w * 30 / π`).
+pub fn rad_s_to_rpm(w: f64) -> f64 {
+    w * 30.0 / PI
+}
+
 /// km/h → m/s (`kmh / 3.6`).
 pub fn kmh_to_m_s(kmh: f64) -> f64 {
     kmh / 3.6
@@ -51,6 +56,10 @@ mod tests {
                 (x * std::f64::consts::PI / 30.0).to_bits()
             );
             assert_eq!(kmh_to_m_s(x).to_bits(), (x / 3.6).to_bits());
+            assert_eq!(
+                rad_s_to_rpm(x).to_bits(),
+                (x * 30.0 / std::f64::consts::PI).to_bits()
+            );
         }
         assert_eq!(crate::physics::oil::KELVIN_OFFSET, KELVIN_OFFSET);
     }

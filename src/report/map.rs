@@ -1,6 +1,7 @@
-//! `map.csv`: one row per grid point of an operating map (the contract `report::plots` reads).
+//! `map.csv`: one row per grid point of an operating map (the contract `report::plots` reads),
+//! and `map.json` ([`MapMeta`]), written by `map` and read back by `report DIR` with this type.
 
-use crate::physics::oil::KELVIN_OFFSET;
+use crate::physics::units::k_to_c;
 use crate::scene::N_SOURCES;
 use crate::solve::sweep::MapPoint;
 
@@ -33,15 +34,15 @@ pub fn map_csv(points: &[MapPoint], oil: usize) -> String {
                 }
                 csv.push_str(&format!(
                     "{},{},true,",
-                    e.solution.temperatures[oil] - KELVIN_OFFSET,
+                    k_to_c(e.solution.temperatures[oil]),
                     e.solution.iterations + e.solution.ptc_iterations
                 ));
                 match &e.limit_cycle {
                     Some(c) => csv.push_str(&format!(
                         "{},{},{}\n",
                         c.period_s,
-                        c.min_k[oil] - KELVIN_OFFSET,
-                        c.max_k[oil] - KELVIN_OFFSET
+                        k_to_c(c.min_k[oil]),
+                        k_to_c(c.max_k[oil])
                     )),
                     None => csv.push_str(",,\n"),
                 }
@@ -55,4 +56,27 @@ pub fn map_csv(points: &[MapPoint], oil: usize) -> String {
         }
     }
     csv
+}
+
+/// What a map found besides its table (`map.json`); `report DIR` reads it back with this type
+/// (a key an earlier version did not write reads as its default).
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct MapMeta {
+    /// Model name.
+    pub model: String,
+    /// Gear-state name.
+    pub gear: String,
+    /// Grid points.
+    pub points: usize,
+    /// Points with an equilibrium (all of them in a returned map).
+    pub converged: usize,
+    /// Newton + pseudo-transient iterations per point.
+    pub mean_iterations: f64,
+    /// Wall time of the sweep, s.
+    pub wall_time_s: f64,
+    /// Worker threads.
+    pub threads: usize,
+    /// Loss models used outside their fitted range at the map's equilibria.
+    pub warnings: Vec<crate::scene::RangeWarning>,
 }

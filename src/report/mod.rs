@@ -8,6 +8,8 @@ pub mod map;
 pub mod plots;
 pub mod run;
 pub mod sources;
+pub mod stats_de;
 pub mod study;
+pub mod timeseries;
 pub mod validation;
 pub mod zip;

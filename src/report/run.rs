@@ -1,25 +1,29 @@
-//! Outputs of a transient run: `timeseries.csv` and `summary.json`.
+//! Outputs of a transient run: `timeseries.csv` ([`Timeseries`]) and `summary.json`
+//! ([`Summary`]).
 //!
-//! Column and key names are the contract the plots (`report::plots`) and users rely on; see
-//! docs/outputs.md.
+//! Each file has one set of types: the run writes them, and `report DIR`, the plots and
+//! Python's `read_run` read them back with the same types (serde both ways for the summary, one
+//! table for the time series). Keys that earlier versions did not write read as their defaults,
+//! and renamed keys are read under their old names (docs/outputs.md, "Reading older
+//! directories").
 
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::scene::{
-    sum_by_source, OperatingPoint, RangeLog, RangeWarning, Scene, Skipped, Source, N_SOURCES,
+    sum_by_source, OperatingPoint, PerSource, RangeLog, RangeWarning, Scene, Skipped, Source, N_SOURCES,
 };
 
-use super::sources::{csv_columns, SourceValues};
+use super::sources::SourceValues;
+use super::timeseries::Timeseries;
 use crate::physics::units::{k_to_c, rpm_to_rad_s};
 use crate::solve::transient::{energy_balance, Stats, Trajectory};
 
 pub use crate::solve::drive::RowInputs;
 
 /// Energy of one loss item.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ItemEnergy {
     /// Source.
     pub source: Source,
@@ -30,7 +34,7 @@ pub struct ItemEnergy {
 }
 
 /// Min / max / final temperature of a node, °C.
-#[derive(Debug, Clone, Copy, Serialize)]
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
 pub struct TempStats {
     /// Minimum over the output rows.
     pub min: f64,
@@ -41,7 +45,7 @@ pub struct TempStats {
 }
 
 /// A node listed in the summary.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct NodeInfo {
     /// Name.
     pub name: String,
@@ -49,8 +53,10 @@ pub struct NodeInfo {
     pub boundary: bool,
 }
 
-/// `summary.json`.
-#[derive(Debug, Clone, Serialize)]
+/// `summary.json`. Read back with the same type: a key missing from the file (one an earlier
+/// version did not write) reads as its default (empty, zero, absent).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(default)]
 pub struct Summary {
     /// Model name.
     pub model: String,
@@ -67,6 +73,7 @@ pub struct Summary {
     /// Accepted steps.
     pub steps: usize,
     /// All counters.
+    #[serde(deserialize_with = "super::stats_de::stats")]
     pub stats: Stats,
     /// Cycle duration, s.
     pub duration_s: f64,
@@ -83,7 +90,9 @@ pub struct Summary {
     /// Output energy, J (positive output power integrated).
     pub output_energy_j: f64,
     /// Cycle efficiency, energy-weighted: ∫P_out / ∫P_in over the driving time, with
-    /// ∫P_in = ∫P_out + loss energy while driving (`physics::efficiency`).
+    /// ∫P_in = ∫P_out + loss energy while driving (`physics::efficiency`). Read also under its
+    /// earlier name `mean_efficiency`.
+    #[serde(alias = "mean_efficiency")]
     pub cycle_efficiency: Option<f64>,
     /// All-in energy efficiency E_out/(E_out + E_loss), E_loss every loss item's energy over
     /// the whole cycle (driving, coasting, standing; the engine side's converter and pump
@@ -112,7 +121,7 @@ pub struct Summary {
 }
 
 /// A controller over the run.
-#[derive(Debug, Clone, Serialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct ControlSummary {
     /// Name.
     pub name: String,
@@ -157,7 +166,7 @@ pub fn control_summaries(scene: &Scene, traj: &Trajectory) -> Vec<ControlSummary
 
 /// Engine side of a run with a launch device (torque converter), from the output rows: each row
 /// holds its segment's inputs until the next row.
-#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq)]
 pub struct LaunchSummary {
     /// Highest engine (impeller) speed, rpm.
     pub engine_speed_max_rpm: f64,
@@ -325,7 +334,7 @@ pub fn summary(
         temperatures_c: temps,
         nodes,
         oil_node: scene.thermal.names[scene.thermal.oil].clone(),
-        skipped: scene.skipped.clone(),
+        skipped: scene.skipped().to_vec(),
         frozen_viscosity: scene.frozen_oil_temp().is_some(),
         warnings: run_warnings(scene, traj, rows),
         launch: launch_summary(&traj.times, rows),
@@ -333,95 +342,94 @@ pub fn summary(
     }
 }
 
-fn num(s: &mut String, v: f64) {
-    if v.is_finite() {
-        let _ = write!(s, "{v}");
-    }
-}
-
-/// `timeseries.csv` text: one row per output time. `boundary_temps(t)` gives the boundary
-/// temperatures (K) at time t.
+/// `timeseries.csv` text: the table of [`timeseries`] written ([`Timeseries::to_csv`]).
 pub fn timeseries_csv(
     scene: &Scene,
     traj: &Trajectory,
     rows: &[RowInputs],
     boundary_temps: &dyn Fn(f64) -> Vec<f64>,
 ) -> String {
-    let n = scene.nodes();
-    let mut s = String::with_capacity(traj.times.len() * 64 * (n + scene.items() + 10));
-    s.push_str("time_s,vehicle_speed_kmh,gear,input_speed_rpm,input_torque_nm,output_power_w");
+    timeseries(scene, traj, rows, boundary_temps).to_csv()
+}
+
+/// The `timeseries.csv` table: one row per output time. `boundary_temps(t)` gives the boundary
+/// temperatures (K) at time t. Column order: inputs, the engine side (runs with a launch device
+/// only), node then boundary temperatures, loss items (those the scene left out as zeros),
+/// per-source sums, total, efficiency, controllers (docs/outputs.md).
+pub fn timeseries(
+    scene: &Scene,
+    traj: &Trajectory,
+    rows: &[RowInputs],
+    boundary_temps: &dyn Fn(f64) -> Vec<f64>,
+) -> Timeseries {
+    let m = traj.times.len();
+    let col = |f: &dyn Fn(usize) -> f64| -> Vec<f64> { (0..m).map(f).collect() };
+    let mut t = Timeseries::default();
+    t.push_num("time_s", traj.times.clone());
+    t.push_num("vehicle_speed_kmh", col(&|k| rows[k].vehicle_speed_kmh));
+    t.push_text("gear", (0..m).map(|k| rows[k].gear.to_string()).collect());
+    t.push_num("input_speed_rpm", col(&|k| rows[k].input_speed_rpm));
+    // The input supplies the transmitted torque and the losses: T_in = T_out/i + P_loss/ω_in
+    // (physics spec §9). The loss items themselves are evaluated at the loss-free torque
+    // (docs/physics.md §10, "Mesh loads").
+    t.push_num(
+        "input_torque_nm",
+        col(&|k| input_shaft_torque(scene, &rows[k], &traj.losses[k])),
+    );
+    t.push_num("output_power_w", col(&|k| rows[k].output_power_w));
     // Engine side only for runs with a launch device (docs/outputs.md).
-    let engine = rows.iter().any(|r| r.engine.is_some());
-    if engine {
-        s.push_str(",engine_speed_rpm,engine_torque_nm,lockup");
+    if rows.iter().any(|r| r.engine.is_some()) {
+        let e = |f: &dyn Fn(&crate::solve::drive::EngineRow) -> f64| {
+            col(&|k| rows[k].engine.as_ref().map_or(f64::NAN, f))
+        };
+        t.push_num("engine_speed_rpm", e(&|e| e.speed_rpm));
+        t.push_num("engine_torque_nm", e(&|e| e.torque_nm));
+        t.push_num("lockup", e(&|e| f64::from(u8::from(e.lockup))));
     }
-    for name in scene.thermal.names.iter().chain(&scene.thermal.boundary_names) {
-        let _ = write!(s, ",temp_{name}_c");
+    for (i, name) in scene.thermal.names.iter().enumerate() {
+        t.push_num(format!("temp_{name}_c"), col(&|k| k_to_c(traj.states[k][i])));
     }
-    for it in &scene.losses.items {
-        let _ = write!(s, ",loss_{}_{}_w", it.source.as_str(), it.name);
-    }
-    let left_out = skipped_items(scene);
-    for (source, name) in &left_out {
-        let _ = write!(s, ",loss_{}_{name}_w", source.as_str());
-    }
-    let _ = write!(s, ",{},loss_total_w,efficiency", csv_columns());
-    for c in &scene.thermal.controls {
-        let _ = write!(s, ",control_{}", c.name);
-    }
-    s.push('\n');
-    for (k, t) in traj.times.iter().enumerate() {
-        let r = &rows[k];
-        let y = &traj.states[k];
-        let by = sum_by_source(&scene.losses.items, &traj.losses[k]);
-        let total: f64 = by.iter().sum();
-        // The input supplies the transmitted torque and the losses: T_in = T_out/i + P_loss/ω_in
-        // (physics spec §9). The loss items themselves are evaluated at the loss-free torque
-        // (docs/physics.md §10, "Mesh loads").
-        let t_in = input_shaft_torque(scene, r, &traj.losses[k]);
-        let _ = write!(
-            s,
-            "{t},{},{},{},{},{}",
-            r.vehicle_speed_kmh, r.gear, r.input_speed_rpm, t_in, r.output_power_w
+    let bt: Vec<Vec<f64>> = traj.times.iter().map(|x| boundary_temps(*x)).collect();
+    for (j, name) in scene.thermal.boundary_names.iter().enumerate() {
+        t.push_num(
+            format!("temp_{name}_c"),
+            col(&|k| bt[k].get(j).map_or(f64::NAN, |v| k_to_c(*v))),
         );
-        if engine {
-            match r.engine {
-                Some(e) => {
-                    let _ = write!(s, ",{},{},{}", e.speed_rpm, e.torque_nm, u8::from(e.lockup));
-                }
-                None => s.push_str(",,,"),
-            }
-        }
-        for v in y.iter().take(n) {
-            s.push(',');
-            num(&mut s, k_to_c(*v));
-        }
-        for v in boundary_temps(*t) {
-            s.push(',');
-            num(&mut s, k_to_c(v));
-        }
-        for q in &traj.losses[k] {
-            s.push(',');
-            num(&mut s, *q);
-        }
-        for _ in &left_out {
-            s.push_str(",0");
-        }
-        for v in by {
-            let _ = write!(s, ",{v}");
-        }
-        let _ = write!(s, ",{total}");
-        s.push(',');
-        if let Some(eta) = crate::physics::efficiency::efficiency(r.output_power_w, total) {
-            num(&mut s, eta);
-        }
-        for x in traj.controls.get(k).unwrap_or(&[]) {
-            s.push(',');
-            num(&mut s, *x);
-        }
-        s.push('\n');
     }
-    s
+    for (i, it) in scene.losses.items.iter().enumerate() {
+        t.push_num(
+            format!("loss_{}_{}_w", it.source.as_str(), it.name),
+            col(&|k| traj.losses[k][i]),
+        );
+    }
+    for (source, name) in skipped_items(scene) {
+        t.push_num(format!("loss_{}_{name}_w", source.as_str()), vec![0.0; m]);
+    }
+    let by: Vec<PerSource> = (0..m)
+        .map(|k| sum_by_source(&scene.losses.items, &traj.losses[k]))
+        .collect();
+    for s in Source::ALL {
+        t.push_num(format!("loss_{}_w", s.as_str()), col(&|k| by[k][s.index()]));
+    }
+    let total: Vec<f64> = by.iter().map(|b| b.iter().sum()).collect();
+    let eff = col(&|k| {
+        crate::physics::efficiency::efficiency(rows[k].output_power_w, total[k]).unwrap_or(f64::NAN)
+    });
+    t.push_num("loss_total_w", total);
+    t.push_num("efficiency", eff);
+    for (j, c) in scene.thermal.controls.iter().enumerate() {
+        t.push_num(
+            format!("control_{}", c.name),
+            col(&|k| {
+                traj.controls
+                    .get(k)
+                    .and_then(|x| x.get(j))
+                    .copied()
+                    .unwrap_or(f64::NAN)
+            }),
+        );
+    }
+    t
 }
 
 /// The loss items the scene left out (its `skipped` list, `<source> of <gear|mesh> <name>`),
@@ -429,7 +437,7 @@ pub fn timeseries_csv(
 /// the model's whatever the overrides (an oil level that leaves a gear dry keeps its column).
 pub fn skipped_items(scene: &Scene) -> Vec<(Source, String)> {
     scene
-        .skipped
+        .skipped()
         .iter()
         .filter_map(|sk| {
             let (src, rest) = sk.what.split_once(" of ")?;
@@ -528,6 +536,11 @@ pub fn check_finite(
 }
 
 impl Summary {
+    /// True when `node` is a boundary node of the run.
+    pub fn is_boundary(&self, node: &str) -> bool {
+        self.nodes.iter().any(|n| n.name == node && n.boundary)
+    }
+
     /// The first non-finite number of the summary, named, or `Ok`.
     pub fn check_finite(&self) -> Result<(), String> {
         let e = &self.energy_lost_j;

@@ -1,6 +1,7 @@
 //! Per-source values in reports: one key or column per loss source of [`Source::ALL`], so a new
 //! source appears in every output without touching the writers.
 
+use serde::de::{Deserialize, Deserializer};
 use serde::ser::{Serialize, SerializeMap, Serializer};
 
 use crate::scene::{PerSource, Source};
@@ -53,6 +54,20 @@ impl SourceValues {
             .map(|s| format!("{} {:.digits$} {unit}", s.as_str(), self.get(*s) * scale))
             .collect::<Vec<_>>()
             .join(", ")
+    }
+}
+
+/// Read back as `summary.json` writes it (`energy_lost_j`: keys `<source>` and `total`, no
+/// prefix or suffix): a source the file has no key for (one added after the file was written)
+/// reads as 0; `total` is the sum again (the writer writes the sum); other keys are ignored.
+impl<'de> Deserialize<'de> for SourceValues {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let map = std::collections::BTreeMap::<String, Option<f64>>::deserialize(d)?;
+        let mut values = [0.0; crate::scene::N_SOURCES];
+        for s in Source::ALL {
+            values[s.index()] = map.get(s.as_str()).copied().flatten().unwrap_or(0.0);
+        }
+        Ok(SourceValues::new(values, "", map.contains_key("total")))
     }
 }
 

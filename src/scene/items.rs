@@ -53,7 +53,7 @@ pub struct LossItem {
 }
 
 /// A part of the model the scene left out, and why.
-#[derive(Debug, Clone, serde::Serialize)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Skipped {
     /// What (e.g. "churning of gear s1_sun").
     pub what: String,

@@ -56,14 +56,14 @@ pub struct Scene {
     pub losses: LossScene,
     /// Thermal network.
     pub thermal: ThermalScene,
-    /// What the compile step left out and why.
-    pub skipped: Vec<Skipped>,
+    /// What the compile step left out and why ([`Scene::skipped`]).
+    skipped: Vec<Skipped>,
     /// Oil temperature used for the oil properties instead of the oil node's (K); `None` for the
     /// normal coupled model. Used to measure the viscosity feedback. Set by the compile
     /// ([`Needs::frozen_oil_temp_k`]).
     frozen_oil_temp: Option<f64>,
     /// Energy quadrature (offset after the nodes) each loss item adds to.
-    pub energy_slot: Vec<usize>,
+    energy_slot: Vec<usize>,
     /// Number of energy quadratures (items, or 3 sources).
     energies: usize,
     /// True when each item has its own energy quadrature (slot k = item k).
@@ -149,6 +149,11 @@ impl Scene {
     /// The temperature the oil properties are frozen at (K), when the scenario freezes them.
     pub fn frozen_oil_temp(&self) -> Option<f64> {
         self.frozen_oil_temp
+    }
+
+    /// What the compile step left out and why (read only: the list is the compile's).
+    pub fn skipped(&self) -> &[Skipped] {
+        &self.skipped
     }
 
     /// Compile only what `needs` asks for (scene pruning): see [`LossScene::compile_for`].
@@ -521,7 +526,7 @@ impl Scene {
                 what: format!(
                     "loss is {} at oil temperature {:.3} °C",
                     q[k],
-                    self.oil_temp(y) - crate::physics::oil::KELVIN_OFFSET
+                    crate::physics::units::k_to_c(self.oil_temp(y))
                 ),
             };
         }

@@ -5,7 +5,7 @@
 use std::fmt;
 
 /// One warning: an item, the range or condition, and what was seen.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RangeWarning {
     /// Loss item (e.g. "churning of gear wheel").
     pub item: String,

@@ -166,11 +166,13 @@ class RunResult:
 
 def read_run(directory: PathLike) -> RunResult:
     """A run directory (``geartherm run --out DIR`` or :meth:`RunResult.write`) as the
-    :class:`RunResult` the run returned.
+    :class:`RunResult` the run returned, read with the writer's types (the library's ``Summary``
+    and time-series table, as ``geartherm report`` reads it): a directory of an earlier version
+    reads with today's keys (``mean_efficiency`` as ``cycle_efficiency``, keys it lacks at their
+    defaults).
 
     Raises :class:`FileNotFoundError` when ``summary.json`` is missing."""
-    d = Path(directory)
-    summary = (d / "summary.json").read_text()
-    ts = d / "timeseries.csv"
-    csv: Optional[str] = ts.read_text() if ts.exists() else None
-    return RunResult(json.dumps(json.loads(summary)), csv)
+    from . import _native
+
+    summary, csv = _native.read_run(str(Path(directory)))
+    return RunResult(summary, csv)

@@ -89,7 +89,7 @@ pub fn fitted_once(specs: &[FitSpec], doc: &toml::Table) -> Result<(), JobError>
     for b in 0..specs.len() {
         if let Some(a) = (0..b).find(|&a| canon[a] == canon[b]) {
             let msg = format!(
-                "fit (--fit) = {}: the same number as --fit {} ({}): each number is fitted once",
+                "fit = {}: the same number as fit {} ({}): each number is fitted once",
                 specs[b], specs[a], canon[a]
             );
             return Err(JobError::option(

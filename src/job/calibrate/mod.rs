@@ -151,7 +151,7 @@ fn window(s: &str) -> Result<(f64, f64), JobError> {
             "holdout",
             s,
             "T0:T1 in s, T0 < T1",
-            format!("holdout (--holdout) = {s}: must be T0:T1, two finite times in s with T0 < T1"),
+            format!("holdout = {s}: must be T0:T1, two finite times in s with T0 < T1"),
         )
     };
     let (a, b) = s.split_once(':').ok_or_else(bad)?;
@@ -178,7 +178,7 @@ impl CalibrateOptions {
         MAX_ITERATIONS.check(self.max_iterations as f64)?;
         if !["ar1", "ar1-gls", "independent"].contains(&self.residuals.as_str()) {
             let msg = format!(
-                "residuals (--residuals) = {}: must be ar1, ar1-gls or independent",
+                "residuals = {}: must be ar1, ar1-gls or independent",
                 self.residuals
             );
             return Err(JobError::option(
@@ -194,7 +194,7 @@ impl CalibrateOptions {
                 .parse()
                 .map_err(|e: String| JobError::option("fit", f, "KEYPATH[=LO:HI]", e))?;
             if specs.iter().any(|x| x.path == s.path) {
-                let msg = format!("fit (--fit) = {f}: {} is fitted twice", s.path);
+                let msg = format!("fit = {f}: {} is fitted twice", s.path);
                 return Err(JobError::option("fit", f, "each key path once", msg));
             }
             specs.push(s);
@@ -304,9 +304,9 @@ impl<'a> Prepared<'a> {
             return Err(JobError::option(
                 "band_from",
                 file,
-                "a run that fits nothing (no --fit, every row held out)",
+                "a run that fits nothing (no fit, every row held out)",
                 format!(
-                    "band_from (--band-from) = {file}: only for a prediction (no --fit, --holdout over the whole \
+                    "band_from = {file}: only for a prediction (no fit, holdout over the whole \
                      trace); this run fits its own band"
                 ),
             ));
@@ -1057,42 +1057,44 @@ pub const LIMITS: [Limit; 4] = [limits::RTOL, limits::ATOL, limits::MAX_STEPS, M
 impl super::command::ToArgs for CalibrateOptions {
     const COMMAND: &'static str = "calibrate";
     fn to_args(&self) -> Vec<String> {
-        let mut a = vec!["--trace".to_string(), self.trace.clone()];
+        // Each option by its name, spelled as a flag by the one rule of `options::flag`.
+        let flag = super::options::flag;
+        let mut a = vec![flag("trace"), self.trace.clone()];
         for f in &self.fit {
-            a.extend(["--fit".to_string(), f.clone()]);
+            a.extend([flag("fit"), f.clone()]);
         }
         for h in &self.holdout {
-            a.extend(["--holdout".to_string(), h.clone()]);
+            a.extend([flag("holdout"), h.clone()]);
         }
         a.extend([
-            "--rtol".into(),
+            flag("rtol"),
             format!("{}", self.rtol),
-            "--atol".into(),
+            flag("atol"),
             format!("{}", self.atol),
         ]);
-        a.extend(["--max-steps".into(), self.max_steps.to_string()]);
-        a.extend(["--max-iterations".into(), self.max_iterations.to_string()]);
+        a.extend([flag("max_steps"), self.max_steps.to_string()]);
+        a.extend([flag("max_iterations"), self.max_iterations.to_string()]);
         if !self.initial_from_trace {
-            a.push("--keep-initial".into());
+            a.push(flag("keep_initial"));
         }
         if let Some(k) = self.segment {
-            a.extend(["--segment".into(), k.to_string()]);
+            a.extend([flag("segment"), k.to_string()]);
         }
         if self.refuse_missing {
-            a.push("--refuse-missing".into());
+            a.push(flag("refuse_missing"));
         }
-        a.extend(["--residuals".into(), self.residuals.clone()]);
+        a.extend([flag("residuals"), self.residuals.clone()]);
         for p in &self.prior {
-            a.extend(["--prior".to_string(), p.clone()]);
+            a.extend([flag("prior"), p.clone()]);
         }
         for p in &self.profile {
-            a.extend(["--profile".to_string(), p.clone()]);
+            a.extend([flag("profile"), p.clone()]);
         }
         if let Some(k) = &self.gearbox_kind {
-            a.extend(["--gearbox-kind".to_string(), k.clone()]);
+            a.extend([flag("gearbox_kind"), k.clone()]);
         }
         if let Some(r) = &self.rated {
-            a.extend(["--rated".to_string(), r.clone()]);
+            a.extend([flag("rated"), r.clone()]);
         }
         a
     }

@@ -72,12 +72,11 @@ impl std::str::FromStr for FitSpec {
         let path: KeyPath = path
             .trim()
             .parse()
-            .map_err(|e| format!("fit (--fit) = {s}: bad key path: {e}"))?;
+            .map_err(|e| format!("fit = {s}: bad key path: {e}"))?;
         let bounds = match bounds {
             None => None,
             Some(b) => {
-                let bad =
-                    || format!("fit (--fit) = {s}: bounds must be LO:HI, two finite numbers with LO < HI");
+                let bad = || format!("fit = {s}: bounds must be LO:HI, two finite numbers with LO < HI");
                 let (lo, hi) = b.split_once(':').ok_or_else(bad)?;
                 let lo: f64 = lo.trim().parse().map_err(|_| bad())?;
                 let hi: f64 = hi.trim().parse().map_err(|_| bad())?;
@@ -114,11 +113,7 @@ impl Parameter {
         let value = match got {
             Ok(Value::Float(x)) => Some(x),
             Ok(Value::Integer(i)) => Some(i as f64),
-            Ok(v) => {
-                return Err(format!(
-                    "fit (--fit) = {name}: the model holds {v} there, not a number"
-                ))
-            }
+            Ok(v) => return Err(format!("fit = {name}: the model holds {v} there, not a number")),
             Err(_) => None,
         };
         let temp = is_temperature(&spec.path);
@@ -128,12 +123,12 @@ impl Parameter {
             (None, Some(v)) if v > 0.0 => (v / DEFAULT_SPAN, v * DEFAULT_SPAN),
             (None, Some(v)) => {
                 return Err(format!(
-                    "fit (--fit) = {name}: the model's value {v} is not positive: give bounds KEYPATH=LO:HI"
+                    "fit = {name}: the model's value {v} is not positive: give bounds KEYPATH=LO:HI"
                 ))
             }
             (None, None) => {
                 return Err(format!(
-                    "fit (--fit) = {name}: the model file does not write this key: give bounds KEYPATH=LO:HI \
+                    "fit = {name}: the model file does not write this key: give bounds KEYPATH=LO:HI \
                      (the fit starts at their mean)"
                 ))
             }
@@ -142,7 +137,7 @@ impl Parameter {
         let start = value.unwrap_or(if log { (lo * hi).sqrt() } else { 0.5 * (lo + hi) });
         if !(lo..=hi).contains(&start) {
             return Err(format!(
-                "fit (--fit) = {}: the model's value {start} lies outside the bounds [{lo}, {hi}]",
+                "fit = {}: the model's value {start} lies outside the bounds [{lo}, {hi}]",
                 spec
             ));
         }

@@ -10,7 +10,7 @@
 //!   factor 2 either way) are this tool's reading of "on the order of", not the source's.
 
 use crate::model::Gearbox;
-use crate::physics::oil::KELVIN_OFFSET;
+use crate::physics::units::{c_to_k, rad_s_to_rpm, rpm_to_rad_s};
 use crate::report::calibration::{LossAt, Plausibility, Reference};
 use crate::scene::{LossScene, OperatingPoint};
 
@@ -52,7 +52,7 @@ pub fn check_kind(kind: &str) -> Result<(), JobError> {
         "gearbox_kind",
         kind,
         allowed.clone(),
-        format!("gearbox_kind (--gearbox-kind) = {kind}: no sourced loss figure for it (known: {allowed})"),
+        format!("gearbox_kind = {kind}: no sourced loss figure for it (known: {allowed})"),
     ))
 }
 
@@ -63,7 +63,7 @@ pub fn rated_point(s: &str) -> Result<(f64, f64), JobError> {
             "rated",
             s,
             "RPM:NM, speed > 0 and a finite torque",
-            format!("rated (--rated) = {s}: must be RPM:NM (input speed > 0 rpm, input torque in N m)"),
+            format!("rated = {s}: must be RPM:NM (input speed > 0 rpm, input torque in N m)"),
         )
     };
     let (a, b) = s.split_once(':').ok_or_else(bad)?;
@@ -84,7 +84,7 @@ fn loss_at(gb: &Gearbox, scene: &LossScene, state: usize, w: f64, t: f64, oil_c:
         state,
         input_speed: w,
         input_torque: t,
-        oil: gb.oil.properties(oil_c + KELVIN_OFFSET),
+        oil: gb.oil.properties(c_to_k(oil_c)),
     };
     let mut out = vec![0.0; scene.len()];
     scene.evaluate(&op, &mut out);
@@ -92,7 +92,7 @@ fn loss_at(gb: &Gearbox, scene: &LossScene, state: usize, w: f64, t: f64, oil_c:
     let total: f64 = out.iter().sum();
     let power = (w * t).abs();
     LossAt {
-        input_speed_rpm: w * 30.0 / std::f64::consts::PI,
+        input_speed_rpm: rad_s_to_rpm(w),
         input_torque_nm: t,
         power_w: power,
         oil_temp_c: oil_c,
@@ -177,7 +177,7 @@ pub fn assess(
         .collect();
     let highest = mean(&points);
     let rated_at = rated.map(|(n, t)| {
-        let w = n * std::f64::consts::PI / 30.0;
+        let w = rpm_to_rad_s(n);
         loss_at(
             &gb,
             &scene,

@@ -51,7 +51,7 @@ fn bad_prior(text: &str, why: &str) -> JobError {
         "prior",
         text,
         "KEYPATH=normal:MEAN:SD or KEYPATH=lognormal:MEDIAN:SD_LN, SD > 0",
-        format!("prior (--prior) = {text}: {why}"),
+        format!("prior = {text}: {why}"),
     )
 }
 
@@ -228,7 +228,7 @@ impl Priors {
             let Some(k) = canon.iter().position(|x| *x == c) else {
                 return Err(bad_prior(
                     &s.text,
-                    &format!("{} is not a fitted parameter (give it with --fit)", s.path),
+                    &format!("{} is not a fitted parameter (add it to fit)", s.path),
                 ));
             };
             if list.iter().any(|p| p.param == k) {

@@ -2,6 +2,7 @@
 //! (segments, boundary series, measured nodes, initial temperatures), the parameters, and the
 //! simulation at a parameter point with or without sensitivities.
 
+use crate::physics::units::{c_to_k, k_to_c};
 use std::path::PathBuf;
 
 use crate::model::overrides;
@@ -9,7 +10,6 @@ use crate::model::parse::{parse_document, parse_table};
 use crate::model::thermal::BoundaryTemp;
 use crate::model::validate::validate;
 use crate::model::{self, Gearbox, Override, Problems};
-use crate::physics::oil::KELVIN_OFFSET;
 use crate::scene::{Needs, Scene};
 use crate::solve::drive::segments;
 use crate::solve::sensitivity::{
@@ -259,7 +259,7 @@ impl<'a> Problem<'a> {
                         .times
                         .iter()
                         .zip(&c.values_c)
-                        .map(|(&t, &v)| (t, v + KELVIN_OFFSET))
+                        .map(|(&t, &v)| (t, c_to_k(v)))
                         .collect();
                     b.temp = BoundaryTemp::Series(series);
                 }
@@ -337,12 +337,7 @@ impl<'a> Problem<'a> {
         let mut temps_c = Vec::with_capacity(self.rows.len());
         let mut sens = Vec::with_capacity(if p > 0 { self.rows.len() } else { 0 });
         for &r in &self.rows {
-            temps_c.push(
-                self.channels
-                    .iter()
-                    .map(|&n| traj.temps[r][n] - KELVIN_OFFSET)
-                    .collect(),
-            );
+            temps_c.push(self.channels.iter().map(|&n| k_to_c(traj.temps[r][n])).collect());
             if p > 0 {
                 let mut row = Vec::with_capacity(self.channels.len() * p);
                 for &n in &self.channels {

@@ -32,7 +32,7 @@ pub fn resolve(keys: &[String], params: &[Parameter], doc: &toml::Table) -> Resu
                 "profile",
                 k,
                 "the key path of a fitted parameter",
-                format!("profile (--profile) = {k}: {why}"),
+                format!("profile = {k}: {why}"),
             )
         };
         let path: KeyPath = k.trim().parse().map_err(|e| bad(format!("bad key path: {e}")))?;
@@ -40,7 +40,7 @@ pub fn resolve(keys: &[String], params: &[Parameter], doc: &toml::Table) -> Resu
         let i = canon
             .iter()
             .position(|x| *x == c)
-            .ok_or_else(|| bad("not a fitted parameter (give it with --fit)".into()))?;
+            .ok_or_else(|| bad("not a fitted parameter (add it to fit)".into()))?;
         if !out.contains(&i) {
             out.push(i);
         }

@@ -10,6 +10,7 @@
 //! (`fmi2SetRealInputDerivatives`, order 1), held when none was set. Derivatives are forgotten
 //! after each step.
 
+use crate::physics::units::{c_to_k, RAD_S_PER_RPM};
 use std::sync::Arc;
 
 use super::variables::{Causality, Role, Variable};
@@ -19,7 +20,6 @@ use crate::job::limits::{self, Limit};
 use crate::job::run::DEFAULT_MAX_STEPS;
 use crate::job::{JobError, Model};
 use crate::physics::efficiency::efficiency;
-use crate::physics::oil::KELVIN_OFFSET;
 use crate::scene::{sum_by_source, Inputs, Scene};
 use crate::solve::cosim::Stepper;
 use crate::solve::transient::{Method, TransientOptions};
@@ -497,7 +497,7 @@ impl Instance {
 
 /// A limit in rpm as one in rad/s.
 fn rad_per_s(l: &Limit) -> Limit {
-    let k = std::f64::consts::PI / 30.0;
+    let k = RAD_S_PER_RPM;
     Limit {
         lo: l.lo * k,
         hi: l.hi * k,
@@ -519,8 +519,8 @@ fn m_per_s(l: &Limit) -> Limit {
 /// A limit in °C as one in K.
 fn kelvin(l: &Limit) -> Limit {
     Limit {
-        lo: l.lo + KELVIN_OFFSET,
-        hi: l.hi + KELVIN_OFFSET,
+        lo: c_to_k(l.lo),
+        hi: c_to_k(l.hi),
         unit: "K",
         ..*l
     }

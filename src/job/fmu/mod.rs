@@ -142,7 +142,7 @@ impl FmuModel {
     }
 }
 
-/// Every `--param` key path: parsed, present in the model (with its overrides) and a number.
+/// Every parameter key path: parsed, present in the model (with its overrides) and a number.
 fn check_params(payload: &Payload, ovs: &[Override]) -> Result<Vec<Param>, JobError> {
     let mut problems = Vec::new();
     let mut doc: toml::Table = payload
@@ -157,7 +157,7 @@ fn check_params(payload: &Payload, ovs: &[Override]) -> Result<Vec<Param>, JobEr
         let path: KeyPath = match text.parse() {
             Ok(p) => p,
             Err(e) => {
-                problems.push(format!("--param {text}: bad key path: {e}"));
+                problems.push(format!("parameter {text}: bad key path: {e}"));
                 continue;
             }
         };
@@ -175,9 +175,9 @@ fn check_params(payload: &Payload, ovs: &[Override]) -> Result<Vec<Param>, JobEr
                 integer: true,
             }),
             Ok(other) => problems.push(format!(
-                "--param {text}: holds {other}, not a number (only numbers can be FMU parameters)"
+                "parameter {text}: holds {other}, not a number (only numbers can be FMU parameters)"
             )),
-            Err(e) => problems.push(format!("--param {text}: {e}")),
+            Err(e) => problems.push(format!("parameter {text}: {e}")),
         }
     }
     if !problems.is_empty() {

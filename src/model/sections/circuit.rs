@@ -434,7 +434,7 @@ fn source(s: &SourceSpec, p: &str, names: &CircuitNames<'_>, problems: &mut Prob
             if !(eff > 0.05 && eff <= 1.0) {
                 problems.push(format!("{p}.efficiency"), eff, "required, in (0.05, 1]");
             }
-            let rpm = std::f64::consts::PI / 30.0;
+            let rpm = crate::physics::units::RAD_S_PER_RPM;
             let flow = flow_curve(&s.flow, "input_rpm", rpm, p, problems);
             SourceKind::ElectricPump {
                 flow: flow.unwrap_or_else(zero_curve),

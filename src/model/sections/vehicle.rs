@@ -473,7 +473,7 @@ min_hold_s = 2.0
         let s = v.shift.unwrap();
         assert_relative_eq!(
             s.upshift[0],
-            2200.0 * std::f64::consts::PI / 30.0,
+            crate::physics::units::rpm_to_rad_s(2200.0),
             epsilon = 1e-12
         );
         assert_eq!(s.gears.len(), 6);

@@ -1,18 +1,23 @@
-//! Reading run, map and bench outputs (the file formats written by `report`).
+//! What the figures draw from run, map and bench outputs, read with the writers' types: a run's
+//! [`Summary`] and [`Timeseries`] (`report::run`, `report::timeseries`), a map's
+//! [`MapMeta`] (`report::map`), a bench's [`BenchRow`]s (`solve::work_precision`).
 //!
-//! Missing numeric values (empty fields, `NaN`) become `f64::NAN` and are skipped by the plots;
+//! Missing numeric values (empty fields) become `f64::NAN` and are skipped by the plots;
 //! anything that is not a number, a wrong field count or a missing required column is an error
 //! that names the file.
 
-use std::collections::BTreeMap;
 use std::fs;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use serde::Deserialize;
 
 use super::style::Source;
 use super::PlotError;
+pub use crate::report::map::MapMeta;
+pub use crate::report::run::Summary;
+use crate::report::timeseries::{parse_num, Timeseries};
 use crate::scene::N_SOURCES;
+pub use crate::solve::work_precision::BenchRow;
 
 /// One loss item's power over time.
 #[derive(Clone, Debug)]
@@ -83,16 +88,6 @@ impl TimeSeries {
     }
 }
 
-/// A CSV number: empty is "no value" (NaN inside, a break in the curve); `NaN`, `inf` and
-/// anything else that is not a finite number is rejected (geartherm never writes them).
-fn parse_num(field: &str) -> Option<f64> {
-    let f = field.trim();
-    if f.is_empty() {
-        return Some(f64::NAN);
-    }
-    f.parse::<f64>().ok().filter(|v| v.is_finite())
-}
-
 /// What is wrong with an efficiency outside [0, 1].
 const NOT_AN_EFFICIENCY: &str = "is not an efficiency (a fraction in [0, 1])";
 
@@ -130,41 +125,52 @@ fn open_csv(path: &Path) -> Result<csv::Reader<fs::File>, PlotError> {
         .from_reader(file))
 }
 
-/// Read `timeseries.csv`.
-pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
-    let mut rdr = open_csv(path)?;
-    let headers = rdr.headers().map_err(|e| csv_err(path, e))?.clone();
-    let find = |name: &str| headers.iter().position(|h| h == name);
-    let require = |name: &str| {
-        find(name).ok_or_else(|| PlotError::Data {
-            path: path.to_path_buf(),
-            what: format!("missing required column `{name}`"),
-        })
+/// The plots' view of a `timeseries.csv` table (`path` names it in errors): the required columns
+/// (`time_s`, `vehicle_speed_kmh`, `gear`, the three gear sources' `loss_<source>_w`,
+/// `loss_total_w`, `efficiency`), times that increase from row to row, efficiencies in [0, 1],
+/// every value drawn within ±[`MAX_AXIS_VALUE`]. Per-source columns are read under their
+/// earlier names too (`<source>_w`, `total_loss_w`); a source without a column (added after the
+/// file was written) is zero.
+pub fn from_table(t: &Timeseries, path: &Path) -> Result<TimeSeries, PlotError> {
+    let data = |what: String| PlotError::Data {
+        path: path.to_path_buf(),
+        what,
     };
-    let c_time = require("time_s")?;
-    let c_speed = require("vehicle_speed_kmh")?;
-    let c_gear = require("gear")?;
+    let require = |names: &[&str]| -> Result<&[f64], PlotError> {
+        names
+            .iter()
+            .find_map(|n| t.num(n))
+            .ok_or_else(|| data(format!("missing required column `{}`", names[0])))
+    };
+    let time = require(&["time_s"])?;
+    let speed = require(&["vehicle_speed_kmh"])?;
+    let gear = t
+        .text("gear")
+        .ok_or_else(|| data("missing required column `gear`".into()))?;
     // The three gear sources are required; later sources are optional (older files).
-    let mut c_src = [None; N_SOURCES];
+    let mut src: Vec<Option<&[f64]>> = Vec::with_capacity(N_SOURCES);
     for s in Source::ALL {
-        let col = format!("loss_{}_w", s.as_str());
-        c_src[s.index()] = if s.index() < 3 {
-            Some(require(&col)?)
+        let names = [format!("loss_{}_w", s.as_str()), format!("{}_w", s.as_str())];
+        let names = [names[0].as_str(), names[1].as_str()];
+        src.push(if s.index() < 3 {
+            Some(require(&names)?)
         } else {
-            find(&col)
-        };
+            names.iter().find_map(|n| t.num(n))
+        });
     }
-    let c_total = require("loss_total_w")?;
-    let c_eff = require("efficiency")?;
-
+    let total = require(&["loss_total_w", "total_loss_w"])?;
+    let eff = require(&["efficiency"])?;
     let mut ts = TimeSeries::default();
-    let mut temp_cols = Vec::new();
-    let mut item_cols = Vec::new();
-    for (i, h) in headers.iter().enumerate() {
+    let mut used: Vec<(&str, &[f64])> = vec![("time_s", time), ("vehicle_speed_kmh", speed)];
+    for c in &t.columns {
+        let crate::report::timeseries::Values::Num(v) = &c.values else {
+            continue;
+        };
+        let h = c.name.as_str();
         if let Some(node) = h.strip_prefix("temp_").and_then(|r| r.strip_suffix("_c")) {
             if !node.is_empty() {
-                temp_cols.push(i);
-                ts.temps_c.push((node.to_string(), Vec::new()));
+                ts.temps_c.push((node.to_string(), v.clone()));
+                used.push((h, v));
             }
         } else if let Some(rest) = h.strip_prefix("loss_").and_then(|r| r.strip_suffix("_w")) {
             let parsed = Source::ALL.into_iter().find_map(|s| {
@@ -174,228 +180,87 @@ pub fn read_timeseries(path: &Path) -> Result<TimeSeries, PlotError> {
                     .map(|n| (s, n))
             });
             if let Some((source, name)) = parsed {
-                item_cols.push(i);
                 ts.items.push(LossItemSeries {
                     source,
                     name: name.to_string(),
-                    power_w: Vec::new(),
+                    power_w: v.clone(),
                 });
+                used.push((h, v));
             }
             // loss columns of an unknown source are ignored (forward compatibility).
         }
     }
-
-    let mut record = csv::StringRecord::new();
-    let mut line = 1u64;
-    loop {
-        match rdr.read_record(&mut record) {
-            Ok(true) => {}
-            Ok(false) => break,
-            Err(e) => return Err(csv_err(path, e)),
-        }
-        line = record.position().map(|p| p.line()).unwrap_or(line + 1);
-        // Every value is drawn on an axis: finite and within ±MAX_AXIS_VALUE (an axis spanning
-        // ±1e308 has an infinite width, on which the tick search never ends).
-        let num = |c: usize| -> Result<f64, PlotError> {
-            let field = record.get(c).unwrap_or("");
-            parse_num(field)
-                .filter(|v| v.is_nan() || v.abs() <= MAX_AXIS_VALUE)
-                .ok_or_else(|| PlotError::Csv {
-                    path: path.to_path_buf(),
-                    msg: format!(
-                        "line {line}, column `{}`: `{field}` is not a finite number within \
-                         ±{MAX_AXIS_VALUE:e}",
-                        &headers[c]
-                    ),
-                })
-        };
-        let t = num(c_time)?;
-        let speed = num(c_speed)?;
-        let prev = ts.time_s.last().copied().unwrap_or(f64::NEG_INFINITY);
-        // A run writes one row per sample, at increasing times (the axis and the energy weights
-        // rest on it).
-        {
-            let increases = t.partial_cmp(&prev) == Some(std::cmp::Ordering::Greater);
-            if !increases || t.abs() > MAX_AXIS_VALUE {
-                return Err(PlotError::Csv {
-                    path: path.to_path_buf(),
-                    msg: format!(
-                        "line {line}, column `time_s`: {} does not follow {} (times increase \
-                         from row to row, |time| ≤ {MAX_AXIS_VALUE:e} s)",
-                        number(t),
-                        number(prev)
-                    ),
-                });
-            }
-        }
-        ts.time_s.push(t);
-        ts.vehicle_speed_kmh.push(speed);
-        ts.gear.push(record.get(c_gear).unwrap_or("").to_string());
-        for (k, &c) in temp_cols.iter().enumerate() {
-            let v = num(c)?;
-            ts.temps_c[k].1.push(v);
-        }
-        for (k, &c) in item_cols.iter().enumerate() {
-            let v = num(c)?;
-            ts.items[k].power_w.push(v);
-        }
-        for (k, c) in c_src.iter().enumerate() {
-            let v = match c {
-                Some(c) => num(*c)?,
-                None => 0.0,
-            };
-            ts.source_w[k].push(v);
-        }
-        ts.total_loss_w.push(num(c_total)?);
-        let eff = num(c_eff)?;
-        if !is_efficiency(eff) {
-            return Err(PlotError::Csv {
-                path: path.to_path_buf(),
-                msg: format!(
-                    "line {line}, column `efficiency`: {} {NOT_AN_EFFICIENCY}",
-                    number(eff)
-                ),
-            });
-        }
-        ts.efficiency.push(eff);
+    for (s, c) in Source::ALL.iter().zip(&src) {
+        ts.source_w[s.index()] = c.map_or_else(|| vec![0.0; t.rows()], <[f64]>::to_vec);
     }
+    used.extend(src.iter().flatten().map(|c| ("per-source loss", *c)));
+    used.push(("loss_total_w", total));
+    used.push(("efficiency", eff));
+    check_values(t, path, &used)?;
+    ts.time_s = time.to_vec();
+    ts.vehicle_speed_kmh = speed.to_vec();
+    ts.gear = gear.to_vec();
+    ts.total_loss_w = total.to_vec();
+    ts.efficiency = eff.to_vec();
     if ts.is_empty() {
-        return Err(PlotError::Data {
-            path: path.to_path_buf(),
-            what: "no data rows".into(),
-        });
+        return Err(data("no data rows".into()));
     }
     Ok(ts)
 }
 
-/// `energy_lost_j`: one key per source and `total` (missing or null values are `None`).
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(transparent)]
-pub struct EnergyBySource(BTreeMap<String, Option<f64>>);
-
-impl EnergyBySource {
-    /// Energy lost by source `s` over the run, J.
-    pub fn get(&self, s: Source) -> Option<f64> {
-        self.0.get(s.as_str()).copied().flatten()
-    }
-
-    /// Energy lost by all sources over the run, J.
-    pub fn total(&self) -> Option<f64> {
-        self.0.get("total").copied().flatten()
-    }
-}
-
-/// One entry of `energy_by_item_j`: the energy one loss item dissipated over the run.
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(default)]
-pub struct ItemEnergy {
-    /// Loss source of the item (`churning`, `bearing`, …).
-    pub source: String,
-    /// Item name.
-    pub name: String,
-    /// Energy, J.
-    pub j: Option<f64>,
-}
-
-/// One node's entry of `temperatures_c`, °C.
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(default)]
-pub struct TempStats {
-    /// Lowest temperature over the output rows, °C.
-    pub min: Option<f64>,
-    /// Highest temperature over the output rows, °C.
-    pub max: Option<f64>,
-    /// Temperature at the end of the run, °C (key `final`).
-    #[serde(rename = "final")]
-    pub last: Option<f64>,
-}
-
-/// One entry of `nodes`: a thermal network node.
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(default)]
-pub struct NodeInfo {
-    /// Node name from the model file.
-    pub name: String,
-    /// True for a boundary (prescribed temperature), false for a capacity node.
-    pub boundary: bool,
-}
-
-/// One entry of `skipped`: something the scene left out of the run.
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(default)]
-pub struct Skipped {
-    /// The item or table left out.
-    pub what: String,
-    /// Why (idle in every gear state the run uses, above the oil, …).
-    pub why: String,
-}
-
-/// `summary.json`. Every field is optional so that a partial summary still renders; unknown
-/// keys are ignored.
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(default)]
-pub struct Summary {
-    /// Model name.
-    pub model: Option<String>,
-    /// Cycle name.
-    pub cycle: Option<String>,
-    /// Solver as asked (`auto` by default).
-    pub solver: Option<serde_json::Value>,
-    /// Relative tolerance of the integration.
-    pub rtol: Option<serde_json::Value>,
-    /// Absolute tolerance of the integration, K on temperatures.
-    pub atol: Option<serde_json::Value>,
-    /// Wall time of the integration, s.
-    pub wall_time_s: Option<f64>,
-    /// Accepted integration steps.
-    pub steps: Option<f64>,
-    /// Energy lost per source and in total, J.
-    pub energy_lost_j: Option<EnergyBySource>,
-    /// Energy lost per loss item, J.
-    pub energy_by_item_j: Vec<ItemEnergy>,
-    /// |lost − stored − to boundaries| over the largest of the three energies.
-    pub energy_balance_relative: Option<f64>,
-    /// `cycle_efficiency` (∫P_out/∫P_in); `mean_efficiency` in directories of earlier versions.
-    #[serde(alias = "mean_efficiency")]
-    pub cycle_efficiency: Option<f64>,
-    /// Min, max and final temperature per node, °C.
-    pub temperatures_c: BTreeMap<String, TempStats>,
-    /// The network's nodes, capacity nodes first.
-    pub nodes: Vec<NodeInfo>,
-    /// Name of the node whose temperature sets the oil properties.
-    pub oil_node: Option<String>,
-    /// What the scene left out of the run.
-    pub skipped: Vec<Skipped>,
-}
-
-impl Summary {
-    /// True when `node` is a boundary node of the run.
-    pub fn is_boundary(&self, node: &str) -> bool {
-        self.nodes.iter().any(|n| n.name == node && n.boundary)
-    }
-
-    /// The values the report writes as they must be: `cycle_efficiency` a fraction in [0, 1]
-    /// (an efficiency is never drawn or written over 100 %). Err: the key and what is wrong.
-    pub fn check(&self) -> Result<(), String> {
-        match self.cycle_efficiency {
-            Some(e) if !is_efficiency(e) => {
-                Err(format!("cycle_efficiency: {} {NOT_AN_EFFICIENCY}", number(e)))
+/// The checks of [`from_table`] on the values it draws: within ±[`MAX_AXIS_VALUE`], times
+/// increasing, efficiencies in [0, 1]; errors name the line and column.
+fn check_values(t: &Timeseries, path: &Path, used: &[(&str, &[f64])]) -> Result<(), PlotError> {
+    let csv = |line: usize, msg: String| PlotError::Csv {
+        path: path.to_path_buf(),
+        msg: format!("line {line}, {msg}"),
+    };
+    for k in 0..t.rows() {
+        let line = k + 2;
+        for (name, v) in used {
+            // An axis spanning ±1e308 has an infinite width, on which the tick search never ends.
+            if v[k].abs() > MAX_AXIS_VALUE {
+                return Err(csv(
+                    line,
+                    format!(
+                        "column `{name}`: `{}` is not a finite number within ±{MAX_AXIS_VALUE:e}",
+                        number(v[k])
+                    ),
+                ));
             }
-            _ => Ok(()),
+        }
+        // A run writes one row per sample, at increasing times (the axis and the energy weights
+        // rest on it).
+        let time = used[0].1;
+        let prev = if k > 0 { time[k - 1] } else { f64::NEG_INFINITY };
+        if time[k].partial_cmp(&prev) != Some(std::cmp::Ordering::Greater) {
+            return Err(csv(
+                line,
+                format!(
+                    "column `time_s`: {} does not follow {} (times increase from row to row, |time| ≤ \
+                     {MAX_AXIS_VALUE:e} s)",
+                    number(time[k]),
+                    number(prev)
+                ),
+            ));
+        }
+        let eff = used[used.len() - 1].1[k];
+        if !is_efficiency(eff) {
+            return Err(csv(
+                line,
+                format!("column `efficiency`: {} {NOT_AN_EFFICIENCY}", number(eff)),
+            ));
         }
     }
+    Ok(())
 }
 
-/// A JSON scalar as display text (strings without quotes).
-pub fn value_text(v: &Option<serde_json::Value>) -> String {
-    match v {
-        None | Some(serde_json::Value::Null) => "–".into(),
-        Some(serde_json::Value::String(s)) => s.clone(),
-        Some(serde_json::Value::Number(n)) => match n.as_f64() {
-            Some(x) if n.is_f64() => super::style::fmt_sig(x, 3),
-            _ => n.to_string(),
-        },
-        Some(other) => other.to_string(),
+/// `name`, or `default` when it is empty (a summary without the key).
+pub fn name_or<'a>(name: &'a str, default: &'a str) -> &'a str {
+    if name.is_empty() {
+        default
+    } else {
+        name
     }
 }
 
@@ -411,27 +276,36 @@ pub fn read_json<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T, PlotErr
     })
 }
 
-/// Everything a run report needs.
-pub struct RunData {
-    /// The run's output directory.
-    pub dir: PathBuf,
-    /// Its `timeseries.csv`.
+/// Everything a run report needs: the run's summary and its time series as the plots see it.
+pub struct RunData<'a> {
+    /// The run's `timeseries.csv`, as the figures draw it.
     pub ts: TimeSeries,
     /// Its `summary.json`.
-    pub summary: Summary,
+    pub summary: &'a Summary,
 }
 
-/// Read `timeseries.csv` and `summary.json` of the run output directory `dir`.
-pub fn read_run(dir: &Path) -> Result<RunData, PlotError> {
-    let ts = read_timeseries(&dir.join("timeseries.csv"))?;
-    let path = dir.join("summary.json");
-    let summary: Summary = read_json(&path)?;
-    summary.check().map_err(|what| PlotError::Data { path, what })?;
-    Ok(RunData {
-        dir: dir.to_path_buf(),
-        ts,
-        summary,
-    })
+impl<'a> RunData<'a> {
+    /// The figures' view of a run's results (`dir` names the files in errors): the summary's
+    /// `cycle_efficiency` must be a fraction in [0, 1] (an efficiency is never drawn or written
+    /// over 100 %).
+    pub fn new(dir: &Path, summary: &'a Summary, table: &Timeseries) -> Result<RunData<'a>, PlotError> {
+        let ts = from_table(table, &dir.join("timeseries.csv"))?;
+        if let Some(e) = summary.cycle_efficiency.filter(|e| !is_efficiency(*e)) {
+            return Err(PlotError::Data {
+                path: dir.join("summary.json"),
+                what: format!("cycle_efficiency: {} {NOT_AN_EFFICIENCY}", number(e)),
+            });
+        }
+        Ok(RunData { ts, summary })
+    }
+}
+
+/// Read `summary.json` and `timeseries.csv` of the run output directory `dir` with the writer's
+/// types.
+pub fn read_run(dir: &Path) -> Result<(Summary, Timeseries), PlotError> {
+    let table = Timeseries::read(&dir.join("timeseries.csv"))?;
+    let summary: Summary = read_json(&dir.join("summary.json"))?;
+    Ok((summary, table))
 }
 
 /// One row of `map.csv`.
@@ -461,16 +335,6 @@ pub struct MapRow {
     pub iterations: Option<f64>,
     /// True when the steady solver converged at this point.
     pub converged: bool,
-}
-
-/// `map.json`: what the map was computed for.
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(default)]
-pub struct MapMeta {
-    /// Model name.
-    pub model: Option<String>,
-    /// Gear state of the map.
-    pub gear: Option<serde_json::Value>,
 }
 
 /// A map on its (speed × torque) grid. Cell (i, j) = speed i, torque j; `None` = no point.
@@ -619,39 +483,6 @@ pub fn read_map(dir: &Path) -> Result<MapGrid, PlotError> {
     })
 }
 
-/// One row of `bench.csv`.
-#[derive(Clone, Debug, Deserialize)]
-pub struct BenchRow {
-    /// Solver (method) name.
-    pub solver: String,
-    /// Relative tolerance.
-    pub rtol: Option<f64>,
-    /// Absolute tolerance, K on temperatures.
-    pub atol: Option<f64>,
-    /// Wall time of the integration, s.
-    pub wall_time_s: Option<f64>,
-    /// Accepted steps.
-    pub steps: Option<f64>,
-    /// Rejected steps.
-    pub rejected: Option<f64>,
-    /// Right-hand-side evaluations.
-    pub rhs_evals: Option<f64>,
-    /// Jacobian oil-column evaluations (ROS3: explicit loss-slope differences).
-    pub jac_evals: Option<f64>,
-    /// LU factorisations.
-    pub lu_count: Option<f64>,
-    /// Largest |T − T_ref| over the nodes at the end of the run, K.
-    pub err_final_k: Option<f64>,
-    /// Largest |T − T_ref| over the nodes and the output grid, K.
-    pub err_max_k: Option<f64>,
-    /// RMS of T − T_ref over the nodes and the output grid, K.
-    pub err_rms_k: Option<f64>,
-    /// |lost − stored − to boundaries| over the largest of the three energies.
-    pub energy_balance_relative: Option<f64>,
-    /// True for the default solver and tolerance.
-    pub default: bool,
-}
-
 /// `bench.json`: what the work-precision study was run on.
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(default)]
@@ -662,13 +493,55 @@ pub struct BenchMeta {
     pub cycle: Option<String>,
 }
 
-/// Read `bench.csv` and `bench.json` of the bench output directory `dir`.
+/// Read `bench.csv` (into the writer's [`BenchRow`]: an empty number is NaN, a failed row's
+/// reason is not in the file) and `bench.json` of the bench output directory `dir`.
 pub fn read_bench(dir: &Path) -> Result<(Vec<BenchRow>, BenchMeta), PlotError> {
     let path = dir.join("bench.csv");
     let mut rdr = open_csv(&path)?;
+    let headers = rdr.headers().map_err(|e| csv_err(&path, e))?.clone();
     let mut rows = Vec::new();
-    for r in rdr.deserialize::<BenchRow>() {
-        rows.push(r.map_err(|e| csv_err(&path, e))?);
+    for (k, rec) in rdr.records().enumerate() {
+        let rec = rec.map_err(|e| csv_err(&path, e))?;
+        let bad = |name: &str, field: &str| PlotError::Csv {
+            path: path.clone(),
+            msg: format!("line {}, column `{name}`: `{field}` is not a valid value", k + 2),
+        };
+        let field = |name: &str| -> Result<&str, PlotError> {
+            let i = headers
+                .iter()
+                .position(|h| h == name)
+                .ok_or_else(|| PlotError::Data {
+                    path: path.clone(),
+                    what: format!("missing required column `{name}`"),
+                })?;
+            Ok(rec.get(i).unwrap_or(""))
+        };
+        let num = |name: &str| -> Result<f64, PlotError> {
+            let f = field(name)?;
+            parse_num(f).ok_or_else(|| bad(name, f))
+        };
+        let count = |name: &str| -> Result<usize, PlotError> {
+            let f = field(name)?;
+            f.parse::<usize>().map_err(|_| bad(name, f))
+        };
+        let default = field("default")?;
+        rows.push(BenchRow {
+            solver: field("solver")?.to_string(),
+            rtol: num("rtol")?,
+            atol: num("atol")?,
+            wall_time_s: num("wall_time_s")?,
+            steps: count("steps")?,
+            rejected: count("rejected")?,
+            rhs_evals: count("rhs_evals")?,
+            jac_evals: count("jac_evals")?,
+            lu_count: count("lu_count")?,
+            err_final_k: num("err_final_k")?,
+            err_max_k: num("err_max_k")?,
+            err_rms_k: num("err_rms_k")?,
+            energy_balance_relative: num("energy_balance_relative")?,
+            default: default.parse::<bool>().map_err(|_| bad("default", default))?,
+            failure: None,
+        });
     }
     if rows.is_empty() {
         return Err(PlotError::Data {

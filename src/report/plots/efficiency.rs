@@ -108,8 +108,8 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     let sm = &run.summary;
     let title = format!(
         "Efficiency — {} / {}",
-        sm.model.as_deref().unwrap_or("model"),
-        sm.cycle.as_deref().unwrap_or("cycle")
+        super::data::name_or(&sm.model, "model"),
+        super::data::name_or(&sm.cycle, "cycle")
     );
     let root = style::titled(root, &title)?;
     let (w, h) = root.dim_in_pixel();

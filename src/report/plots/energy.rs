@@ -40,7 +40,7 @@ pub fn item_energies(run: &RunData) -> Vec<(Option<Source>, String, f64)> {
         return sm
             .energy_by_item_j
             .iter()
-            .map(|e| (Source::parse(&e.source), e.name.clone(), e.j.unwrap_or(f64::NAN)))
+            .map(|e| (Some(e.source), e.name.clone(), e.j))
             .collect();
     }
     let order = run.ts.time_order();
@@ -57,17 +57,18 @@ pub fn item_energies(run: &RunData) -> Vec<(Option<Source>, String, f64)> {
         .collect()
 }
 
+/// The summary's energy per source, when it has one (`energy_lost_j` with its `total`; a
+/// summary without the key reads as none).
+pub fn summary_energies<'a>(run: &'a RunData) -> Option<&'a crate::report::sources::SourceValues> {
+    Some(&run.summary.energy_lost_j).filter(|e| e.total)
+}
+
 /// Energy per source, J (summary first, else integrated source columns).
 pub fn source_energies(run: &RunData) -> PerSource {
     let order = run.ts.time_order();
     let mut out = [0.0; N_SOURCES];
     for s in Source::ALL {
-        let from_summary = run
-            .summary
-            .energy_lost_j
-            .as_ref()
-            .and_then(|e| e.get(s))
-            .filter(|v| v.is_finite());
+        let from_summary = summary_energies(run).map(|e| e.get(s)).filter(|v| v.is_finite());
         out[s.index()] =
             from_summary.unwrap_or_else(|| trapezoid(&order, &run.ts.time_s, &run.ts.source_w[s.index()]));
     }
@@ -79,8 +80,8 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     let sm = &run.summary;
     let title = format!(
         "Energy lost over the cycle — {} / {}",
-        sm.model.as_deref().unwrap_or("model"),
-        sm.cycle.as_deref().unwrap_or("cycle")
+        super::data::name_or(&sm.model, "model"),
+        super::data::name_or(&sm.cycle, "cycle")
     );
     let root = style::titled(root, &title)?;
     let (w, _) = root.dim_in_pixel();
@@ -103,7 +104,7 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
         ));
     }
     style::draw_legend_column(&legend_area, Some("Bar colour = loss source"), &entries, 20)?;
-    if let Some(b) = sm.energy_balance_relative.filter(|b| b.is_finite()) {
+    if let Some(b) = Some(sm.energy_balance_relative).filter(|b| b.is_finite()) {
         let (_, lh) = legend_area.dim_in_pixel();
         legend_area.draw(&Text::new(
             format!("energy balance residual: {:.2e} (relative)", b),
@@ -221,11 +222,8 @@ fn draw_items(area: &Canvas, items: &[(Option<Source>, String, f64)]) -> DrawRes
 /// Right panel: one bar per source and the total (kJ), the three largest shares in %.
 fn draw_sources(area: &Canvas, run: &RunData) -> DrawResult {
     let src_kj: Vec<f64> = source_energies(run).iter().map(|j| j / 1e3).collect();
-    let total_kj: f64 = run
-        .summary
-        .energy_lost_j
-        .as_ref()
-        .and_then(|e| e.total())
+    let total_kj: f64 = summary_energies(run)
+        .map(|e| e.sum())
         .filter(|v| v.is_finite())
         .map(|j| j / 1e3)
         .unwrap_or_else(|| src_kj.iter().sum());

@@ -245,8 +245,8 @@ impl Field {
 
 /// Draw the heatmap of `q` over the map's speed × torque grid.
 pub fn draw(root: &Canvas, grid: &MapGrid, q: Quantity) -> DrawResult {
-    let model = grid.meta.model.as_deref().unwrap_or("model");
-    let gear = super::data::value_text(&grid.meta.gear);
+    let model = super::data::name_or(&grid.meta.model, "model");
+    let gear = super::data::name_or(&grid.meta.gear, "–");
     let title = format!("{} — {model}, gear {gear}", q.title());
     let root = style::titled(root, &title)?;
     let (w, _) = root.dim_in_pixel();

@@ -2,7 +2,7 @@
 
 use std::fmt::Write;
 
-use super::data::{value_text, RunData};
+use super::data::{name_or, RunData};
 use super::energy::source_energies;
 use super::style::{fmt_fixed, fmt_share, fmt_sig, Source};
 
@@ -19,26 +19,30 @@ fn opt(v: Option<f64>, f: impl Fn(f64) -> String) -> String {
 pub fn markdown(run: &RunData) -> String {
     let sm = &run.summary;
     let ts = &run.ts;
-    let model = sm.model.as_deref().unwrap_or("(unnamed model)");
-    let cycle = sm.cycle.as_deref().unwrap_or("(unnamed cycle)");
+    let model = name_or(&sm.model, "(unnamed model)");
+    let cycle = name_or(&sm.cycle, "(unnamed cycle)");
     let mut s = String::new();
     let _ = writeln!(s, "# geartherm run report: {} — {}\n", cell(model), cell(cycle));
     let _ = writeln!(s, "| Quantity | Value |\n|---|---|");
     let _ = writeln!(s, "| Model | {} |", cell(model));
     let _ = writeln!(s, "| Cycle | {} |", cell(cycle));
-    let _ = writeln!(s, "| Solver | {} |", cell(&value_text(&sm.solver)));
+    let _ = writeln!(s, "| Solver | {} |", cell(name_or(&sm.solver, "–")));
     let _ = writeln!(
         s,
         "| rtol / atol | {} / {} |",
-        cell(&value_text(&sm.rtol)),
-        cell(&value_text(&sm.atol))
+        cell(&fmt_sig(sm.rtol, 3)),
+        cell(&fmt_sig(sm.atol, 3))
     );
     let _ = writeln!(
         s,
         "| Wall time | {} |",
-        opt(sm.wall_time_s, |t| format!("{} s", fmt_sig(t, 3)))
+        opt(Some(sm.wall_time_s), |t| format!("{} s", fmt_sig(t, 3)))
     );
-    let _ = writeln!(s, "| Steps | {} |", opt(sm.steps, |n| fmt_fixed(n, 0)));
+    let _ = writeln!(
+        s,
+        "| Steps | {} |",
+        opt(Some(sm.steps as f64), |n| fmt_fixed(n, 0))
+    );
     let t0 = ts.time_order().first().map(|&i| ts.time_s[i]);
     let t1 = ts.time_order().last().map(|&i| ts.time_s[i]);
     if let (Some(a), Some(b)) = (t0, t1) {
@@ -52,22 +56,20 @@ pub fn markdown(run: &RunData) -> String {
     let _ = writeln!(
         s,
         "| Energy balance residual (relative) | {} |",
-        opt(sm.energy_balance_relative, |b| format!("{b:.2e}"))
+        opt(Some(sm.energy_balance_relative), |b| format!("{b:.2e}"))
     );
     let _ = writeln!(
         s,
         "| Cycle efficiency (energy-weighted, ∫P_out/∫P_in) | {} |",
         opt(sm.cycle_efficiency, |m| format!("{:.2} %", 100.0 * m))
     );
-    if let Some(oil) = &sm.oil_node {
-        let _ = writeln!(s, "| Oil node | {} |", cell(oil));
+    if !sm.oil_node.is_empty() {
+        let _ = writeln!(s, "| Oil node | {} |", cell(&sm.oil_node));
     }
 
     let src = source_energies(run);
-    let total = sm
-        .energy_lost_j
-        .as_ref()
-        .and_then(|e| e.total())
+    let total = super::energy::summary_energies(run)
+        .map(|e| e.sum())
         .filter(|v| v.is_finite())
         .unwrap_or_else(|| src.iter().sum());
     let _ = writeln!(
@@ -104,12 +106,12 @@ pub fn markdown(run: &RunData) -> String {
         let from_ts = series.map(finite).unwrap_or_default();
         let st = sm.temperatures_c.get(n);
         let min = st
-            .and_then(|t| t.min)
+            .map(|t| t.min)
             .or_else(|| from_ts.iter().copied().reduce(f64::min));
         let max = st
-            .and_then(|t| t.max)
+            .map(|t| t.max)
             .or_else(|| from_ts.iter().copied().reduce(f64::max));
-        let last = st.and_then(|t| t.last).or_else(|| {
+        let last = st.map(|t| t.r#final).or_else(|| {
             let order = ts.time_order();
             series.and_then(|v| order.iter().rev().map(|&i| v[i]).find(|x| x.is_finite()))
         });

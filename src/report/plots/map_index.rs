@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use super::data::{value_text, MapGrid};
+use super::data::{name_or, MapGrid};
 use super::style::fmt_fixed;
 
 fn range(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
@@ -30,8 +30,8 @@ pub fn markdown(grid: &MapGrid) -> String {
     let _ = writeln!(
         s,
         "# Operating map — {} / gear {}\n",
-        grid.meta.model.as_deref().unwrap_or("model"),
-        value_text(&grid.meta.gear)
+        name_or(&grid.meta.model, "model"),
+        name_or(&grid.meta.gear, "–")
     );
     let _ = writeln!(s, "| | |\n|---|---|");
     let axis = |v: &[f64]| match (v.first(), v.last()) {

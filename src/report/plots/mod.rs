@@ -1,7 +1,9 @@
 //! PNG reports (plotters, bitmap backend, embedded DejaVu Sans font).
 //!
 //! - [`render_run`]: `temperatures.png`, `losses.png`, `energy.png`, `efficiency.png` and
-//!   `report.md` from a run directory (`timeseries.csv`, `summary.json`).
+//!   `report.md` from a run's results in memory (its [`Summary`] and [`Timeseries`]);
+//!   [`render_run_dir`] reads them from a run directory (`summary.json`, `timeseries.csv`) with
+//!   the same types.
 //! - [`render_map`]: `map_efficiency.png`, `map_total_loss.png`, `map_oil_temp.png` and
 //!   `report.md` from a map directory (`map.csv`, `map.json`).
 //! - [`render_bench`]: `work_precision.png` from a bench directory (`bench.csv`, `bench.json`).
@@ -18,12 +20,14 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use tempfile::NamedTempFile;
 
-use crate::report::files::user_path;
+use crate::report::run::Summary;
+use crate::report::timeseries::Timeseries;
 
 pub mod calibration;
 pub mod data;
 pub mod efficiency;
 pub mod energy;
+pub mod error;
 pub mod heatmap;
 pub mod index;
 pub mod losses;
@@ -40,57 +44,7 @@ pub mod work_precision;
 #[cfg(test)]
 mod tests;
 
-/// Errors of the plot reports. Every variant names the file concerned, as the user knows it
-/// (a file in a transaction's temporary directory by its place in the target:
-/// [`user_path`]).
-#[derive(Debug, thiserror::Error)]
-pub enum PlotError {
-    /// A file could not be read or written.
-    #[error("{}: {source}", user_path(path).display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The I/O error.
-        #[source]
-        source: std::io::Error,
-    },
-    /// A CSV file is malformed (field count, a value that is not a finite number).
-    #[error("{}: malformed CSV: {msg}", user_path(path).display())]
-    Csv {
-        /// The file.
-        path: PathBuf,
-        /// What is wrong, with line and column where known.
-        msg: String,
-    },
-    /// A JSON file does not parse.
-    #[error("{}: malformed JSON: {source}", user_path(path).display())]
-    Json {
-        /// The file.
-        path: PathBuf,
-        /// The parser's error.
-        #[source]
-        source: serde_json::Error,
-    },
-    /// A file parses but lacks what the figure needs (a required column, any data rows).
-    #[error("{}: {what}", user_path(path).display())]
-    Data {
-        /// The file.
-        path: PathBuf,
-        /// What is missing.
-        what: String,
-    },
-    /// Rendering a figure failed.
-    #[error("{}: drawing failed: {msg}", user_path(path).display())]
-    Draw {
-        /// The figure's file.
-        path: PathBuf,
-        /// The drawing backend's error.
-        msg: String,
-    },
-    /// The embedded font could not be registered.
-    #[error("the embedded DejaVu Sans font could not be loaded")]
-    Font,
-}
+pub use error::PlotError;
 
 /// The bitmap drawing area every figure draws on.
 pub(crate) type Canvas<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
@@ -192,12 +146,12 @@ fn check_dir(dir: &Path) -> Result<(), PlotError> {
     }
 }
 
-/// Render the run report into `dir` (which holds `timeseries.csv` and `summary.json`).
-/// Returns the paths written: the four PNGs and `report.md`.
-pub fn render_run(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+/// Render the run report of `summary` and `table` (the run's results) into `dir`. Returns the
+/// paths written: the four PNGs and `report.md`.
+pub fn render_run(dir: &Path, summary: &Summary, table: &Timeseries) -> Result<Vec<PathBuf>, PlotError> {
     check_dir(dir)?;
     style::ensure_fonts()?;
-    let run = data::read_run(dir)?;
+    let run = data::RunData::new(dir, summary, table)?;
     let run = &run;
     let jobs: Vec<Box<dyn FnOnce() -> Result<Staged, PlotError> + Send + '_>> = vec![
         Box::new(move || stage_png(dir, "temperatures.png", |root| temperatures::draw(root, run))),
@@ -207,6 +161,14 @@ pub fn render_run(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
         Box::new(move || stage_text(dir, "report.md", &index::markdown(run))),
     ];
     commit(stage_parallel(jobs)?)
+}
+
+/// Read the run directory `dir` (`summary.json`, `timeseries.csv`, with the writer's types) and
+/// render its report into it ([`render_run`]).
+pub fn render_run_dir(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+    check_dir(dir)?;
+    let (summary, table) = data::read_run(dir)?;
+    render_run(dir, &summary, &table)
 }
 
 /// Render the three heat maps into `dir` (which holds `map.csv` and `map.json`).

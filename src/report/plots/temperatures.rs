@@ -43,8 +43,8 @@ pub fn draw(root: &Canvas, run: &RunData) -> DrawResult {
     let sm = &run.summary;
     let title = format!(
         "Temperatures — {} / {}",
-        sm.model.as_deref().unwrap_or("model"),
-        sm.cycle.as_deref().unwrap_or("cycle")
+        super::data::name_or(&sm.model, "model"),
+        super::data::name_or(&sm.cycle, "cycle")
     );
     let root = style::titled(root, &title)?;
     let (w, h) = root.dim_in_pixel();
@@ -78,7 +78,7 @@ fn draw_temperatures(area: &Canvas, legend: &Canvas, run: &RunData, line: Timeli
     let (ts, sm) = (&run.ts, &run.summary);
     let (order, time, buckets) = line;
     let (x0, x1) = (time.x0, time.x1);
-    let oil = sm.oil_node.as_deref();
+    let oil = (!sm.oil_node.is_empty()).then_some(sm.oil_node.as_str());
     let any_node = ts.temps_c.iter().any(|(n, _)| !sm.is_boundary(n));
     let any_boundary = ts.temps_c.iter().any(|(n, _)| sm.is_boundary(n));
     let range_of = |boundary: bool| {

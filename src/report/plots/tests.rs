@@ -194,7 +194,7 @@ fn write_run(dir: &Path, spec: &RunSpec) {
 }
 
 fn check_run(dir: &Path) {
-    let paths = render_run(dir).unwrap_or_else(|e| panic!("render_run: {e}"));
+    let paths = render_run_dir(dir).unwrap_or_else(|e| panic!("render_run: {e}"));
     assert_eq!(paths.len(), 5);
     for name in ["temperatures.png", "losses.png", "energy.png", "efficiency.png"] {
         let p = dir.join(name);
@@ -303,7 +303,7 @@ fn malformed_csv_names_the_file_and_writes_nothing() {
     let mut text = fs::read_to_string(&path).unwrap();
     text.push_str("1000,abc,3\n");
     fs::write(&path, &text).unwrap();
-    let err = render_run(dir.path()).unwrap_err();
+    let err = render_run_dir(dir.path()).unwrap_err();
     assert!(err.to_string().contains("timeseries.csv"), "{err}");
     assert!(matches!(err, PlotError::Csv { .. }), "{err:?}");
     assert_eq!(
@@ -321,7 +321,7 @@ fn malformed_csv_names_the_file_and_writes_nothing() {
     bad.push_str(&last);
     bad.push('\n');
     fs::write(&path, bad).unwrap();
-    let err = render_run(dir.path()).unwrap_err();
+    let err = render_run_dir(dir.path()).unwrap_err();
     let msg = err.to_string();
     assert!(
         msg.contains("timeseries.csv") && msg.contains("vehicle_speed_kmh"),
@@ -330,7 +330,7 @@ fn malformed_csv_names_the_file_and_writes_nothing() {
 
     // Missing required column.
     fs::write(&path, "time_s,gear\n0,1\n").unwrap();
-    let err = render_run(dir.path()).unwrap_err();
+    let err = render_run_dir(dir.path()).unwrap_err();
     assert!(err.to_string().contains("timeseries.csv"), "{err}");
 
     // Malformed JSON.
@@ -342,7 +342,7 @@ fn malformed_csv_names_the_file_and_writes_nothing() {
         },
     );
     fs::write(dir.path().join("summary.json"), "{\"model\": ").unwrap();
-    let err = render_run(dir.path()).unwrap_err();
+    let err = render_run_dir(dir.path()).unwrap_err();
     assert!(err.to_string().contains("summary.json"), "{err}");
     assert_no_temp_files(dir.path());
 }
@@ -354,7 +354,7 @@ fn write_map(dir: &Path, nx: usize, ny: usize, shuffle: bool) {
             let n = 500.0 + 5500.0 * i as f64 / (nx.max(2) - 1) as f64;
             let t = 20.0 * j as f64 / (ny.max(2) - 1) as f64 * 10.0;
             let loss = 20.0 + 0.01 * n + 0.002 * n * t.sqrt();
-            let p_in = n * std::f64::consts::PI / 30.0 * t;
+            let p_in = crate::physics::units::rpm_to_rad_s(n) * t;
             let eff = if p_in > 0.0 {
                 format!("{}", (p_in - loss).max(0.0) / p_in)
             } else {
@@ -552,7 +552,7 @@ fn write_samples() {
         let d = out.join(name);
         fs::create_dir_all(&d).unwrap();
         write_run(&d, &spec);
-        render_run(&d).unwrap();
+        render_run_dir(&d).unwrap();
     }
     let extra = [
         (
@@ -577,7 +577,7 @@ fn write_samples() {
         let d = out.join(name);
         fs::create_dir_all(&d).unwrap();
         write_run(&d, &spec);
-        render_run(&d).unwrap();
+        render_run_dir(&d).unwrap();
     }
     for (name, nx, ny) in [("map", 30, 25), ("map_small", 6, 5)] {
         let d = out.join(name);

@@ -12,6 +12,11 @@ use super::style::{self, LegendEntry, Marker, Swatch};
 use super::{Canvas, DrawResult};
 
 /// Log-axis tick label: 1e-3 style outside [0.01, 1000), plain otherwise.
+/// A value a bench row holds, None where it has none (NaN: an empty field, a failed run).
+fn fin(v: f64) -> Option<f64> {
+    v.is_finite().then_some(v)
+}
+
 fn log_label(v: f64) -> String {
     if !(v.is_finite() && v > 0.0) {
         return String::new();
@@ -81,7 +86,7 @@ fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 
 /// True for a row with a positive finite error and wall time (drawn on the log–log axes).
 fn drawable(r: &BenchRow) -> bool {
-    matches!((r.err_max_k, r.wall_time_s), (Some(e), Some(t)) if e.is_finite() && e > 0.0 && t.is_finite() && t > 0.0)
+    matches!((fin(r.err_max_k), fin(r.wall_time_s)), (Some(e), Some(t)) if e.is_finite() && e > 0.0 && t.is_finite() && t > 0.0)
 }
 
 /// A log axis with its own tick values.
@@ -117,8 +122,16 @@ pub fn draw(root: &Canvas, rows: &[BenchRow], meta: &BenchMeta) -> DrawResult {
     let (w, _) = root.dim_in_pixel();
     let (main, legend) = root.split_horizontally(w - 320);
     let hidden = rows.iter().filter(|r| !drawable(r)).count();
-    let (ex0, ex1) = log_range(rows.iter().filter(|r| drawable(r)).filter_map(|r| r.err_max_k));
-    let (ty0, ty1) = log_range(rows.iter().filter(|r| drawable(r)).filter_map(|r| r.wall_time_s));
+    let (ex0, ex1) = log_range(
+        rows.iter()
+            .filter(|r| drawable(r))
+            .filter_map(|r| fin(r.err_max_k)),
+    );
+    let (ty0, ty1) = log_range(
+        rows.iter()
+            .filter(|r| drawable(r))
+            .filter_map(|r| fin(r.wall_time_s)),
+    );
     let mut chart = ChartBuilder::on(&main)
         .margin_left(20)
         .margin_right(30)
@@ -186,10 +199,10 @@ fn draw_solvers(
             .iter()
             .filter(|r| r.solver == *solver && drawable(r))
             .collect();
-        pts.sort_by(|a, b| b.rtol.unwrap_or(f64::NAN).total_cmp(&a.rtol.unwrap_or(f64::NAN)));
+        pts.sort_by(|a, b| b.rtol.total_cmp(&a.rtol));
         let xy: Vec<(f64, f64)> = pts
             .iter()
-            .filter_map(|r| Some((r.err_max_k?, r.wall_time_s?)))
+            .filter_map(|r| Some((fin(r.err_max_k)?, fin(r.wall_time_s)?)))
             .collect();
         chart.draw_series(LineSeries::new(xy.clone(), colour.stroke_width(3)))?;
         for (j, (r, p)) in pts.iter().zip(&xy).enumerate() {
@@ -198,7 +211,7 @@ fn draw_solvers(
             placed.boxes.push((px - 12, py - 12, px + 12, py + 12));
             // Sparse labels: every other point, plus the last one.
             let wanted = j % 2 == 0 || j + 1 == xy.len();
-            if let Some(rt) = r.rtol.filter(|_| wanted) {
+            if let Some(rt) = fin(r.rtol).filter(|_| wanted) {
                 placed.pending.push(((px, py), format!("rtol {}", log_label(rt))));
             }
         }
@@ -209,7 +222,7 @@ fn draw_solvers(
 
 /// The default setting `r`: ringed and annotated (right of the point, or left near the edge).
 fn draw_default(chart: &LogChart, r: &BenchRow, colour: RGBColor, placed: &mut Placement) -> DrawResult {
-    let (Some(e), Some(t)) = (r.err_max_k, r.wall_time_s) else {
+    let (Some(e), Some(t)) = (fin(r.err_max_k), fin(r.wall_time_s)) else {
         return Ok(());
     };
     let plot = chart.plotting_area().strip_coord_spec();
@@ -219,7 +232,7 @@ fn draw_default(chart: &LogChart, r: &BenchRow, colour: RGBColor, placed: &mut P
     let label = format!(
         "default: {}, rtol {}",
         r.solver,
-        r.rtol.map(log_label).unwrap_or_default()
+        fin(r.rtol).map(log_label).unwrap_or_default()
     );
     let (pw, _) = plot.dim_in_pixel();
     let right = px - ox < pw as i32 - 420;

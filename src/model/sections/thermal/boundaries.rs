@@ -1,11 +1,11 @@
 //! `[[thermal.boundaries]]`: nodes with a given temperature, fixed or a time series; one of them
 //! is the ambient air.
 
+use crate::physics::units::c_to_k;
 use serde::{Deserialize, Serialize};
 
 use super::common::temp_ok;
 use crate::model::problems::Problems;
-use crate::physics::oil::KELVIN_OFFSET;
 
 /// `[[thermal.boundaries]]` as written: a boundary node, fixed temperature or a time series.
 #[derive(Debug, Clone, Deserialize, Serialize)]
@@ -101,7 +101,7 @@ pub(crate) fn check_boundaries(specs: &[BoundarySpec], problems: &mut Problems) 
         let temp = match (&b.temp_c, &b.series) {
             (Some(t), None) => {
                 temp_ok(problems, &format!("{p}.temp_c"), *t);
-                BoundaryTemp::Fixed(t + KELVIN_OFFSET)
+                BoundaryTemp::Fixed(c_to_k(*t))
             }
             (None, Some(s)) if !s.is_empty() => match series(s, &p, problems) {
                 Some(s) => s,
@@ -147,5 +147,5 @@ fn series(s: &[[f64; 2]], p: &str, problems: &mut Problems) -> Option<BoundaryTe
             ok = false;
         }
     }
-    ok.then(|| BoundaryTemp::Series(s.iter().map(|pt| (pt[0], pt[1] + KELVIN_OFFSET)).collect()))
+    ok.then(|| BoundaryTemp::Series(s.iter().map(|pt| (pt[0], c_to_k(pt[1]))).collect()))
 }

@@ -1,11 +1,11 @@
 //! `[[thermal.coolers]]`: heat exchangers `Q = ε·C_min·x(T_hot)·(T_hot − T_cold)` with an optional
 //! thermostat on the hot side.
 
+use crate::physics::units::c_to_k;
 use serde::{Deserialize, Serialize};
 
 use super::common::{temp_ok, NodeNames, NodeRef};
 use crate::model::problems::Problems;
-use crate::physics::oil::KELVIN_OFFSET;
 
 /// Thermostat: closed below `open_c`, fully open above `full_c`, smooth in between.
 #[derive(Debug, Clone, Deserialize, Serialize)]
@@ -113,5 +113,5 @@ fn thermostat(t: &ThermostatSpec, p: &str, problems: &mut Problems) -> (f64, f64
     if ok && t.full_c <= t.open_c {
         problems.push(format!("{p}.thermostat.full_c"), t.full_c, "must be above open_c");
     }
-    (t.open_c + KELVIN_OFFSET, t.full_c + KELVIN_OFFSET)
+    (c_to_k(t.open_c), c_to_k(t.full_c))
 }

@@ -8,6 +8,7 @@
 //! non-positive capacities, heat fractions that do not sum to 1, links with no or two laws,
 //! nodes with no path to a boundary.
 
+use crate::physics::units::c_to_k;
 use serde::{Deserialize, Serialize};
 
 pub mod boundaries;
@@ -31,7 +32,6 @@ pub use nodes::{NodeSpec, ThermalNode};
 pub use wall_mesh::WallMeshSpec;
 
 use crate::model::problems::Problems;
-use crate::physics::oil::KELVIN_OFFSET;
 use common::{temp_ok, NodeNames};
 
 /// `[thermal]` as written.
@@ -105,7 +105,7 @@ pub fn validate_thermal(
         controls,
         heat,
         oil_node: oil_node?,
-        initial_temp: initial + KELVIN_OFFSET,
+        initial_temp: c_to_k(initial),
         groups: Vec::new(),
     };
     Some(match &spec.wall_mesh {

@@ -1,13 +1,13 @@
 //! `[[thermal.nodes]]`: nodes with heat capacity, their initial temperatures and the gear bodies
 //! they lump.
 
+use crate::physics::units::c_to_k;
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
 use super::common::{temp_ok, GearInfo};
 use crate::model::problems::Problems;
-use crate::physics::oil::KELVIN_OFFSET;
 
 /// `[[thermal.nodes]]` as written: a node with heat capacity, `capacity_j_per_k`, or `mass_kg` × `cp_j_per_kgk`.
 #[derive(Debug, Clone, Deserialize, Serialize)]
@@ -86,7 +86,7 @@ pub(crate) fn check_nodes(
         nodes.push(ThermalNode {
             name: n.name.clone(),
             capacity,
-            initial_temp: n.initial_temp_c.map(|t| t + KELVIN_OFFSET),
+            initial_temp: n.initial_temp_c.map(c_to_k),
             specific_heat: n.cp_j_per_kgk,
             gears: gi,
         });

@@ -1,0 +1,266 @@
+//! One schema per output file: the directories the commands write are read back by `report DIR`
+//! and `read_run` with the writers' types, and so are directories written by earlier versions
+//! (tests/fixtures/README.md).
+//!
+//! - run: `summary.json` read as `report::run::Summary` and written again gives the same JSON
+//!   value; `timeseries.csv` read as `report::timeseries::Timeseries` and written again gives
+//!   the same bytes; `report DIR` draws the same PNGs and `report.md` as `run --report` drew from
+//!   the results in memory.
+//! - map: `map.json` read as `report::map::MapMeta` gives the same JSON value; `report DIR` draws the
+//!   same heat maps and `report.md` as `map` did.
+//! - bench: `bench.csv` read into `solve::work_precision::BenchRow`s; `report DIR` draws the same
+//!   `work_precision.png` as `bench` did.
+//! - rating, study, calibrate and validate directories hold none of these files: `report`
+//!   refuses them (exit 1) and writes nothing.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use geartherm::report::map::MapMeta;
+use geartherm::report::plots::data::{read_bench, read_json, read_run};
+use geartherm::report::run::Summary;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn bin(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_geartherm"))
+        .current_dir(root())
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn ok(args: &[&str]) {
+    let o = bin(args);
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_slice(&fs::read(path).unwrap()).unwrap()
+}
+
+/// A copy of `files` of `from` in a new directory `to` (the inputs of `report`, without the
+/// figures).
+fn inputs(from: &Path, to: &Path, files: &[&str]) {
+    fs::create_dir_all(to).unwrap();
+    for f in files {
+        fs::copy(from.join(f), to.join(f)).unwrap();
+    }
+}
+
+/// `report DIR` on a copy of the inputs of `dir`: the figures and `report.md` it writes are the
+/// bytes of those in `dir`.
+fn report_redraws(dir: &Path, copy: &Path, files: &[&str], drawn: &[&str]) {
+    inputs(dir, copy, files);
+    ok(&["report", copy.to_str().unwrap()]);
+    for f in drawn {
+        assert!(
+            fs::read(dir.join(f)).unwrap() == fs::read(copy.join(f)).unwrap(),
+            "{f}: report DIR drew other bytes than the command that wrote {}",
+            dir.display()
+        );
+    }
+}
+
+/// Read a run directory with the writer's types; the summary written again is the same JSON
+/// value and the time series the same bytes.
+fn run_reads_back(dir: &Path) -> Summary {
+    let (summary, table) = read_run(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+    assert_eq!(
+        serde_json::to_value(&summary).unwrap(),
+        json(&dir.join("summary.json")),
+        "{}",
+        dir.display()
+    );
+    assert_eq!(
+        table.to_csv(),
+        fs::read_to_string(dir.join("timeseries.csv")).unwrap(),
+        "{}",
+        dir.display()
+    );
+    summary
+}
+
+const RUN_FILES: [&str; 2] = ["summary.json", "timeseries.csv"];
+const RUN_DRAWN: [&str; 5] = [
+    "temperatures.png",
+    "losses.png",
+    "energy.png",
+    "efficiency.png",
+    "report.md",
+];
+
+#[test]
+fn run_directories_read_back_with_the_writers_types() {
+    let d = tempfile::tempdir().unwrap();
+    for (model, cycle) in [
+        ("models/at6_lepelletier.toml", "hwfet"),
+        ("models/fzg_c.toml", "tests/data/rig_short.csv"),
+    ] {
+        let dir = d.path().join(Path::new(model).file_stem().unwrap());
+        let s = dir.to_str().unwrap();
+        ok(&["run", model, "--cycle", cycle, "--out", s, "--report", "--quiet"]);
+        let summary = run_reads_back(&dir);
+        assert!(summary.stats.steps > 0 && !summary.stats.method.is_empty());
+        report_redraws(
+            &dir,
+            &d.path().join(format!("{}_again", summary.cycle)),
+            &RUN_FILES,
+            &RUN_DRAWN,
+        );
+    }
+}
+
+#[test]
+fn map_and_bench_directories_read_back_with_the_writers_types() {
+    let d = tempfile::tempdir().unwrap();
+    let map = d.path().join("map");
+    let m = map.to_str().unwrap();
+    ok(&[
+        "map",
+        "models/fzg_c.toml",
+        "--gear",
+        "1",
+        "--speed-rpm",
+        "500:1500:3",
+        "--torque-nm",
+        "0:100:3",
+        "--out",
+        m,
+        "--quiet",
+    ]);
+    let meta: MapMeta = read_json(&map.join("map.json")).unwrap();
+    assert_eq!(serde_json::to_value(&meta).unwrap(), json(&map.join("map.json")));
+    assert_eq!(meta.points, 9);
+    report_redraws(
+        &map,
+        &d.path().join("map_again"),
+        &["map.csv", "map.json"],
+        &[
+            "map_efficiency.png",
+            "map_total_loss.png",
+            "map_oil_temp.png",
+            "report.md",
+        ],
+    );
+
+    let bench = d.path().join("bench");
+    let b = bench.to_str().unwrap();
+    ok(&[
+        "bench",
+        "models/fzg_c.toml",
+        "--cycle",
+        "tests/data/rig_short.csv",
+        "--repeats",
+        "1",
+        "--min-rtol",
+        "1e-4",
+        "--solvers",
+        "ros3,bdf",
+        "--out",
+        b,
+    ]);
+    let (rows, _) = read_bench(&bench).unwrap();
+    let lines = fs::read_to_string(bench.join("bench.csv"))
+        .unwrap()
+        .lines()
+        .count();
+    assert_eq!(rows.len(), lines - 1);
+    assert!(rows.iter().any(|r| r.solver == "ros3") && rows.iter().any(|r| r.default));
+    report_redraws(
+        &bench,
+        &d.path().join("bench_again"),
+        &["bench.csv", "bench.json"],
+        &["work_precision.png"],
+    );
+}
+
+#[test]
+fn directories_report_does_not_draw_are_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let rating = d.path().join("rating");
+    let r = rating.to_str().unwrap();
+    ok(&[
+        "rating",
+        "models/fzg_c.toml",
+        "--gear",
+        "1",
+        "--speed-rpm",
+        "1500",
+        "--oil-limit-c",
+        "90",
+        "--out",
+        r,
+        "--quiet",
+    ]);
+    let before = fs::read_dir(&rating).unwrap().count();
+    let o = bin(&["report", r]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("holds no timeseries.csv, map.csv or bench.csv"));
+    assert_eq!(fs::read_dir(&rating).unwrap().count(), before);
+}
+
+#[test]
+fn a_run_directory_of_the_previous_binary_reads_back() {
+    let fixture = root().join("tests/fixtures/run_main_9d79de0");
+    let summary = run_reads_back(&fixture);
+    assert_eq!(summary.model, "FZG C-type test gearbox");
+    let d = tempfile::tempdir().unwrap();
+    inputs(&fixture, d.path(), &RUN_FILES);
+    ok(&["report", d.path().to_str().unwrap()]);
+    for f in RUN_DRAWN {
+        assert!(d.path().join(f).is_file(), "{f}");
+    }
+}
+
+#[test]
+fn a_run_directory_of_an_earlier_format_reads_with_todays_names() {
+    let fixture = root().join("tests/fixtures/run_d379aa5");
+    let file = json(&fixture.join("summary.json"));
+    let (summary, table) = read_run(&fixture).unwrap();
+    // Renamed key: mean_efficiency is read as cycle_efficiency.
+    assert_eq!(summary.cycle_efficiency, file["mean_efficiency"].as_f64());
+    assert!(summary.cycle_efficiency.is_some());
+    // Keys the version did not write read as their defaults.
+    assert!(summary.warnings.is_empty() && summary.controls.is_empty() && summary.launch.is_none());
+    assert_eq!(summary.energy_efficiency, None);
+    assert_eq!(summary.stats.method, "");
+    assert_eq!(
+        summary.stats.steps as u64,
+        file["stats"]["steps"].as_u64().unwrap()
+    );
+    // Keys it wrote keep their values.
+    let e = &file["energy_lost_j"];
+    assert_eq!(Some(summary.energy_lost_j.sum()), e["total"].as_f64());
+    assert_eq!(
+        summary.temperatures_c["sump"].max,
+        file["temperatures_c"]["sump"]["max"].as_f64().unwrap()
+    );
+    assert_eq!(summary.oil_node, "sump");
+    // Its per-source columns under their earlier names.
+    assert!(table.num("churning_w").is_some() && table.num("total_loss_w").is_some());
+    assert_eq!(
+        table.to_csv(),
+        fs::read_to_string(fixture.join("timeseries.csv")).unwrap()
+    );
+    let d = tempfile::tempdir().unwrap();
+    inputs(&fixture, d.path(), &RUN_FILES);
+    ok(&["report", d.path().to_str().unwrap()]);
+    let md = fs::read_to_string(d.path().join("report.md")).unwrap();
+    let pct = format!("{:.2} %", 100.0 * file["mean_efficiency"].as_f64().unwrap());
+    assert!(md.contains(&pct), "{pct} not in report.md:\n{md}");
+    assert!(
+        md.contains(&format!(
+            "| churning | {} |",
+            geartherm::report::plots::style::fmt_sig(e["churning"].as_f64().unwrap() / 1e3, 4)
+        )),
+        "{md}"
+    );
+}
