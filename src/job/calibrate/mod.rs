@@ -516,9 +516,10 @@ pub fn fit(m: &Model, p: &Prepared<'_>, o: &CalibrateOptions) -> Result<Calibrat
     assemble(m, p, o, &fitted, clock)
 }
 
-/// Channels' noise scales that differ: a fit of several channels weights each by its own.
+/// Channels' noise scales that differ (each finite and above zero): a fit of several channels
+/// weights each by its own. A channel the fit matches exactly (scale 0) leaves the fit unweighted.
 fn unequal(weights: &[f64]) -> bool {
-    weights.iter().any(|&w| w != weights[0])
+    weights.iter().all(|&w| w.is_finite() && w > 0.0) && weights.iter().any(|&w| w != weights[0])
 }
 
 /// The MAP fit from the least-squares fit `ols`: the data rows divided by their channel's
