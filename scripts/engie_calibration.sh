@@ -1,6 +1,7 @@
 #!/usr/bin/env sh
 # The La Haute Borne calibration of docs/validation.md ("Wind-turbine gearbox"): calibrate
-# models/mm82_wind_gearbox.toml on turbine R80711 (spring 2017: the first 14 days fitted, the
+# validation/engie_la_haute_borne/mm82_sump_only.toml (the MM82 model with one oil node, no
+# bearings) on turbine R80711 (spring 2017: the first 14 days fitted, the
 # rest held out), then predict R80711 in summer 2016 and R80721 in both periods with the
 # calibrated model and the band of its calibration (--band-from); once by least squares (with
 # the profile likelihood of the churning level), once with priors on the loss levels; print the
@@ -23,7 +24,7 @@ mkdir -p "$out"
 python3 scripts/engie_traces.py "$extract" "$out/traces"
 fit() {
     dir=$1; shift
-    "$bin" calibrate models/mm82_wind_gearbox.toml --trace "$out/traces/R80711_2017-spring.csv" \
+    "$bin" calibrate validation/engie_la_haute_borne/mm82_sump_only.toml --trace "$out/traces/R80711_2017-spring.csv" \
         --fit 'losses.multiplier.sliding=0.05:50' \
         --fit 'losses.multiplier.churning=0.01:100' \
         --fit 'thermal.coolers["oil_cooler"].capacity_rate_w_per_k=100:30000' \

@@ -11,8 +11,9 @@ R80711_2017-spring.csv, R80711_2016-summer.csv, R80721_2017-spring.csv, R80721_2
 
 Default: two calibrations on R80711 spring 2017 (days 1–14 fitted, days 15–27 held out), each
 followed by predictions of R80711 summer 2016 and R80721 in both periods:
-  before: models/mm82_wind_gearbox.toml as it is (a cooler with a smooth thermostat, a heater
-          as a two-way exchanger), fitted as scripts/engie_calibration.sh does;
+  before: validation/engie_la_haute_borne/mm82_sump_only.toml (the MM82 model with one oil
+          node, no bearings: a cooler with a smooth thermostat, a heater as a two-way
+          exchanger), fitted as scripts/engie_calibration.sh does;
   after:  the model with its cooler and heater block replaced by
           validation/engie_la_haute_borne/switching_cooler_heater.toml (a two-point fan on the
           cooler and a thermostatic heater, set points read from the data), its loss
@@ -36,7 +37,7 @@ import statistics
 import subprocess
 import sys
 
-MODEL = "models/mm82_wind_gearbox.toml"
+MODEL = "validation/engie_la_haute_borne/mm82_sump_only.toml"
 SWITCHING_BLOCK = "validation/engie_la_haute_borne/switching_cooler_heater.toml"
 PERIODS = ["R80711_2017-spring", "R80711_2016-summer", "R80721_2017-spring", "R80721_2016-summer"]
 BEGIN = "# >>> cooler and heater"

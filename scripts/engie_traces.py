@@ -10,8 +10,13 @@
     boundary:nacelle  nacelle temperature Yt_avg, °C
     boundary:outdoor  outdoor temperature Ot_avg, °C
     node:sump         gearbox oil sump temperature Gost_avg, °C
+  with --channels also (models/mm82_wind_gearbox.toml has these nodes; the single-node
+  variant validation/engie_la_haute_borne/mm82_sump_only.toml does not):
+    node:inlet          gearbox oil inlet temperature Git_avg, °C
+    node:hss_bearing_1  gearbox bearing temperature Gb1t_avg, °C
+    node:hss_bearing_2  gearbox bearing temperature Gb2t_avg, °C
 
-    python3 scripts/engie_traces.py EXTRACT_DIR OUT_DIR
+    python3 scripts/engie_traces.py [--channels] EXTRACT_DIR OUT_DIR
 
 Reads the extracts and the full records (R80711_2013-2020.csv, …, in
 ../shared/data/engie_la_haute_borne/ from the repository root). A source cell that is empty
@@ -52,7 +57,12 @@ def inputs(x):
     return f"{n}", f"{torque:.1f}"
 
 
-def main(src, out):
+# Measured node columns: (trace column, extract column).
+SUMP = [("node:sump", "Gost_avg")]
+CHANNELS = SUMP + [("node:inlet", "Git_avg"), ("node:hss_bearing_1", "Gb1t_avg"), ("node:hss_bearing_2", "Gb2t_avg")]
+
+
+def main(src, out, measured=SUMP):
     os.makedirs(out, exist_ok=True)
     for path in sorted(glob.glob(os.path.join(src, "R807*_*.csv"))):
         r = rows(path)
@@ -62,17 +72,22 @@ def main(src, out):
         dest = os.path.join(out, os.path.basename(path))
         empty = 0
         with open(dest, "w") as fh:
-            fh.write("time_s,input_speed_rpm,input_torque_nm,gear,boundary:nacelle,boundary:outdoor,node:sump\n")
+            names = ",".join(c for c, _ in measured)
+            fh.write(f"time_s,input_speed_rpm,input_torque_nm,gear,boundary:nacelle,boundary:outdoor,{names}\n")
             for x in r:
                 t = datetime.fromisoformat(x["Date_time"]).timestamp() - t0
                 n, torque = inputs(x)
-                cells = [n, torque, (x["Yt_avg"] or "").strip(), (x["Ot_avg"] or "").strip(), (x["Gost_avg"] or "").strip()]
+                cells = [n, torque, (x["Yt_avg"] or "").strip(), (x["Ot_avg"] or "").strip()]
+                cells += [(x[k] or "").strip() for _, k in measured]
                 empty += any(c == "" for c in cells)
-                fh.write(f"{t:.0f},{cells[0]},{cells[1]},run,{cells[2]},{cells[3]},{cells[4]}\n")
+                fh.write(f"{t:.0f},{cells[0]},{cells[1]},run," + ",".join(cells[2:]) + "\n")
         print(f"{dest}: {len(r)} rows ({empty} with an empty cell), ratio Ds/Rs {ratio:.3f}")
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 3:
+    args = sys.argv[1:]
+    channels = "--channels" in args
+    args = [a for a in args if a != "--channels"]
+    if len(args) != 2:
         sys.exit(__doc__)
-    main(sys.argv[1], sys.argv[2])
+    main(args[0], args[1], CHANNELS if channels else SUMP)

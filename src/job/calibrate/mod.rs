@@ -469,6 +469,7 @@ pub fn fit(m: &Model, p: &Prepared<'_>, o: &CalibrateOptions) -> Result<Calibrat
     };
     let layout = residuals::Layout::of(&p.held, pr.channels.len());
     let known = !layout.stretch.is_empty();
+    let mut channel_weights = None;
     let (res, noise) = match o.residuals.as_str() {
         "ar1-gls" if known => {
             let (res, models) = residuals::refit(
@@ -487,11 +488,12 @@ pub fn fit(m: &Model, p: &Prepared<'_>, o: &CalibrateOptions) -> Result<Calibrat
             let models = layout.estimate(&ols.at.r);
             let weights: Vec<f64> = models.iter().map(residuals::Ar1::long_run_sd).collect();
             let res = map_fit(p, ols, &weights, &bounds, &free, &lmo)?;
-            let models = if p.priors.is_empty() {
+            let models = if p.priors.is_empty() && !unequal(&weights) {
                 models
             } else {
                 layout.estimate(&res.at.r)
             };
+            channel_weights = unequal(&weights).then_some(weights);
             (res, Some(models))
         }
         _ => {
@@ -503,6 +505,7 @@ pub fn fit(m: &Model, p: &Prepared<'_>, o: &CalibrateOptions) -> Result<Calibrat
     };
     let fitted = Fitted {
         res,
+        weights: channel_weights,
         noise,
         whitened: o.residuals == "ar1-gls" && known,
         layout,
@@ -513,10 +516,17 @@ pub fn fit(m: &Model, p: &Prepared<'_>, o: &CalibrateOptions) -> Result<Calibrat
     assemble(m, p, o, &fitted, clock)
 }
 
+/// Channels' noise scales that differ (each finite and above zero): a fit of several channels
+/// weights each by its own. A channel the fit matches exactly (scale 0) leaves the fit unweighted.
+fn unequal(weights: &[f64]) -> bool {
+    weights.iter().all(|&w| w.is_finite() && w > 0.0) && weights.iter().any(|&w| w != weights[0])
+}
+
 /// The MAP fit from the least-squares fit `ols`: the data rows divided by their channel's
 /// noise scale `weights`, the prior rows appended (docs/calibration.md, "Priors"). Without
-/// priors `ols` itself. The result's evaluation is the data's, unweighted; its evaluations
-/// count those of `ols`.
+/// priors and with equal weights (one channel) `ols` itself; without priors and with unequal
+/// weights (several channels) the weighted least-squares fit. The result's evaluation is the
+/// data's, unweighted; its evaluations count those of `ols`.
 fn map_fit(
     p: &Prepared<'_>,
     ols: lm::LmResult,
@@ -525,7 +535,7 @@ fn map_fit(
     free: &[bool],
     lmo: &LmOptions,
 ) -> Result<lm::LmResult, JobError> {
-    if p.priors.is_empty() {
+    if p.priors.is_empty() && !unequal(weights) {
         return Ok(ols);
     }
     let params = &p.problem.params;
@@ -555,6 +565,9 @@ struct Independent {
 struct Fitted {
     /// The last fit (its evaluation whitened with `noise`).
     res: lm::LmResult,
+    /// Each channel's noise scale, K, when the fit weighted its channels by them (several
+    /// channels, residual model `ar1`): the covariance is the weighted fit's sandwich.
+    weights: Option<Vec<f64>>,
     /// The channels' AR(1) errors (None: independent).
     noise: Option<Vec<residuals::Ar1>>,
     /// `res` is the generalised least-squares fit (its evaluation whitened); else the ordinary
@@ -818,6 +831,31 @@ fn cycle_csv(trace: &Trace) -> String {
     s
 }
 
+/// The fit's evaluation and residual processes in the units it was fitted in: each channel
+/// divided by its weight when the fit weighted its channels (the weighted fit's sandwich
+/// (JᵀWJ)⁻¹ JᵀWΣWJ (JᵀWJ)⁻¹ is the unweighted one on rows and processes scaled by 1/w, W the
+/// diagonal of 1/w²); else as they are.
+fn weighted_at(f: &Fitted) -> (Evaluation, Option<Vec<residuals::Ar1>>) {
+    let at = Evaluation {
+        r: f.res.at.r.clone(),
+        j: f.res.at.j.clone(),
+    };
+    match (&f.weights, &f.noise) {
+        (Some(w), Some(models)) => {
+            let scaled = models
+                .iter()
+                .zip(w)
+                .map(|(a, w)| residuals::Ar1 {
+                    phi: a.phi,
+                    sigma: a.sigma / w,
+                })
+                .collect();
+            (prior::weighted(at, w), Some(scaled))
+        }
+        _ => (at, f.noise.clone()),
+    }
+}
+
 fn assemble(
     m: &Model,
     p: &Prepared<'_>,
@@ -829,10 +867,11 @@ fn assemble(
     let bounds: Vec<(f64, f64)> = pr.params.iter().map(Parameter::theta_bounds).collect();
     let identifiable = identifiable(&res.theta, &bounds, &f.free);
     let lost = f.noise.as_ref().map_or(0, Vec::len);
-    let mut lin = stats::linearised(&res.at.j, res.at.r.norm_squared(), &identifiable, lost);
-    if let (Some(models), false) = (&f.noise, f.whitened) {
-        let sj = f.layout.covariance_times(&res.at.j, models);
-        stats::sandwich(&mut lin, &(res.at.j.transpose() * sj));
+    let (at, scaled) = weighted_at(f);
+    let mut lin = stats::linearised(&at.j, at.r.norm_squared(), &identifiable, lost);
+    if let (Some(models), false) = (&scaled, f.whitened) {
+        let sj = f.layout.covariance_times(&at.j, models);
+        stats::sandwich(&mut lin, &(at.j.transpose() * sj));
     }
     if let Some(models) = &f.noise {
         let used = identifiable.iter().filter(|&&k| k).count() as f64;
