@@ -21,6 +21,7 @@
 
 #![warn(missing_docs)]
 
+#[cfg(feature = "cli")]
 mod cli;
 pub mod cycle;
 pub mod job;
@@ -32,4 +33,5 @@ pub mod scene;
 pub mod solve;
 pub mod study;
 
+#[cfg(feature = "cli")]
 pub use cli::main as cli_main;

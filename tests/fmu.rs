@@ -7,10 +7,13 @@ use std::process::Command;
 use std::sync::Arc;
 
 use geartherm::job::fmu::instance::{Instance, Phase};
-use geartherm::job::fmu::{slot, FmuModel, Payload, Role};
+use geartherm::job::fmu::{self as job_fmu, slot, FmuModel, FmuOptions, Payload, Role};
 use geartherm::job::{run, Model, RunOptions};
 use geartherm::solve::cosim::Stepper;
 use geartherm::solve::transient::integrate;
+
+#[path = "common/wall.rs"]
+mod wall;
 
 const AT6: &str = "models/at6_lepelletier.toml";
 
@@ -57,8 +60,12 @@ fn stepper_fed_a_runs_segments_reproduces_its_states() {
 /// largest temperature difference (K) and energy-per-source difference (relative).
 fn drive_instance(step: f64) -> (f64, f64) {
     let (_, p) = at6();
+    drive_model(fmu_model(&[]), &p, step)
+}
+
+/// Drive an instance of `fm` through the segments of the run `p` as [`drive_instance`].
+fn drive_model(fm: Arc<FmuModel>, p: &run::Prepared, step: f64) -> (f64, f64) {
     let traj = integrate(&p.scene, &p.segs, &p.opts, &mut |_, _| {}).unwrap();
-    let fm = fmu_model(&[]);
     let mut inst = Instance::new(fm.clone());
     let vr = |role: Role| fm.vars.iter().find(|v| v.role == role).unwrap().vr;
     inst.enter_initialization().unwrap();
@@ -268,4 +275,116 @@ fn cli_export_without_a_runtime_library_is_an_io_error() {
     assert_eq!(o.status.code(), Some(3));
     assert!(String::from_utf8_lossy(&o.stderr).contains("missing.so"));
     assert!(listing(dir.path()).is_empty());
+}
+
+/// A network larger than the 24 nodes up to which `Method::Auto` picks ROS3 for a run: the AT6
+/// with its housing meshed into 30 patches exports, and its instance at 1 s steps reproduces a
+/// `geartherm run --solver ros3` of the same model over the WLTC.
+#[test]
+fn a_thirty_patch_housing_mesh_exports_and_reproduces_a_ros3_run() {
+    let text = std::fs::read_to_string(AT6).unwrap() + &wall::mesh_toml(10, 3, Some(0.3), 100.0);
+    let o = FmuOptions {
+        params: vec![],
+        model_identifier: "at6_mesh".into(),
+    };
+    let export = job_fmu::prepare(&text, AT6, &[], &o).unwrap();
+    assert!(export.variables() > 0);
+    let fm = Arc::new(
+        FmuModel::build(Payload {
+            file: AT6.into(),
+            text: text.clone(),
+            overrides: vec![],
+            params: vec![],
+        })
+        .unwrap(),
+    );
+    let nodes = fm.scene.nodes();
+    assert!(nodes > 30, "{nodes} nodes");
+    let m = Model::from_text(&text, Path::new(AT6), &[]).unwrap();
+    let ros3 = RunOptions {
+        solver: "ros3".into(),
+        ..RunOptions::default()
+    };
+    let p = run::prepare(&m, &ros3).unwrap();
+    let (dt, de) = drive_model(fm, &p, 1.0);
+    println!(
+        "FMU instance vs run --solver ros3, AT6 with a 30-patch housing ({nodes} nodes), WLTC, 1 s steps: |dT| ≤ {dt:.3e} K, energy per source ≤ {de:.3e} relative"
+    );
+    assert!(dt <= 1e-6, "{dt:e} K");
+    assert!(de <= 1e-9, "{de:e}");
+}
+
+/// An instance of the AT6 FMU with `param.lubrication.oil_level_mm`, at rtol 1e-8, started at
+/// `t0` with `initial` temperatures (None: the model's) and the oil level `level`, at 300 rad/s,
+/// 100 N·m, gear index 2.
+fn tuned(fm: &Arc<FmuModel>, t0: f64, initial: Option<&[f64]>, level: f64) -> Instance {
+    let vr = |role: Role| fm.vars.iter().find(|v| v.role == role).unwrap().vr;
+    let mut i = Instance::new(fm.clone());
+    i.setup_experiment(None, t0).unwrap();
+    i.set(vr(Role::Rtol), 1e-8).unwrap();
+    i.set(vr(Role::Param(0)), level).unwrap();
+    for (n, t) in initial.unwrap_or(&[]).iter().enumerate() {
+        i.set(vr(Role::InitialTemp(n)), *t).unwrap();
+    }
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    i.set(vr(Role::InputSpeed), 300.0).unwrap();
+    i.set(vr(Role::InputTorque), 100.0).unwrap();
+    i.set(vr(Role::Gear), 2.0).unwrap();
+    i
+}
+
+/// A tunable parameter changed between two steps: the run continues from the state at that
+/// point with the new value, as a second instance started there from that state with the new
+/// value does (within the integration's tolerance: the two integrators take their own steps);
+/// a value the model refuses is an FMI error naming the key path and the time.
+#[test]
+fn a_tunable_parameter_changed_between_steps_equals_two_segments() {
+    let fm = fmu_model(&["lubrication.oil_level_mm"]);
+    let vr = |role: Role| fm.vars.iter().find(|v| v.role == role).unwrap().vr;
+    let nodes = fm.scene.nodes();
+    let temps = |i: &mut Instance| -> Vec<f64> {
+        (0..nodes)
+            .map(|n| i.get(vr(Role::NodeTemp(n))).unwrap())
+            .collect()
+    };
+    let level = fm.params[0].value;
+    let (mut a, mut same) = (tuned(&fm, 0.0, None, level), tuned(&fm, 0.0, None, level));
+    for k in 0..300 {
+        a.do_step(k as f64, 1.0).unwrap();
+        same.do_step(k as f64, 1.0).unwrap();
+    }
+    let at_300 = temps(&mut a);
+    let e_300 = a.get(vr(Role::TotalEnergy)).unwrap();
+    a.set(vr(Role::Param(0)), level + 20.0).unwrap();
+    let mut b = tuned(&fm, 300.0, Some(&at_300), level + 20.0);
+    let (mut d_ab, mut d_same) = (0.0f64, 0.0f64);
+    for k in 300..900 {
+        for i in [&mut a, &mut b, &mut same] {
+            i.do_step(k as f64, 1.0).unwrap();
+        }
+        let (ta, tb, ts) = (temps(&mut a), temps(&mut b), temps(&mut same));
+        for n in 0..nodes {
+            d_ab = d_ab.max((ta[n] - tb[n]).abs());
+            d_same = d_same.max((ta[n] - ts[n]).abs());
+        }
+    }
+    let e_a = a.get(vr(Role::TotalEnergy)).unwrap() - e_300;
+    let e_b = b.get(vr(Role::TotalEnergy)).unwrap();
+    let de = (e_a - e_b).abs() / e_b;
+    println!(
+        "oil level {level} -> {} mm at 300 s, 300-900 s: |T(one instance) - T(two segments)| <= {d_ab:.3e} K, \
+         loss energy {de:.3e} relative; the change itself moves T by up to {d_same:.3e} K",
+        level + 20.0
+    );
+    assert!(d_same > 1e-2, "the change has no effect: {d_same:e} K");
+    assert!(d_ab <= 1e-6, "{d_ab:e} K");
+    assert!(de <= 1e-8, "{de:e}");
+    let e = a.set(vr(Role::Param(0)), 1e6).unwrap_err();
+    assert!(e.contains("oil_level_mm") && e.contains("t = 900 s"), "{e}");
+    assert_eq!(a.phase(), Phase::Error);
+    a.reset();
+    a.enter_initialization().unwrap();
+    a.exit_initialization().unwrap();
+    a.do_step(0.0, 1.0).unwrap();
 }

@@ -1,6 +1,7 @@
 //! `Model.to_fmu`: the FMU export of `geartherm fmu` (`geartherm::job::fmu`) for Python. The
-//! runtime library is the `runtime` argument, else `$GEARTHERM_FMU_RUNTIME`: the wheel does not
-//! carry it (cargo builds it: `target/release/libgeartherm_fmu.so`).
+//! runtime library is the `runtime` argument (the Python side passes the one the wheel carries,
+//! `geartherm/_bin/libgeartherm_fmu.so`, unless the caller names another), else
+//! `$GEARTHERM_FMU_RUNTIME`.
 
 use std::path::{Path, PathBuf};
 
@@ -46,7 +47,7 @@ pub fn export_fmu(
         .ok_or_else(|| {
             io(
                 format!(
-                    "no FMU runtime library: pass runtime= or set {} to target/release/{} (built by `cargo build --release`)",
+                    "no FMU runtime library: pass runtime= or set {} to a {} (`cargo build --release` builds one in target/release/)",
                     job_fmu::RUNTIME_ENV,
                     job_fmu::RUNTIME_FILE
                 ),

@@ -451,14 +451,6 @@ fn render_calibration(py: Python<'_>, dir: PathBuf) -> PyResult<()> {
         .map_err(|e| py_error("io", format!("calibration.png: {e}"), Vec::new(), None))
 }
 
-/// The `geartherm` command line (the program's name first), run in this process exactly as the
-/// binary runs it, with the GIL released; returns the exit code (the console script exits with
-/// it).
-#[pyfunction]
-fn cli(py: Python<'_>, argv: Vec<std::ffi::OsString>) -> i32 {
-    py.detach(|| geartherm::cli_main(argv))
-}
-
 /// Version of the geartherm library this binding was built with.
 #[pyfunction]
 fn version() -> &'static str {
@@ -475,7 +467,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(oils, m)?)?;
     m.add_function(wrap_pyfunction!(cycles, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
-    m.add_function(wrap_pyfunction!(cli, m)?)?;
     m.add_function(wrap_pyfunction!(read_trace, m)?)?;
     m.add_function(wrap_pyfunction!(read_run, m)?)?;
     m.add_function(wrap_pyfunction!(render_calibration, m)?)?;

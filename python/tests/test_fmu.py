@@ -2,11 +2,13 @@
 `simulate_fmu` over the WLTC with a `geartherm run`'s inputs reproduces the run's temperatures
 and energies, the result does not depend on the communication step beyond the solver's
 tolerance, bad values are FMI errors the instance recovers from, and 1000 instantiate / reset /
-free cycles leave the memory flat. Figures are printed (`pytest -s`).
+free cycles leave the memory flat, a tunable parameter changed between steps equals a run of two
+segments. Figures are printed (`pytest -s`).
 
-The FMU needs the runtime library `libgeartherm_fmu.so`, which `cargo build --release` builds
-(the wheel does not carry it): `$GEARTHERM_FMU_RUNTIME`, else `target/release/`. Without it the
-tests are skipped, unless `GEARTHERM_FMU_REQUIRED=1` (CI) makes that a failure.
+The FMUs are exported with the runtime library the wheel carries (`geartherm/_bin/
+libgeartherm_fmu.so`, `Model.to_fmu` with no `runtime`), which is checked self-contained (ldd,
+nm). An installation without it (e.g. a `maturin develop` build) skips these tests, unless
+`GEARTHERM_FMU_REQUIRED=1` (CI) makes that a failure.
 """
 
 import csv
@@ -31,12 +33,12 @@ from fmpy.validation import validate_fmu  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 AT6 = ROOT / "models" / "at6_lepelletier.toml"
-RUNTIME = Path(os.environ.get("GEARTHERM_FMU_RUNTIME", ROOT / "target" / "release" / "libgeartherm_fmu.so"))
+RUNTIME = Path(geartherm._cli.BIN_DIR) / "libgeartherm_fmu.so"
 REQUIRED = os.environ.get("GEARTHERM_FMU_REQUIRED") == "1"
 
 pytestmark = pytest.mark.skipif(
     not RUNTIME.is_file() and not REQUIRED,
-    reason=f"no FMU runtime library at {RUNTIME} (cargo build --release builds it)",
+    reason=f"no FMU runtime library at {RUNTIME} (`pip install ./python` puts it there)",
 )
 
 KELVIN = 273.15
@@ -75,7 +77,8 @@ def work(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def fmu(work):
-    path = geartherm.Model.load(AT6).to_fmu(work / "at6.fmu", runtime=RUNTIME)
+    assert "GEARTHERM_FMU_RUNTIME" not in os.environ
+    path = geartherm.Model.load(AT6).to_fmu(work / "at6.fmu")
     return path
 
 
@@ -280,10 +283,79 @@ def test_to_fmu_errors_write_nothing(work):
     out = work / "errors"
     out.mkdir()
     with pytest.raises(geartherm.InputError) as e:
-        m.to_fmu(out / "x.fmu", params=["lubrication.no_such_key"], runtime=RUNTIME)
+        m.to_fmu(out / "x.fmu", params=["lubrication.no_such_key"])
     assert "lubrication.no_such_key" in str(e.value)
     with pytest.raises(FileNotFoundError):
-        m.to_fmu(out / "missing" / "x.fmu", runtime=RUNTIME)
+        m.to_fmu(out / "missing" / "x.fmu")
     with pytest.raises(FileNotFoundError):
         m.to_fmu(out / "x.fmu", runtime=out / "no_runtime.so")
     assert list(out.iterdir()) == []
+
+
+def test_the_wheels_runtime_is_self_contained():
+    """The runtime library the wheel carries needs only the C runtime (no libpython, no other
+    library) and exports the FMI 2.0 functions and the model slot."""
+    ldd = subprocess.run(["ldd", str(RUNTIME)], check=True, capture_output=True, text=True).stdout
+    libs = sorted({line.split()[0] for line in ldd.splitlines() if line.strip()})
+    allowed = ("linux-vdso.so", "libc.so", "libm.so", "libgcc_s.so", "ld-linux", "/lib64/ld-linux")
+    nm = subprocess.run(["nm", "-D", "--defined-only", str(RUNTIME)], check=True, capture_output=True,
+                        text=True).stdout
+    exported = sorted(line.split()[-1] for line in nm.splitlines() if line.strip())
+    fmi = [x for x in exported if x.startswith("fmi2")]
+    print(f"\n{RUNTIME.name}: {RUNTIME.stat().st_size} bytes; needs {libs}; exports {len(fmi)} fmi2 functions "
+          f"and {[x for x in exported if not x.startswith('fmi2')]}")
+    assert all(lib.startswith(allowed) for lib in libs), libs
+    assert len(fmi) == 34 and "fmi2DoStep" in fmi and "fmi2Instantiate" in fmi
+    assert [x for x in exported if not x.startswith("fmi2")] == ["MODEL_SLOT"]
+
+
+def test_a_tunable_parameter_changed_between_steps_equals_two_segments(work):
+    """`param.KEYPATH` is tunable: the oil level raised by 20 mm at 300 s in one instance gives,
+    over 300-900 s, the temperatures of a second instance started at 300 s from the first's
+    temperatures with the new level (within the tolerance; the two integrators take their own
+    steps), and differs from the unchanged run by far more; a refused value is an FMI error."""
+    path = geartherm.Model.load(AT6).to_fmu(work / "at6_param.fmu", params=["lubrication.oil_level_mm"])
+    problems = validate_fmu(path)
+    md = _description(path)
+    param = next(v for v in md.modelVariables if v.name == "param.lubrication.oil_level_mm")
+    assert param.variability == "tunable" and problems == []
+    level = float(param.start)
+    nodes = [f"T.{n}" for n in _nodes(md)]
+
+    def instance(name, start, level, initial=None):
+        s, vr = _slave(path, work, name)
+        s.instantiate()
+        s.setupExperiment(startTime=start)
+        s.setReal([vr["rtol"], vr[param.name]], [1e-8, level])
+        for n, t in (initial or {}).items():
+            s.setReal([vr[f"T_initial.{n[2:]}"]], [t])
+        s.enterInitializationMode()
+        s.exitInitializationMode()
+        s.setReal([vr["input_speed"], vr["input_torque"]], [300.0, 100.0])
+        s.setInteger([vr["gear"]], [2])
+        return s, vr
+
+    a, vr = instance("tuned", 0.0, level)
+    same, _ = instance("same", 0.0, level)
+    for k in range(300):
+        a.doStep(float(k), 1.0)
+        same.doStep(float(k), 1.0)
+    at_300 = dict(zip(nodes, a.getReal([vr[n] for n in nodes])))
+    a.setReal([vr[param.name]], [level + 20.0])
+    b, _ = instance("two_segments", 300.0, level + 20.0, at_300)
+    d_ab = d_same = 0.0
+    for k in range(300, 900):
+        for s in (a, b, same):
+            s.doStep(float(k), 1.0)
+        ta, tb, ts = (np.array(s.getReal([vr[n] for n in nodes])) for s in (a, b, same))
+        d_ab = max(d_ab, float(np.max(np.abs(ta - tb))))
+        d_same = max(d_same, float(np.max(np.abs(ta - ts))))
+    print(f"\noil level {level} -> {level + 20} mm at 300 s (FMPy FMU2Slave, rtol 1e-8), 300-900 s: "
+          f"max |T(one instance) - T(two segments)| = {d_ab:.3e} K; the change moves T by up to {d_same:.3e} K")
+    assert d_same > 1e-2
+    assert d_ab <= 1e-6
+    with pytest.raises(fmpy.fmi1.FMICallException) as e:
+        a.setReal([vr[param.name]], [1e6])
+    assert e.value.status == 3
+    for s in (a, b, same):
+        s.fmi2FreeInstance(s.component)

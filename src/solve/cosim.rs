@@ -20,7 +20,7 @@ use super::rosenbrock::{self, Carry};
 use super::sparse_lu::NetworkSparseLu;
 use super::trajectory::NumericalFailure;
 use super::transient::state_atol;
-use super::transient_options::{Method, TransientOptions, ROS3_MAX_NODES};
+use super::transient_options::{Method, TransientOptions};
 use crate::scene::{Inputs, Scene, Work};
 
 /// One scene integrated piece by piece.
@@ -73,7 +73,9 @@ pub struct StepperStats {
 impl Stepper {
     /// A stepper at time `t0` and state `y0` (temperatures K, zero energies: see
     /// [`Scene::initial_state`]) with `inputs`. The method is ROS3 (`opts.method` must be ROS3 or
-    /// Auto, and the scene at most [`ROS3_MAX_NODES`] nodes): the error says why not.
+    /// Auto; the error says why not) whatever the network's size: [`ROS3_MAX_NODES`](super::transient_options::ROS3_MAX_NODES) is where
+    /// `Method::Auto` prefers TR-BDF2 for a whole run's speed, not a limit of ROS3 (a larger
+    /// network takes the sparse LU from `SPARSE_FROM_STATES` states on, as a run does).
     pub fn new(
         scene: &Scene,
         y0: Vec<f64>,
@@ -81,16 +83,10 @@ impl Stepper {
         opts: TransientOptions,
         t0: f64,
     ) -> Result<Self, String> {
-        let n = scene.nodes();
         if !matches!(opts.method, Method::Ros3 | Method::Auto) {
             return Err(format!(
                 "co-simulation integrates with ros3, not {}",
                 opts.method.name()
-            ));
-        }
-        if n > ROS3_MAX_NODES {
-            return Err(format!(
-                "co-simulation integrates with ros3, for networks of at most {ROS3_MAX_NODES} nodes; this one has {n}"
             ));
         }
         if y0.len() != scene.n_states() {
@@ -178,10 +174,11 @@ impl Stepper {
     /// which the caller did not change since the last call unless it called
     /// [`Stepper::restart`]: the integrator keeps its own steps, each at most up to
     /// `t_max`, and the state at `t1` comes from the cubic Hermite interpolant of the step
-    /// containing it, from the states and derivatives f at both ends: the cubic Hermite
-    /// interpolation of a step, the dense output of order 3 Hairer, Nørsett & Wanner (Solving
-    /// ODEs I, Section II.6) give for any one-step method; that book was not read here, the
-    /// formula is checked by `hermite_is_exact_on_cubics`. No continuous extension of ROS3's
+    /// containing it, from the states and derivatives f at both ends (the Hermite basis and its
+    /// mapping to a step [ta, tb], slopes scaled by h, as read in the notes "Cubic Hermite
+    /// Splines" of github.com/uw-ipd/tmol; Hairer, Nørsett & Wanner, Solving ODEs I, §II.6,
+    /// and Shampine 1985, "Interpolation for Runge–Kutta methods", could not be read here);
+    /// `hermite_is_exact_on_cubics` checks the formula. No continuous extension of ROS3's
     /// own is used (none was read with its coefficients, [`super::rosenbrock`]; a continuous
     /// extension would need its stages). The interpolant's error is O(h⁴), below the step's
     /// embedded error estimate O(h³), which the step-size control keeps under the tolerance.

@@ -27,7 +27,7 @@ import math
 import os
 from typing import TYPE_CHECKING, Dict, Iterable, List, Literal, Mapping, Optional, Sequence, Tuple, Union, overload
 
-from . import _native
+from . import _cli, _native
 from ._tables import frame as _frame
 from ._tables import html_table as _html_table
 from ._tables import warn_ranges as _warn_ranges
@@ -257,8 +257,9 @@ class Model:
             Key paths exported as FMU parameters (checked as ``--set``: each must exist and hold
             a number).
         runtime : str or path-like, optional
-            The runtime library ``libgeartherm_fmu.so`` (``cargo build --release`` writes it to
-            ``target/release/``); default ``$GEARTHERM_FMU_RUNTIME``. The wheel does not carry it.
+            The runtime library ``libgeartherm_fmu.so`` to put into the FMU; default
+            ``$GEARTHERM_FMU_RUNTIME`` when set, else the one the wheel carries
+            (``geartherm/_bin/libgeartherm_fmu.so``, built with the package).
 
         Returns
         -------
@@ -272,8 +273,9 @@ class Model:
         OSError
             No runtime library, or the FMU cannot be written.
         """
-        rt = None if runtime is None else os.fspath(runtime)
-        return _native.export_fmu(self._m, os.fspath(path), list(params), rt)
+        if runtime is None:
+            runtime = os.environ.get("GEARTHERM_FMU_RUNTIME") or _cli.BIN_DIR / "libgeartherm_fmu.so"
+        return _native.export_fmu(self._m, os.fspath(path), list(params), os.fspath(runtime))
 
     def __eq__(self, other: object) -> bool:
         """Equal when the checked models are: every value bit for bit, whatever text, file name

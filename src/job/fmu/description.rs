@@ -1,6 +1,6 @@
 //! modelDescription.xml of an exported FMU (FMI 2.0 co-simulation), from the variable table.
 
-use super::variables::{Causality, Variable};
+use super::variables::{Causality, Role, Variable};
 use super::FmuModel;
 
 /// Units the variables use (FMI 2.0 `UnitDefinitions`: SI base-unit exponents).
@@ -34,6 +34,11 @@ fn scalar(v: &Variable) -> String {
         (Causality::Input, true) => ("input", "discrete", ""),
         (Causality::Input, false) => ("input", "continuous", ""),
         (Causality::Output, _) => ("output", "continuous", ""),
+        // Exported model values may change between steps (`instance`); initial temperatures and
+        // tolerances only before initialisation.
+        (Causality::Parameter, _) if matches!(v.role, Role::Param(_)) => {
+            ("parameter", "tunable", r#" initial="exact""#)
+        }
         (Causality::Parameter, _) => ("parameter", "fixed", r#" initial="exact""#),
     };
     let start = v

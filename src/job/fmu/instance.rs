@@ -9,6 +9,12 @@
 //! temperature follows a line from its value with the first derivative the importer set
 //! (`fmi2SetRealInputDerivatives`, order 1), held when none was set. Derivatives are forgotten
 //! after each step.
+//!
+//! Exported model parameters (`param.KEYPATH`) are tunable: set between two `doStep`s, the model
+//! is checked and compiled again with the new value ([`FmuModel::with_params`]) and the
+//! integration restarts from the state at the current communication point, the boundary lines
+//! in force carried over: the step change equals a run of two segments, the second started
+//! from the first's end state with the new value. Initial temperatures and tolerances are fixed.
 
 use crate::physics::units::{c_to_k, RAD_S_PER_RPM};
 use std::sync::Arc;
@@ -61,6 +67,7 @@ struct Run {
     model: Model,
     scene: Scene,
     stepper: Stepper,
+    opts: TransientOptions,
     envelope: Envelope,
     /// (value, derivative) of each boundary input as last applied to the scene.
     applied: Vec<(f64, f64)>,
@@ -275,8 +282,9 @@ impl Instance {
             max_steps: DEFAULT_MAX_STEPS,
             ..TransientOptions::default()
         };
-        let stepper = Stepper::new(&scene, y0, self.inputs(), opts, self.start_time)?;
+        let stepper = Stepper::new(&scene, y0, self.inputs(), opts.clone(), self.start_time)?;
         Ok(Run {
+            opts,
             envelope: Envelope::of(&scene),
             applied: self.boundary_inputs(),
             line_span: (self.start_time, self.start_time),
@@ -331,7 +339,10 @@ impl Instance {
         let v = var_of(&fm, vr)?;
         let settable = match v.causality {
             Causality::Input => self.phase != Phase::Terminated && self.phase != Phase::Error,
-            Causality::Parameter => matches!(self.phase, Phase::Instantiated | Phase::Initialization),
+            Causality::Parameter => {
+                matches!(self.phase, Phase::Instantiated | Phase::Initialization)
+                    || (self.phase == Phase::Step && matches!(v.role, Role::Param(_)))
+            }
             Causality::Output => false,
         };
         if !settable {
@@ -344,8 +355,36 @@ impl Instance {
         if v.role == Role::Rtol {
             self.rtol_set = true;
         }
-        self.values[vr as usize - 1] = x;
+        let old = std::mem::replace(&mut self.values[vr as usize - 1], x);
         self.outputs_fresh = false;
+        if self.phase == Phase::Step && matches!(v.role, Role::Param(_)) && old != x {
+            if let Err(m) = self.retune() {
+                return self.fail(format!("t = {time} s: {m}"));
+            }
+        }
+        Ok(())
+    }
+
+    /// A tunable parameter changed in step mode: the model with the parameters' values, checked
+    /// and compiled, the boundary lines in force applied to its scene, and a stepper started
+    /// from the state at the current time.
+    fn retune(&mut self) -> Result<(), Message> {
+        let params: Vec<f64> = (0..self.fm.params.len())
+            .map(|k| self.value_of(Role::Param(k)))
+            .collect();
+        let (model, mut scene) = self.fm.with_params(&params).map_err(|e| e.to_string())?;
+        let Some(run) = self.run.as_mut() else {
+            return Err("no run".into());
+        };
+        let (t0, t_end) = run.line_span;
+        apply_lines(&self.fm, &run.applied, &mut scene, t0, t_end - t0);
+        let now = run.stepper.time();
+        let y = run.stepper.state().to_vec();
+        let inputs = run.stepper.inputs();
+        run.stepper = Stepper::new(&scene, y, inputs, run.opts.clone(), now)?;
+        run.envelope = Envelope::of(&scene);
+        run.model = model;
+        run.scene = scene;
         Ok(())
     }
 

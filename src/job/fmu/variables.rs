@@ -13,7 +13,7 @@ pub enum Causality {
     Input,
     /// Computed.
     Output,
-    /// Set before initialisation.
+    /// Set before initialisation (exported model values, `param.*`, also between steps: tunable).
     Parameter,
 }
 
