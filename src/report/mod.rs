@@ -8,6 +8,7 @@ pub mod map;
 pub mod plots;
 pub mod run;
 pub mod sources;
+pub mod spread;
 pub mod study;
 pub mod validation;
 pub mod zip;

@@ -1,0 +1,51 @@
+//! Model-form spread of a job: every applicable model choice of each loss item's source at an
+//! operating point (`losses`, `steady`), and each source's energy per model choice along a
+//! run's own trajectory (`run --spread`; the thermal network is not solved again per model).
+
+use crate::model::Gearbox;
+use crate::report::spread::SpreadBlock;
+use crate::scene::{Inputs, LossScene, Needs, OperatingPoint, Scene, SourceSpread, SpreadScene};
+use crate::solve::transient::{Segment, Trajectory};
+
+/// The spread at `op` of `scene` (compiled from `gb` for `needs`), whose values there are
+/// `out`.
+pub fn at_point(
+    gb: &Gearbox,
+    needs: &Needs,
+    scene: &LossScene,
+    out: &[f64],
+    op: &OperatingPoint,
+) -> SpreadBlock {
+    let spread = SpreadScene::compile(gb, needs, scene);
+    SpreadBlock::new(spread.evaluate(scene, out, op))
+}
+
+/// Each source's energy per model choice along `traj` (the rows of a run of `scene` over
+/// `segs`): every interval between two output rows with its segment's inputs and the oil at
+/// both ends (trapezoid rule).
+pub fn along_run(
+    gb: &Gearbox,
+    needs: &Needs,
+    scene: &Scene,
+    segs: &[Segment],
+    traj: &Trajectory,
+) -> Vec<SourceSpread> {
+    let spread = SpreadScene::compile(gb, needs, &scene.losses);
+    let mut work = spread.work(&scene.losses);
+    let oil = |r: usize| {
+        let y = traj.states.get(r).unwrap_or(&[]);
+        scene.thermal.oil_properties(scene.oil_temp(y))
+    };
+    for r in 0..traj.times.len().saturating_sub(1) {
+        let dt = traj.times[r + 1] - traj.times[r];
+        let Some(seg) = traj.segment.get(r).and_then(|&k| segs.get(k)) else {
+            continue;
+        };
+        if dt <= 0.0 {
+            continue;
+        }
+        let inputs: Inputs = seg.inputs;
+        spread.accumulate(&scene.losses, &inputs, [oil(r), oil(r + 1)], dt, &mut work);
+    }
+    spread.source_energies(&scene.losses, &work)
+}
