@@ -20,17 +20,15 @@ pub fn at_point(
     SpreadBlock::new(spread.evaluate(scene, out, op))
 }
 
-/// Each source's energy per model choice along `traj` (the rows of a run of `scene` over
-/// `segs`): every interval between two output rows with its segment's inputs and the oil at
-/// both ends (trapezoid rule).
+/// Each source's energy per model choice of `spread` along `traj` (the rows of a run of
+/// `scene` over `segs`): every interval between two output rows with its segment's inputs and
+/// the oil at both ends (trapezoid rule). Non-finite energies are left out of the block.
 pub fn along_run(
-    gb: &Gearbox,
-    needs: &Needs,
+    spread: &SpreadScene,
     scene: &Scene,
     segs: &[Segment],
     traj: &Trajectory,
 ) -> Vec<SourceSpread> {
-    let spread = SpreadScene::compile(gb, needs, &scene.losses);
     let mut work = spread.work(&scene.losses);
     let oil = |r: usize| {
         let y = traj.states.get(r).unwrap_or(&[]);
@@ -47,5 +45,17 @@ pub fn along_run(
         let inputs: Inputs = seg.inputs;
         spread.accumulate(&scene.losses, &inputs, [oil(r), oil(r + 1)], dt, &mut work);
     }
-    spread.source_energies(&scene.losses, &work)
+    let mut out = spread.source_energies(&scene.losses, &work);
+    for s in &mut out {
+        for m in &mut s.models {
+            if m.j.is_some_and(|j| !j.is_finite()) {
+                m.j = None;
+                m.not_applicable.push("not finite along this trajectory".into());
+            }
+        }
+        let js = s.models.iter().filter_map(|m| m.j);
+        s.min_j = js.clone().fold(s.default_j, f64::min);
+        s.max_j = js.fold(s.default_j, f64::max);
+    }
+    out
 }
