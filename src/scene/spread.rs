@@ -73,7 +73,7 @@ impl SpreadScene {
     /// The alternatives of `gb`, compiled for `needs`, matched to the items of `default` (the
     /// scene compiled from `gb` with the same `needs`).
     pub fn compile(gb: &Gearbox, needs: &Needs, default: &LossScene) -> SpreadScene {
-        let alt = &gb.losses.alternatives;
+        let alt = &gb.loss_alternatives;
         let mut models = Vec::new();
         for a in &alt.churning {
             models.push(choice(gb, needs, default, Source::Churning, a, |g, c| {

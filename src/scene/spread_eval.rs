@@ -124,23 +124,7 @@ impl SpreadScene {
                     .iter()
                     .zip(&evaluated)
                     .filter(|(m, _)| m.slots[k] != Slot::Other)
-                    .map(|(m, e)| {
-                        let (w, why, out) = match (&m.slots[k], e) {
-                            (Slot::Item(i), Some((v, warn))) => {
-                                (Some(v[*i]), None, outside(warn, it.source, &it.name))
-                            }
-                            (Slot::NotApplicable(why), _) => (None, Some(why.clone()), Vec::new()),
-                            _ => (Some(default_out[k]), None, outside(&own, it.source, &it.name)),
-                        };
-                        ModelValue {
-                            model: m.choice,
-                            label: label(m.choice),
-                            default: m.slots[k] == Slot::Default,
-                            w,
-                            not_applicable: why,
-                            outside: out,
-                        }
-                    })
+                    .map(|(m, e)| model_value(m, e.as_ref(), k, it, default_out[k], &own))
                     .collect();
                 if models.is_empty() {
                     models.push(ModelValue {
@@ -155,6 +139,34 @@ impl SpreadScene {
                 item_spread(it.source, &it.name, default_out[k], models)
             })
             .collect()
+    }
+}
+
+/// Model `m`'s value of item `k` (`it`), from its evaluation `e` (values, range warnings) or
+/// the default's value `own_w` and warnings `own`; a non-finite value is not applicable.
+fn model_value(
+    m: &super::spread::SpreadModel,
+    e: Option<&(Vec<f64>, Vec<RangeWarning>)>,
+    k: usize,
+    it: &super::items::LossItem,
+    own_w: f64,
+    own: &[RangeWarning],
+) -> ModelValue {
+    let (w, why, out) = match (&m.slots[k], e) {
+        (Slot::Item(i), Some((v, warn))) if v[*i].is_finite() => {
+            (Some(v[*i]), None, outside(warn, it.source, &it.name))
+        }
+        (Slot::Item(_), _) => (None, Some("not finite at this point".to_string()), Vec::new()),
+        (Slot::NotApplicable(why), _) => (None, Some(why.clone()), Vec::new()),
+        _ => (Some(own_w), None, outside(own, it.source, &it.name)),
+    };
+    ModelValue {
+        model: m.choice,
+        label: label(m.choice),
+        default: m.slots[k] == Slot::Default,
+        w,
+        not_applicable: why,
+        outside: out,
     }
 }
 

@@ -368,9 +368,6 @@ pub struct LossModels {
     /// Loss multipliers `[losses] multiplier`: (source, None) for a source, (source, Some(item))
     /// for one item; each multiplies the item's loss (default 1).
     pub multipliers: Vec<(Source, Option<String>, f64)>,
-    /// Every model choice of churning, windage and sliding, resolved or why not applicable
-    /// (the model-form spread).
-    pub alternatives: super::loss_alternatives::LossAlternatives,
 }
 
 /// Default discharge coefficient of pocketing (physics.md §6: 0.6–0.7).
@@ -404,7 +401,6 @@ pub fn validate_losses(
         sliding,
         windage,
         multipliers,
-        alternatives: super::loss_alternatives::alternatives(l, sump_volume_l, oil_lubricant_factor),
     })
 }
 
