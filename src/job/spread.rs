@@ -31,19 +31,23 @@ pub fn along_run(
 ) -> Vec<SourceSpread> {
     let mut work = spread.work(&scene.losses);
     let oil = |r: usize| {
-        let y = traj.states.get(r).unwrap_or(&[]);
-        scene.thermal.oil_properties(scene.oil_temp(y))
+        traj.states
+            .get(r)
+            .map(|y| scene.thermal.oil_properties(scene.oil_temp(y)))
     };
     for r in 0..traj.times.len().saturating_sub(1) {
         let dt = traj.times[r + 1] - traj.times[r];
         let Some(seg) = traj.segment.get(r).and_then(|&k| segs.get(k)) else {
             continue;
         };
+        let (Some(start), Some(end)) = (oil(r), oil(r + 1)) else {
+            continue;
+        };
         if dt <= 0.0 {
             continue;
         }
         let inputs: Inputs = seg.inputs;
-        spread.accumulate(&scene.losses, &inputs, [oil(r), oil(r + 1)], dt, &mut work);
+        spread.accumulate(&scene.losses, &inputs, [start, end], dt, &mut work);
     }
     let mut out = spread.source_energies(&scene.losses, &work);
     for s in &mut out {
