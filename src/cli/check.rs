@@ -86,6 +86,7 @@ pub fn losses(a: &LossesArgs) -> Result<(), Failure> {
     let m = a.source.load()?;
     let report = job::losses::losses(&m, &a.options())?;
     warnings(&report.warnings);
+    super::output::spread_warnings(report.spread.as_ref());
     if a.json {
         emit_json(&report)
     } else {

@@ -94,6 +94,13 @@ pub fn warnings(w: &[crate::job::RangeWarning]) {
     }
 }
 
+/// Each model-form spread disagreement as one stderr line (`warning: item …`).
+pub fn spread_warnings(s: Option<&crate::report::spread::SpreadBlock>) {
+    for x in s.iter().flat_map(|b| &b.warnings) {
+        warn(&format!("warning: {x}"));
+    }
+}
+
 /// A progress bar on a terminal's standard error (None when quiet or not a terminal).
 pub fn progress_bar(
     len: usize,

@@ -63,6 +63,10 @@ pub struct RunArgs {
     /// per-sample loss cache (for measuring what they save; results agree to rounding).
     #[arg(long)]
     pub evaluate_all: bool,
+    /// Model-form spread: the energy each applicable model choice of every loss source would
+    /// give along this run's trajectory, in summary.json (docs/uq.md).
+    #[arg(long)]
+    pub spread: bool,
 }
 
 impl RunArgs {
@@ -80,6 +84,7 @@ impl RunArgs {
             max_steps: self.max_steps,
             summary_only: self.summary_only,
             evaluate_all: self.evaluate_all,
+            spread: self.spread,
         }
     }
 }

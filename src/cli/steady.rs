@@ -115,6 +115,7 @@ pub fn steady(a: &SteadyArgs) -> Result<(), Failure> {
     let m = a.point.source.load()?;
     let r = steady::steady(&m, &a.options())?;
     warnings(&r.warnings);
+    super::output::spread_warnings(r.spread.as_ref());
     if a.json {
         emit_json(&r)
     } else {
@@ -161,6 +162,9 @@ pub(super) fn steady_text(r: &SteadyResult) -> String {
         r.total_loss_w,
         r.efficiency.map_or("n/a".into(), |e| format!("{e:.5}"))
     ));
+    if let Some(s) = &r.spread {
+        t.push_str(&s.to_text());
+    }
     t
 }
 

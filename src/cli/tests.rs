@@ -55,6 +55,7 @@ fn run_options_round_trip() {
             max_steps: 12345,
             summary_only: true,
             evaluate_all: true,
+            spread: true,
         },
     ];
     for o in all {

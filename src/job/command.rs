@@ -131,6 +131,9 @@ impl ToArgs for RunOptions {
         if self.evaluate_all {
             a.push(super::options::flag("evaluate_all"));
         }
+        if self.spread {
+            a.push(super::options::flag("spread"));
+        }
         a
     }
 }

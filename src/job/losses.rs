@@ -61,7 +61,7 @@ pub fn losses(m: &Model, o: &LossesOptions) -> Result<LossReport, JobError> {
             ),
         ));
     }
-    let r = report(&m.gearbox, &scene, &op, o.oil_temp_c);
+    let mut r = report(&m.gearbox, &scene, &op, o.oil_temp_c);
     let bad = r
         .items
         .iter()
@@ -78,5 +78,13 @@ pub fn losses(m: &Model, o: &LossesOptions) -> Result<LossReport, JobError> {
             short(o.oil_temp_c)
         )));
     }
+    let out: Vec<f64> = r.items.iter().map(|it| it.w).collect();
+    r.spread = Some(super::spread::at_point(
+        &m.gearbox,
+        &crate::scene::Needs::default(),
+        &scene,
+        &out,
+        &op,
+    ));
     Ok(r)
 }

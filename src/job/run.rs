@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use crate::cycle::{DriveCycle, Schedule};
 use crate::physics::units::c_to_k;
 use crate::report::run::{check_finite, summary, timeseries_csv, Summary};
-use crate::scene::{Needs, Scene};
+use crate::scene::{Needs, Scene, SpreadScene};
 use crate::solve::drive::{row_inputs, segments};
 use crate::solve::transient::{
     check_stored_values, integrate, Method, Restart, Segment, Trajectory, TransientOptions,
@@ -55,6 +55,9 @@ pub struct RunOptions {
     /// No scene pruning of unused gear states and idle items, no per-sample loss cache (for
     /// measuring what they save; results agree to rounding).
     pub evaluate_all: bool,
+    /// Model-form spread: the energy each applicable model choice of every source would give
+    /// along the run's own trajectory, in the summary (docs/uq.md).
+    pub spread: bool,
 }
 
 impl Default for RunOptions {
@@ -71,6 +74,7 @@ impl Default for RunOptions {
             max_steps: DEFAULT_MAX_STEPS,
             summary_only: false,
             evaluate_all: false,
+            spread: false,
         }
     }
 }
@@ -128,6 +132,8 @@ pub struct Prepared {
     pub segs: Vec<Segment>,
     /// Solver options.
     pub opts: TransientOptions,
+    /// The model-form alternatives (with `spread`).
+    pub spread: Option<SpreadScene>,
 }
 
 /// Check the options, read and schedule the cycle, compile the scene for it: everything that
@@ -163,12 +169,16 @@ pub fn prepare(m: &Model, o: &RunOptions) -> Result<Prepared, JobError> {
     })?;
     check_stored_values(&scene, &segs, &opts)
         .map_err(|e| JobError::invalid(format!("{}: {e}", m.label())))?;
+    let spread = o
+        .spread
+        .then(|| SpreadScene::compile(&m.gearbox, &needs, &scene.losses));
     Ok(Prepared {
         scene,
         cycle,
         sched,
         segs,
         opts,
+        spread,
     })
 }
 
@@ -212,7 +222,7 @@ pub fn solve(m: &Model, p: &Prepared, progress: &mut dyn FnMut(usize, usize)) ->
 /// The post-solve checks and the outputs of an integrated run.
 fn finish(m: &Model, p: &Prepared, traj: &Trajectory) -> Result<RunResult, JobError> {
     let rows = row_inputs(&m.gearbox, &p.sched, traj);
-    let sum = summary(
+    let mut sum = summary(
         &p.scene,
         traj,
         &rows,
@@ -224,6 +234,9 @@ fn finish(m: &Model, p: &Prepared, traj: &Trajectory) -> Result<RunResult, JobEr
     );
     let numerical = |what: String| JobError::numerical(format!("{}: {what}", m.label()));
     check_finite(&p.scene, traj, &rows, &sum).map_err(numerical)?;
+    if let Some(s) = &p.spread {
+        sum.spread = Some(super::spread::along_run(s, &p.scene, &p.segs, traj));
+    }
     Envelope::of(&p.scene)
         .check_run(&p.scene, &p.segs, traj)
         .map_err(numerical)?;

@@ -103,6 +103,9 @@ pub struct SteadyResult {
     /// then `limit_cycle`, `temperatures_c` and the losses are the cycle's means).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub limit_cycle: Option<LimitCycleReport>,
+    /// Model-form spread at the equilibrium (`steady` fills it; not with a limit cycle).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spread: Option<crate::report::spread::SpreadBlock>,
 }
 
 /// A limit cycle in °C per node.
@@ -185,7 +188,9 @@ pub fn steady(m: &Model, o: &SteadyOptions) -> Result<SteadyResult, JobError> {
     check_equilibrium(&scene, &eq)
         .and_then(|()| check_envelope(&Envelope::of(&scene), &eq))
         .map_err(|what| JobError::numerical(format!("{}: {}: {what}", m.label(), o.describe())))?;
-    Ok(result(m, o, &scene, state, &eq))
+    let mut r = result(m, o, &scene, state, &eq);
+    r.spread = spread(m, &scene, &at, &eq);
+    Ok(r)
 }
 
 /// The report of the checked equilibrium `eq` at `o` (`steady`'s, and a rating point's).
@@ -237,7 +242,39 @@ pub(crate) fn result(
         residual_w: eq.solution.residual_w,
         warnings: log.warnings(&scene.losses),
         limit_cycle: eq.limit_cycle.as_ref().map(|c| cycle_report(scene, c)),
+        spread: None,
     }
+}
+
+/// The model-form spread at equilibrium `eq` (None with a limit cycle).
+fn spread(
+    m: &Model,
+    scene: &Scene,
+    at: &Inputs,
+    eq: &Equilibrium,
+) -> Option<crate::report::spread::SpreadBlock> {
+    if eq.limit_cycle.is_some() {
+        return None;
+    }
+    let needs = Needs {
+        states: Some(vec![at.state]),
+        ..Needs::default()
+    };
+    let op = OperatingPoint {
+        state: at.state,
+        input_speed: at.input_speed,
+        input_torque: at.input_torque,
+        oil: scene
+            .thermal
+            .oil_properties(scene.oil_temp(&eq.solution.temperatures)),
+    };
+    Some(super::spread::at_point(
+        &m.gearbox,
+        &needs,
+        &scene.losses,
+        &eq.losses,
+        &op,
+    ))
 }
 
 /// Every number of an equilibrium finite and its residual small, else the first failure named.

@@ -62,6 +62,9 @@ pub struct Gearbox {
     pub sump_volume: Option<f64>,
     /// Loss models with their coefficients.
     pub losses: LossModels,
+    /// Every model choice of churning, windage and sliding, resolved or why not applicable
+    /// (the model-form spread).
+    pub loss_alternatives: crate::model::sections::loss_alternatives::LossAlternatives,
     /// The thermal network (`[thermal]`), if the model has one.
     pub thermal: Option<ThermalNetwork>,
     /// The vehicle (`[vehicle]`), if the model has one.

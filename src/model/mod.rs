@@ -21,6 +21,7 @@
 //! The paths `model::thermal`, `model::wall_mesh`, `model::bearings`, `model::pump` name the
 //! section modules, and `model::gearbox` every checked part type.
 
+pub mod alternative;
 pub mod bearing_catalogue;
 pub mod catalogue;
 pub mod choice;

@@ -50,6 +50,11 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
     let seals = seals::validate_seals(&file.seals, &parts.members, &nodes, problems);
     let lub = &file.lubrication;
     let oil_x_l = oil.as_ref().map_or(1.0, |o| o.lubricant_factor_or_default().0);
+    let loss_alternatives = crate::model::sections::loss_alternatives::alternatives(
+        &file.losses.clone().unwrap_or_default(),
+        lub.sump_volume_l,
+        oil_x_l,
+    );
     let losses = losses::validate_losses(
         &file.losses.clone().unwrap_or_default(),
         lub.sump_volume_l,
@@ -136,6 +141,7 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         oil_level: s.oil_level,
         sump_volume: lub.sump_volume_l.map(|v| v * 1e-3),
         losses: losses?,
+        loss_alternatives,
         thermal,
         vehicle,
         clutch_packs,

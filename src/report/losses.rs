@@ -58,6 +58,9 @@ pub struct LossReport {
     pub warnings: Vec<RangeWarning>,
     /// Per bearing: friction model and μ pair with its origin.
     pub bearings: Vec<super::bearing_info::BearingInfo>,
+    /// Model-form spread: every applicable model of each item's source (`losses` fills it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spread: Option<super::spread::SpreadBlock>,
 }
 
 /// Evaluate the scene at `op` and build the report.
@@ -102,6 +105,7 @@ pub fn losses(gb: &Gearbox, scene: &LossScene, op: &OperatingPoint, oil_temp_c: 
             log.warnings(scene)
         },
         bearings: super::bearing_info::bearing_infos(gb),
+        spread: None,
     }
 }
 
@@ -146,6 +150,9 @@ pub fn to_text(r: &LossReport) -> String {
         for k in &r.skipped {
             let _ = writeln!(s, "  {}: {}", k.what, k.why);
         }
+    }
+    if let Some(sp) = &r.spread {
+        s.push_str(&sp.to_text());
     }
     s
 }

@@ -9,6 +9,7 @@ pub mod plots;
 pub mod run;
 pub mod sources;
 pub mod stats_de;
+pub mod spread;
 pub mod study;
 pub mod timeseries;
 pub mod validation;

@@ -118,6 +118,10 @@ pub struct Summary {
     /// without controllers).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub controls: Vec<ControlSummary>,
+    /// With `--spread`: per source, the energy each applicable model choice gives along the
+    /// run's own trajectory (docs/uq.md, "Model-form spread"; absent without it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spread: Option<Vec<crate::scene::SourceSpread>>,
 }
 
 /// A controller over the run.
@@ -339,6 +343,7 @@ pub fn summary(
         warnings: run_warnings(scene, traj, rows),
         launch: launch_summary(&traj.times, rows),
         controls: control_summaries(scene, traj),
+        spread: None,
     }
 }
 

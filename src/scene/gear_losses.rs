@@ -482,10 +482,11 @@ pub(super) fn compile_sliding(
             ));
             continue;
         }
-        let sm = SlidingMesh::new(&sliding_input(gb, mi), &opts).map_err(|e| SceneError {
-            what: format!("sliding of mesh {}", m.name),
-            why: e.to_string(),
-        })?;
+        let sm =
+            super::sliding_memo::sliding_mesh(&sliding_input(gb, mi), &opts).map_err(|e| SceneError {
+                what: format!("sliding of mesh {}", m.name),
+                why: e.to_string(),
+            })?;
         let (model, law) = match schlenk {
             // μ_mz ∝ (F/b/(v ρ))^0.2·η^−0.05 and the closed form is linear in μ
             Some(s) => (SlideModel::Iso14179(sm, s), Some(PowerLaw::SCHLENK)),

@@ -11,6 +11,9 @@ pub mod items;
 pub mod losses;
 pub mod planet_churning;
 pub mod ranges;
+mod sliding_memo;
+pub mod spread;
+pub mod spread_eval;
 pub mod system;
 pub mod thermal;
 pub mod usage;
@@ -21,4 +24,6 @@ pub use losses::{
     SceneError, Skipped, Source, N_SOURCES,
 };
 pub use ranges::{RangeLog, RangeWarning};
+pub use spread::SpreadScene;
+pub use spread_eval::{ItemSpread, ModelEnergy, ModelValue, SourceSpread, SpreadWork};
 pub use system::{Inputs, RhsFailure, Scene, Work};

@@ -335,7 +335,8 @@ class Model:
             its ``attrs`` hold the rest of the report. ``"dict"``: the ``geartherm losses
             --json`` report: ``loss_<source>_w`` per source and ``loss_total_w`` (W),
             ``items``, ``efficiency``, the oil's viscosity and density at that temperature,
-            ``skipped``, ``warnings``.
+            ``skipped``, ``warnings``, ``spread`` (the model-form spread: every applicable
+            model of each item's source, docs/uq.md).
 
         Range warnings are raised as one :class:`RangeWarning` (a one-line summary).
 
@@ -577,6 +578,7 @@ class Model:
         summary_only: bool = False,
         frozen_viscosity_c: Optional[float] = None,
         evaluate_all: bool = False,
+        spread: bool = False,
     ) -> RunResult:
         """A drive-cycle transient (``geartherm run``).
 
@@ -604,6 +606,9 @@ class Model:
             Oil properties frozen at this temperature, °C (viscosity feedback off).
         evaluate_all : bool, default False
             No pruning of unused gear states and idle items (for measuring what it saves).
+        spread : bool, default False
+            Model-form spread: ``summary["spread"]`` holds, per source, the energy each
+            applicable model choice gives along this run's trajectory (docs/uq.md).
 
         Returns
         -------
@@ -623,6 +628,7 @@ class Model:
             "solver": solver,
             "summary_only": bool(summary_only),
             "evaluate_all": bool(evaluate_all),
+            "spread": bool(spread),
             "frozen_viscosity_c": None if frozen_viscosity_c is None else float(frozen_viscosity_c),
         }
         for k, v in (("rtol", rtol), ("atol", atol), ("max_steps", max_steps)):

@@ -12,7 +12,7 @@ use super::gears::{Gear, GearMount};
 use super::parts::Parts;
 use crate::model::bearing_catalogue::{catalogue, CatalogueBearing, SeriesEntry};
 use crate::model::catalogue::CatalogueOil;
-use crate::model::choice::choice;
+use crate::model::choice::{choice, Choice};
 use crate::model::problems::Problems;
 use crate::physics::losses::bearings::skf::{DragForm, Lubrication};
 use crate::physics::losses::bearings::BearingFriction;
@@ -179,6 +179,9 @@ pub struct Bearing {
     pub mu: Option<BearingMu>,
     /// Keys the file sets that have no effect in this combination (key path and why).
     pub ineffective: Vec<(String, String)>,
+    /// Every friction model of the bearing (`skf_current`, `skf_older`, `palmgren`), resolved
+    /// or why not applicable (the model-form spread).
+    pub alternatives: Vec<crate::model::alternative::Alternative<BearingFriction>>,
 }
 
 fn normalise(s: &str) -> String {
@@ -257,6 +260,7 @@ pub(crate) fn validate_bearings(
             continue;
         };
         let ineffective = ineffective_keys(b, mu.is_some(), axis, oil, entry, &p);
+        let alternatives = friction_alternatives(b, entry, &series, axis, oil, &p);
         let heat = heat_to(&b.heat_to, nodes, &format!("{p}.heat_to"), problems);
         let Some(mount) = mount else { continue };
         let key = match mount {
@@ -275,6 +279,7 @@ pub(crate) fn validate_bearings(
             heat_to: heat,
             mu,
             ineffective,
+            alternatives,
         });
     }
     check_statics(&per_body, parts, &mut out, problems);
@@ -407,6 +412,39 @@ fn friction(
         }
         BearingModelChoice::Palmgren => palmgren(entry, b.sealed, p, problems).map(|f| (f, None)),
     }
+}
+
+/// Bearing `b`'s friction with each model and SKF drag edition, by the checks of [`friction`]
+/// on a copy of the entry with only that choice changed.
+fn friction_alternatives(
+    b: &BearingSpec,
+    entry: &CatalogueBearing,
+    series: &[SeriesEntry],
+    axis: Option<f64>,
+    oil: &OilBath<'_>,
+    p: &str,
+) -> Vec<crate::model::alternative::Alternative<BearingFriction>> {
+    let chosen = model_choice(b, entry);
+    let edition = b.drag_form.unwrap_or_default();
+    [
+        (BearingModelChoice::Skf, Some(DragFormChoice::Current)),
+        (BearingModelChoice::Skf, Some(DragFormChoice::Older)),
+        (BearingModelChoice::Palmgren, None),
+    ]
+    .into_iter()
+    .map(|(model, drag)| {
+        let spec = BearingSpec {
+            model: Some(model),
+            drag_form: drag.or(b.drag_form),
+            ..b.clone()
+        };
+        let mut problems = Problems::default();
+        let found = friction(&spec, entry, series, axis, oil, p, &mut problems).map(|f| f.0);
+        let name = drag.map_or(model.name(), |d| d.name());
+        let default = chosen == model && drag.map_or(true, |d| d == edition);
+        crate::model::alternative::Alternative::checked(name, default, found, problems)
+    })
+    .collect()
 }
 
 /// The friction model bearing `b` asks for (default: SKF where the catalogue has its row).

@@ -435,7 +435,11 @@ fn multipliers(l: &LossesSpec, problems: &mut Problems) -> Vec<(Source, Option<S
 }
 
 /// The churning model with its coefficients (None: churning off).
-fn churning(l: &LossesSpec, sump_volume_l: Option<f64>, problems: &mut Problems) -> Option<ChurningConfig> {
+pub(super) fn churning(
+    l: &LossesSpec,
+    sump_volume_l: Option<f64>,
+    problems: &mut Problems,
+) -> Option<ChurningConfig> {
     let model = l.churning.unwrap_or_default();
     let mut cfg = ChurningConfig::default();
     if let Some(re) = l.seetharaman_transition_reynolds {
@@ -511,7 +515,7 @@ fn pocketing(l: &LossesSpec, problems: &mut Problems) -> Option<PocketingOptions
 }
 
 /// The sliding model with its friction law and options.
-fn sliding(l: &LossesSpec, oil_lubricant_factor: f64, problems: &mut Problems) -> SlidingChoice {
+pub(super) fn sliding(l: &LossesSpec, oil_lubricant_factor: f64, problems: &mut Problems) -> SlidingChoice {
     let xl = l.lubricant_factor.unwrap_or(oil_lubricant_factor);
     problems.in_range("losses.lubricant_factor", xl, 0.3, 2.0, "");
     let schlenk = Schlenk {

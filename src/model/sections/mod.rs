@@ -11,6 +11,7 @@ pub mod common;
 pub mod gear_states;
 pub mod gears;
 pub mod launch;
+pub mod loss_alternatives;
 pub mod losses;
 pub mod lubrication;
 pub mod members;

@@ -19,8 +19,9 @@ pub struct SlidingMesh {
     cos_bb: f64,
     roughness: f64,
     bk_roughness_factor: f64,
-    samples: Vec<Sample>,
-    elements: Vec<ContactElement>,
+    /// Shared between copies of the mesh with other friction laws ([`Self::with_friction`]).
+    samples: std::sync::Arc<[Sample]>,
+    elements: std::sync::Arc<[ContactElement]>,
     /// Σ weight·force·|s| (gear 1 / gear 2 driving), for the μ-independent fast path.
     unit_fwd: f64,
     unit_rev: f64,
@@ -29,6 +30,20 @@ pub struct SlidingMesh {
 }
 
 impl SlidingMesh {
+    /// The same mesh with friction law `law`: the contact-path tables do not depend on the law,
+    /// so this is [`Self::new`] with `law` in the options, without building them again.
+    pub fn with_friction(&self, law: FrictionLaw) -> Result<Self, SlidingError> {
+        law.validate()?;
+        let bk_roughness_factor = match law {
+            FrictionLaw::BenedictKelley(bk) => bk.roughness_factor(self.roughness)?,
+            _ => 1.0,
+        };
+        let mut m = self.clone();
+        m.options.friction = law;
+        m.bk_roughness_factor = bk_roughness_factor;
+        Ok(m)
+    }
+
     /// Validate the input and build the contact-path tables.
     pub fn new(input: &SlidingMeshInput, options: &SlidingOptions) -> Result<Self, SlidingError> {
         input.validate()?;
@@ -112,8 +127,8 @@ impl SlidingMesh {
             cos_bb,
             roughness,
             bk_roughness_factor,
-            samples,
-            elements,
+            samples: samples.into(),
+            elements: elements.into(),
             unit_fwd,
             unit_rev,
             min_contact_length,
