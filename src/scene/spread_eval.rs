@@ -2,7 +2,9 @@
 //! operating point (with the validity ranges it leaves there), and the energy each model would
 //! give per source along a run's trajectory.
 
-use serde::Serialize;
+use std::borrow::Cow;
+
+use serde::{Deserialize, Serialize};
 
 use super::items::{OperatingPoint, Source};
 use super::losses::{LossScene, SampleTerms};
@@ -194,12 +196,12 @@ fn item_spread(source: Source, name: &str, default_w: f64, models: Vec<ModelValu
 }
 
 /// One model choice's energy over a run (J).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ModelEnergy {
     /// The model choice as the model file writes it.
-    pub model: &'static str,
+    pub model: Cow<'static, str>,
     /// Its name in the literature.
-    pub label: &'static str,
+    pub label: Cow<'static, str>,
     /// True when it is the file's choice for every item of the source.
     pub default: bool,
     /// Energy of the source with this model, J (items it does not apply to at their default's
@@ -210,7 +212,7 @@ pub struct ModelEnergy {
 }
 
 /// The model-form spread of one source's energy over a run.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SourceSpread {
     /// Loss source.
     pub source: Source,
@@ -305,8 +307,8 @@ impl SpreadScene {
                 }
             }
             let e = ModelEnergy {
-                model: m.choice,
-                label: label(m.choice),
+                model: m.choice.into(),
+                label: label(m.choice).into(),
                 default: all_default && applies,
                 j: applies.then_some(j),
                 not_applicable: na,
