@@ -471,6 +471,20 @@ fn drive(
             ),
         });
     }
+    if let Some(c) = scene.thermal.controls.iter().find(|c| c.is_pi()) {
+        return Err(NumericalFailure {
+            time: first.t0,
+            node: scene.thermal.names[c.sensor].clone(),
+            item: None,
+            message: format!(
+                "controller {} is a PI valve: its integral is a state the node temperatures \
+                 depend on, and the sensitivity integrator carries the node temperatures alone \
+                 (not implemented); a calibration cannot fit through it — give the cooler a \
+                 proportional valve or no controller to compute sensitivities",
+                c.name
+            ),
+        });
+    }
     let mut r = Tangent::new(scene, dirs, first, opts.initial.as_deref());
     let mut out = SensitivityTrajectory {
         times: Vec::with_capacity(segments.len() + 1),
