@@ -129,7 +129,9 @@ impl CoolerTerm {
 
     /// Opening x, dx/dT_hot, dx/dT_sensor and dx/dI (a PI valve's integral) of its controller
     /// at node temperatures `temps` with hot and cold sides `th`, `tc`, the controllers' modes
-    /// and integrals in `work`.
+    /// and integrals in `work`. A two-way exchanger is fully open while its cold side is the
+    /// warmer one (it heats the oil), whatever its controller: a bypass valve or a fan throttles
+    /// the cooling direction only, as a thermostat does.
     #[inline]
     fn opening_controlled(
         &self,
@@ -140,6 +142,7 @@ impl CoolerTerm {
         tc: f64,
     ) -> (f64, f64, f64, f64) {
         match self.control {
+            Some(_) if self.two_way && tc > th => (1.0, 0.0, 0.0, 0.0),
             Some(c) => {
                 let k = &controls[c];
                 let (x, dxs, dxi) = k.share(work.mode[c], temps[k.sensor], work.integ[c]);
