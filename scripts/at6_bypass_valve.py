@@ -35,7 +35,7 @@ def variant_text() -> str:
 
 def run(model: pathlib.Path, out: pathlib.Path, extra: list[str]) -> dict:
     cmd = [str(BIN), "run", str(model), "--cycle", "wltc", "--out", str(out), "--quiet", *extra]
-    subprocess.run(cmd, check=True)
+    subprocess.run(cmd, check=True, capture_output=True)
     return json.loads((out / "summary.json").read_text(encoding="utf-8"))
 
 

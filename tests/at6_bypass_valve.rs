@@ -10,8 +10,9 @@ use geartherm::model;
 use geartherm::physics::oil::KELVIN_OFFSET;
 use geartherm::solve::transient::{energy_balance, integrate, Method, Segment, TransientOptions};
 
-mod common;
-use common::wall::wltc_scene;
+#[path = "common/wall.rs"]
+mod wall;
+use wall::wltc_scene;
 
 /// The variant's model text: the bypass-valve block in place of the `atf_cooler` block.
 fn variant() -> model::Gearbox {
