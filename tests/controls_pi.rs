@@ -360,3 +360,24 @@ fn jacobian_with_the_integral_column_matches_products_and_differences() {
     assert!((dense[row] - GAIN / TI).abs() < 1e-15);
     assert!(worst < 1e-12, "assembled vs products {worst}");
 }
+
+/// The sensitivity integrator carries the node temperatures alone: a scene with a PI valve is
+/// refused, naming the controller, rather than return a Jacobian without its integral.
+#[test]
+fn sensitivities_refuse_a_pi_valve() {
+    use geartherm::solve::sensitivity::{integrate_sensitivities, SensitivityOptions};
+    let (scene, inputs, _, _) = pi_scene(0.0, 1.0);
+    let opts = SensitivityOptions {
+        rtol: 1e-8,
+        atol: 1e-8,
+        max_steps: 1_000_000,
+        initial: None,
+    };
+    let err = integrate_sensitivities(&scene, &[], &uniform(inputs, 4, 50.0), &opts).unwrap_err();
+    assert!(
+        err.message.contains("controller bypass is a PI valve"),
+        "{}",
+        err.message
+    );
+    assert!(err.message.contains("cannot fit through it"), "{}", err.message);
+}

@@ -458,19 +458,6 @@ fn drive(
         item: None,
         message: "empty input: no segment to integrate".into(),
     })?;
-    if let Some(c) = scene.thermal.controls.iter().find(|c| c.has_min_time()) {
-        return Err(NumericalFailure {
-            time: first.t0,
-            node: scene.thermal.names[c.sensor].clone(),
-            item: None,
-            message: format!(
-                "controller {} has a minimum on or off time: the sensitivities do not carry the \
-                 switching instants across the end of a minimum time (not implemented); give it \
-                 no min_on_s or min_off_s to compute sensitivities",
-                c.name
-            ),
-        });
-    }
     if let Some(c) = scene.thermal.controls.iter().find(|c| c.is_pi()) {
         return Err(NumericalFailure {
             time: first.t0,
