@@ -328,3 +328,128 @@ fn hostile_minimum_times_are_refused() {
     assert_eq!(code, 0, "{err}");
     assert!(written);
 }
+
+fn pi_valve(extra: &str) -> String {
+    format!(
+        "[[thermal.controls]]\nname = \"bypass\"\nkind = \"pi_valve\"\nsensor = \"oil\"\n\
+         cooler = \"fan_cooler\"\n{extra}\n"
+    )
+}
+
+/// PI valve: a valid one runs and writes its integral column and its time at the limits; every
+/// value checked with its key path and range (set point in the oil's range, gain and integral
+/// time positive, min below max within [0, 1], the initial integral within them), keys of
+/// other kinds refused, the set point and gain required.
+#[test]
+fn pi_valve_values_are_checked() {
+    let ok = pi_valve("set_c = 80.0\ngain_per_k = 0.05\nintegral_time_s = 300.0");
+    let d = tempfile::tempdir().unwrap();
+    let m = model_with(d.path(), &ok);
+    let c = d.path().join("c.csv");
+    std::fs::write(&c, CYCLE).unwrap();
+    let out = d.path().join("out");
+    let o = bin()
+        .args(["run", m.to_str().unwrap(), "--cycle", c.to_str().unwrap()])
+        .args(["--out", out.to_str().unwrap(), "--quiet"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let ts = std::fs::read_to_string(out.join("timeseries.csv")).unwrap();
+    let header = ts.lines().next().unwrap();
+    assert!(
+        header.ends_with(",control_bypass,control_bypass_integral"),
+        "{header}"
+    );
+    let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    for key in ["time_at_lower_limit_s", "time_at_upper_limit_s", "integral_final"] {
+        assert!(summary.contains(key), "summary lacks {key}");
+    }
+    let base = "set_c = 80.0\ngain_per_k = 0.05\nintegral_time_s = 300.0";
+    for (extra, path, reason) in [
+        (
+            "set_c = 250.0\ngain_per_k = 0.05\nintegral_time_s = 300.0",
+            "set_c",
+            "must lie in",
+        ),
+        (
+            "set_c = nan\ngain_per_k = 0.05\nintegral_time_s = 300.0",
+            "set_c",
+            "",
+        ),
+        (
+            "set_c = 80.0\ngain_per_k = 0.0\nintegral_time_s = 300.0",
+            "gain_per_k",
+            "must lie in (0, 100]",
+        ),
+        (
+            "set_c = 80.0\ngain_per_k = -1.0\nintegral_time_s = 300.0",
+            "gain_per_k",
+            "1/K",
+        ),
+        (
+            "set_c = 80.0\ngain_per_k = inf\nintegral_time_s = 300.0",
+            "gain_per_k",
+            "must lie in",
+        ),
+        (
+            "set_c = 80.0\ngain_per_k = 0.05\nintegral_time_s = 0.0",
+            "integral_time_s",
+            "must lie in (0,",
+        ),
+        (
+            "set_c = 80.0\ngain_per_k = 0.05\nintegral_time_s = nan",
+            "integral_time_s",
+            "must lie in",
+        ),
+        ("set_c = 80.0\nintegral_time_s = 300.0", "gain_per_k", "required"),
+        ("gain_per_k = 0.05\nintegral_time_s = 300.0", "set_c", "required"),
+        (
+            &format!("{base}\nmin_share = 0.6\nmax_share = 0.4"),
+            "max_share",
+            "must be above min_share",
+        ),
+        (
+            &format!("{base}\nmax_share = 1.5"),
+            "max_share",
+            "must lie in [0, 1]",
+        ),
+        (
+            &format!("{base}\nmin_share = 0.2\ninitial_share = 0.1"),
+            "initial_share",
+            "min_share to max_share",
+        ),
+        (
+            &format!("{base}\nopen_c = 90.0"),
+            "open_c",
+            "not a key of a pi_valve controller",
+        ),
+        (
+            &format!("{base}\non_c = 90.0"),
+            "on_c",
+            "not a key of a pi_valve controller",
+        ),
+        (
+            &format!("{base}\nmin_on_s = 10.0"),
+            "min_on_s",
+            "not a key of a pi_valve controller",
+        ),
+    ] {
+        refused(&pi_valve(extra), &format!("thermal.controls[0].{path}"), reason);
+    }
+    // Without a cooler.
+    let none = "[[thermal.controls]]\nname = \"bypass\"\nkind = \"pi_valve\"\nsensor = \"oil\"\n\
+                set_c = 80.0\ngain_per_k = 0.05\nintegral_time_s = 300.0\n";
+    refused(
+        none,
+        "thermal.controls[0].cooler",
+        "a valve needs the cooler it bypasses",
+    );
+    // A valve key on a proportional valve.
+    let v = "[[thermal.controls]]\nname = \"valve\"\nkind = \"valve\"\nsensor = \"oil\"\n\
+             closed_c = 70.0\nopen_c = 80.0\ngain_per_k = 0.1\ncooler = \"fan_cooler\"\n";
+    refused(
+        v,
+        "thermal.controls[0].gain_per_k",
+        "not a key of a valve controller",
+    );
+}

@@ -181,10 +181,25 @@ sensor = "oil"
 on_c = 20.0
 off_c = 30.0
 heater_w = 300.0
+[[thermal.coolers]]
+name = "pi_cooler"
+hot = "oil"
+cold = "ambient"
+effectiveness = 0.5
+capacity_rate_w_per_k = 40.0
+[[thermal.controls]]
+name = "pi"
+kind = "pi_valve"
+sensor = "oil"
+set_c = 60.0
+gain_per_k = 0.05
+integral_time_s = 100.0
+cooler = "pi_cooler"
 "#;
     let gb = model::from_str(&format!("{text}\n{extra}"), std::path::Path::new("m.toml")).unwrap();
     let scene = Scene::compile(&gb).unwrap();
-    assert_eq!(scene.thermal.controls.len(), 3);
+    assert_eq!(scene.thermal.controls.len(), 4);
+    assert!(scene.thermal.integral_row(3).is_some());
     let inputs = Inputs {
         state: 0,
         input_speed: 250.0,
@@ -196,9 +211,12 @@ heater_w = 300.0
     let mut dy = vec![0.0; y.len()];
     let mut jac = vec![0.0; scene.jacobian_pattern().len()];
     let mut g = vec![0.0; scene.switching_count()];
+    let (mut v, mut jv) = (vec![0.0; y.len()], vec![0.0; y.len()]);
     let before = allocs();
     for k in 0..20 {
         y[scene.thermal.oil] += 3.0; // through the valve's band and the set points
+        v[k % y.len()] = 1.0;
+        scene.jvp(k as f64, &y, &v, &mut work, &mut jv);
         scene.rhs(k as f64, &y, &mut work, &mut dy);
         scene.jacobian_values(k as f64, &y, &mut work, &mut jac);
         scene.switching_functions(&y, &work, &mut g);

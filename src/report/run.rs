@@ -137,6 +137,15 @@ pub struct ControlSummary {
     /// Heat moved, J: through its cooler or links (positive from the hot/first end), or its
     /// heater's energy.
     pub energy_j: f64,
+    /// A PI valve's time with its share at the lower limit, s (absent for other kinds).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_at_lower_limit_s: Option<f64>,
+    /// A PI valve's time with its share at the upper limit, s (absent for other kinds).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_at_upper_limit_s: Option<f64>,
+    /// A PI valve's integral at the end (share; absent for other kinds).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub integral_final: Option<f64>,
 }
 
 /// The controllers' summaries from the first and last state of `traj`.
@@ -154,6 +163,8 @@ pub fn control_summaries(scene: &Scene, traj: &Trajectory) -> Vec<ControlSummary
         .enumerate()
         .map(|(k, c)| {
             let r = r0 + rows * k;
+            let pi = scene.thermal.integral_row(k);
+            let at = |j: usize| pi.map(|p| y1[p + j] - y0[p + j]);
             ControlSummary {
                 name: c.name.clone(),
                 switches: traj.switches.get(k).copied().unwrap_or(0),
@@ -163,6 +174,9 @@ pub fn control_summaries(scene: &Scene, traj: &Trajectory) -> Vec<ControlSummary
                     0.0
                 },
                 energy_j: y1[r] - y0[r],
+                time_at_lower_limit_s: at(1),
+                time_at_upper_limit_s: at(2),
+                integral_final: pi.map(|p| y1[p]),
             }
         })
         .collect()
@@ -434,6 +448,21 @@ pub fn timeseries(
             }),
         );
     }
+    // A PI valve's integral follows the controllers' shares in the trajectory's control rows.
+    let n = scene.thermal.controls.len();
+    let pis = scene.thermal.controls.iter().filter(|c| c.is_pi());
+    for (j, c) in pis.enumerate() {
+        t.push_num(
+            format!("control_{}_integral", c.name),
+            col(&|k| {
+                traj.controls
+                    .get(k)
+                    .and_then(|x| x.get(n + j))
+                    .copied()
+                    .unwrap_or(f64::NAN)
+            }),
+        );
+    }
     t
 }
 
@@ -575,6 +604,15 @@ impl Summary {
         for c in &self.controls {
             named.push((format!("controls.{}.duty_cycle", c.name), c.duty_cycle));
             named.push((format!("controls.{}.energy_j", c.name), c.energy_j));
+            for (what, v) in [
+                ("time_at_lower_limit_s", c.time_at_lower_limit_s),
+                ("time_at_upper_limit_s", c.time_at_upper_limit_s),
+                ("integral_final", c.integral_final),
+            ] {
+                if let Some(v) = v {
+                    named.push((format!("controls.{}.{what}", c.name), v));
+                }
+            }
         }
         if let Some(l) = &self.launch {
             named.push(("launch.engine_speed_max_rpm".into(), l.engine_speed_max_rpm));

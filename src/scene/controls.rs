@@ -9,6 +9,9 @@
 //! mirror; a valve has `T − lo` (below the lower limit), `T − hi` and `lo − T` (proportional),
 //! `hi − T` (at the upper limit), where the share `(T − closed)/(open − closed)` meets its limits,
 //! each shifted by [`EDGE_BAND`] to the far side.
+//! A PI valve has the same three regions and functions on its signal
+//! `v = gain·(T − set) + I` (the share before its limits, [`ControlTerm::signal`]) instead of
+//! the temperature, the limits `min` and `max` in place of `lo` and `hi`.
 //! An unused function is −1.
 //!
 //! A two-point controller with a minimum on (off) time: while that time since its last switch
@@ -41,6 +44,11 @@ fn dwell_tol(end: f64) -> f64 {
 /// State rows per controller after the boundary-energy quadrature: the energy it moved (J) and
 /// the time integral of its share (s; a two-point controller's time on).
 pub const ROWS_PER_CONTROL: usize = 2;
+
+/// State rows per PI valve after every controller's rows: its integral I (share; a state the
+/// right-hand side depends on) and its time at the lower and at the upper limit (s,
+/// quadratures).
+pub const ROWS_PER_PI: usize = 3;
 
 /// A controller's law, temperatures in K.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -76,6 +84,25 @@ pub enum Law {
         lo: f64,
         /// Temperature where it meets `max`, K.
         hi: f64,
+    },
+    /// PI valve: share `u = clamp(v, min, max)` of the signal `v = gain·(T − set) + I`; the
+    /// integral follows `dI/dt = rate·(T − set) + inv_tt·(u − v)` (back-calculation; the last
+    /// term is zero within the limits).
+    Pi {
+        /// Set point, K.
+        set: f64,
+        /// Proportional gain, 1/K.
+        gain: f64,
+        /// gain / integral time, 1/(K·s).
+        rate: f64,
+        /// 1 / tracking time, 1/s.
+        inv_tt: f64,
+        /// Lowest share.
+        min: f64,
+        /// Highest share.
+        max: f64,
+        /// I at the start.
+        initial: f64,
     },
 }
 
@@ -142,6 +169,22 @@ impl ControlTerm {
                 lo: closed + min * (open - closed),
                 hi: closed + max * (open - closed),
             },
+            ControlLaw::Pi {
+                set,
+                gain,
+                ti,
+                min,
+                max,
+                initial,
+            } => Law::Pi {
+                set,
+                gain,
+                rate: gain / ti,
+                inv_tt: 1.0 / ti,
+                min,
+                max,
+                initial,
+            },
         };
         let (action, off_fraction) = match &c.target {
             ControlTarget::Cooler { cooler, off_fraction } => {
@@ -170,12 +213,28 @@ impl ControlTerm {
         matches!(self.law, Law::TwoPoint { .. })
     }
 
-    /// The share x the controller applies in `mode` at sensor temperature `t` (K) and dx/dT:
-    /// a two-point controller 1 on, `off_fraction` off; a valve its limited share.
+    /// True for a PI valve (it has an integral in the state).
+    pub fn is_pi(&self) -> bool {
+        matches!(self.law, Law::Pi { .. })
+    }
+
+    /// The signal the switching functions watch at sensor temperature `t` (K) and integral `i`:
+    /// a PI valve's `gain·(t − set) + i`, else the temperature.
     #[inline]
-    pub fn share(&self, mode: u8, t: f64) -> (f64, f64) {
+    pub fn signal(&self, t: f64, i: f64) -> f64 {
         match self.law {
-            Law::TwoPoint { .. } => (if mode == 1 { 1.0 } else { self.off_fraction }, 0.0),
+            Law::Pi { set, gain, .. } => gain * (t - set) + i,
+            _ => t,
+        }
+    }
+
+    /// The share x the controller applies in `mode` at sensor temperature `t` (K) and integral
+    /// `i` (PI valves), with dx/dT and dx/dI: a two-point controller 1 on, `off_fraction` off; a
+    /// valve its limited share.
+    #[inline]
+    pub fn share(&self, mode: u8, t: f64, i: f64) -> (f64, f64, f64) {
+        match self.law {
+            Law::TwoPoint { .. } => (if mode == 1 { 1.0 } else { self.off_fraction }, 0.0, 0.0),
             Law::Valve {
                 closed,
                 open,
@@ -183,13 +242,63 @@ impl ControlTerm {
                 max,
                 ..
             } => match mode {
-                0 => (min, 0.0),
-                2 => (max, 0.0),
+                0 => (min, 0.0, 0.0),
+                2 => (max, 0.0, 0.0),
                 _ => {
                     let w = 1.0 / (open - closed);
-                    ((t - closed) * w, w)
+                    ((t - closed) * w, w, 0.0)
                 }
             },
+            Law::Pi { min, max, gain, .. } => match mode {
+                0 => (min, 0.0, 0.0),
+                2 => (max, 0.0, 0.0),
+                _ => (self.signal(t, i), gain, 1.0),
+            },
+        }
+    }
+
+    /// A PI valve's dI/dt at sensor temperature `t` (K) and integral `i` in `mode`, and its
+    /// derivatives in T and I: `rate·(t − set)` between the limits, plus `inv_tt·(u − v)` at a
+    /// limit u (back-calculation: with the tracking time equal to the integral time this is
+    /// `(u − i)/ti`, the integral relaxing to the limit); 0 for the other kinds.
+    #[inline]
+    pub fn integral_rate(&self, mode: u8, t: f64, i: f64) -> (f64, f64, f64) {
+        let Law::Pi {
+            set,
+            gain,
+            rate,
+            inv_tt,
+            min,
+            max,
+            ..
+        } = self.law
+        else {
+            return (0.0, 0.0, 0.0);
+        };
+        let e = rate * (t - set);
+        match mode {
+            1 => (e, rate, 0.0),
+            _ => {
+                let u = if mode == 0 { min } else { max };
+                let v = self.signal(t, i);
+                (e + inv_tt * (u - v), rate - inv_tt * gain, -inv_tt)
+            }
+        }
+    }
+
+    /// A PI valve's integral at the start (0 for the other kinds).
+    pub fn initial_integral(&self) -> f64 {
+        match self.law {
+            Law::Pi { initial, .. } => initial,
+            _ => 0.0,
+        }
+    }
+
+    /// A PI valve's proportional gain, 1/K (0 for the other kinds).
+    pub fn gain(&self) -> f64 {
+        match self.law {
+            Law::Pi { gain, .. } => gain,
+            _ => 0.0,
         }
     }
 
@@ -216,8 +325,9 @@ impl ControlTerm {
             .is_some_and(|end| time < end - 2.0 * dwell_tol(end))
     }
 
-    /// The switching functions in `mode` at time `time` (s) and sensor temperature `t` (K), the
-    /// last switch at `last` (s), into `g`: within a minimum time its end as a time event.
+    /// The switching functions in `mode` at time `time` (s) and signal `t` ([`Self::signal`]:
+    /// the sensor temperature, K, or a PI valve's signal), the last switch at `last` (s), into
+    /// `g`: within a minimum time its end as a time event.
     #[inline]
     pub fn events_at(&self, mode: u8, time: f64, last: f64, t: f64, g: &mut [f64]) {
         if let Some(end) = self.dwell_end(mode, last) {
@@ -231,8 +341,8 @@ impl ControlTerm {
         self.events(mode, t, g);
     }
 
-    /// The switching functions in `mode` at sensor temperature `t` (K) into `g`, minimum times
-    /// aside.
+    /// The switching functions in `mode` at signal `t` ([`Self::signal`]) into `g`, minimum
+    /// times aside.
     #[inline]
     pub fn events(&self, mode: u8, t: f64, g: &mut [f64]) {
         let (a, b) = match self.law {
@@ -245,7 +355,7 @@ impl ControlTerm {
                 };
                 (g, -1.0)
             }
-            Law::Valve { lo, hi, .. } => match mode {
+            Law::Valve { lo, hi, .. } | Law::Pi { min: lo, max: hi, .. } => match mode {
                 0 => (t - (lo + EDGE_BAND), -1.0),
                 1 => (t - (hi + EDGE_BAND), (lo - EDGE_BAND) - t),
                 _ => (-1.0, (hi - EDGE_BAND) - t),
@@ -259,7 +369,7 @@ impl ControlTerm {
     pub fn flip(&self, mode: u8, slot: usize) -> u8 {
         match self.law {
             Law::TwoPoint { .. } => 1 - mode.min(1),
-            Law::Valve { .. } => {
+            Law::Valve { .. } | Law::Pi { .. } => {
                 if slot == 0 {
                     (mode + 1).min(2)
                 } else {
@@ -269,7 +379,7 @@ impl ControlTerm {
         }
     }
 
-    /// The mode at the start at sensor temperature `t` (K): a two-point controller as given,
+    /// The mode at the start at signal `t` ([`Self::signal`]): a two-point controller as given,
     /// else on when `t` lies beyond the switch-on temperature; a valve by where `t` lies.
     pub fn initial_mode(&self, t: f64) -> u8 {
         match self.law {
@@ -282,7 +392,7 @@ impl ControlTerm {
                 let beyond = if cooling { t >= on } else { t <= on };
                 u8::from(initial_on.unwrap_or(beyond))
             }
-            Law::Valve { lo, hi, .. } => {
+            Law::Valve { lo, hi, .. } | Law::Pi { min: lo, max: hi, .. } => {
                 if t < lo {
                     0
                 } else if t > hi {
@@ -294,7 +404,7 @@ impl ControlTerm {
         }
     }
 
-    /// A mode in which no switching function is positive at `t` (the mode after the events
+    /// A mode in which no switching function is positive at signal `t` (the mode after the events
     /// that are due at this point; unchanged when none is): flips while one is, minimum times
     /// aside.
     pub fn settle(&self, mode: u8, t: f64) -> u8 {

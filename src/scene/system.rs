@@ -110,6 +110,8 @@ pub struct Work {
     /// do (the finite-difference oil column starts from it instead of evaluating it again).
     base: Option<(u64, u64)>,
     base_y: Vec<f64>,
+    /// The controllers' integrals at that point.
+    base_integ: Vec<f64>,
     base_to_b: f64,
     /// Right-hand-side evaluations.
     pub rhs_evals: usize,
@@ -123,7 +125,9 @@ impl Work {
     /// True when `heat`, `q` and `base_to_b` hold the heat balance of the last right-hand side
     /// and it was evaluated at time `t`, node temperatures `temps` and the current sample.
     fn holds_rhs_at(&self, t: f64, temps: &[f64]) -> bool {
-        self.base == Some((t.to_bits(), self.sample_id)) && self.base_y == temps
+        self.base == Some((t.to_bits(), self.sample_id))
+            && self.base_y == temps
+            && self.base_integ == self.net.integ
     }
 }
 
@@ -144,6 +148,24 @@ impl Scene {
     pub fn with_initial(mut self, initial: Vec<f64>) -> Scene {
         self.thermal.initial = initial;
         self
+    }
+
+    /// This scene with PI valve `k`'s share held at its integral (gain 0, no integration): the
+    /// steady state's search for the share at which the sensor sits at the set point
+    /// (`solve::equilibrium`). Other controllers unchanged.
+    pub fn with_pi_share_held(&self, k: usize) -> Scene {
+        let mut s = self.clone();
+        if let Some(c) = s.thermal.controls.get_mut(k) {
+            if let super::controls::Law::Pi {
+                gain, rate, inv_tt, ..
+            } = &mut c.law
+            {
+                *gain = 0.0;
+                *rate = 0.0;
+                *inv_tt = 0.0;
+            }
+        }
+        s
     }
 
     /// The temperature the oil properties are frozen at (K), when the scenario freezes them.
@@ -184,6 +206,8 @@ impl Scene {
         } else {
             ((0..losses.len()).collect(), losses.len())
         };
+        let n = thermal.len();
+        thermal.set_pi_row0(n + energies + 1 + thermal.control_rows());
         Ok(Scene {
             losses,
             thermal,
@@ -218,7 +242,7 @@ impl Scene {
 
     /// Length of the state vector.
     pub fn n_states(&self) -> usize {
-        self.nodes() + self.energies + 1 + self.thermal.control_rows()
+        self.nodes() + self.energies + 1 + self.thermal.control_rows() + self.thermal.pi_rows()
     }
 
     /// Index of the first controller row in the state (each controller has
@@ -242,8 +266,7 @@ impl Scene {
     /// The controllers' switching functions at time `t` (s) and state `y` into `g`: a
     /// controller within its minimum on or off time has the time event of its end.
     pub fn switching_functions_at(&self, t: f64, y: &[f64], work: &Work, g: &mut [f64]) {
-        self.thermal
-            .switching_functions(t, &y[..self.nodes()], &work.net, g);
+        self.thermal.switching_functions(t, y, &work.net, g);
     }
 
     /// True when switching function `idx` at time `t` (s) is the end of a controller's minimum
@@ -302,7 +325,8 @@ impl Scene {
     pub fn settle_controls_at(&self, t: f64, y: &[f64], work: &mut Work) -> bool {
         let mut changed = false;
         for (k, c) in self.thermal.controls.iter().enumerate() {
-            let m = c.settle_at(work.net.mode[k], t, work.net.last_switch[k], y[c.sensor]);
+            let s = self.thermal.signal_in(k, y);
+            let m = c.settle_at(work.net.mode[k], t, work.net.last_switch[k], s);
             if m != work.net.mode[k] && t.is_finite() {
                 work.net.last_switch[k] = t;
             }
@@ -320,7 +344,7 @@ impl Scene {
     /// Set every controller's mode from the initial state `y` (as a fresh work area does).
     pub fn initial_control_modes(&self, y: &[f64], work: &mut Work) {
         for (k, c) in self.thermal.controls.iter().enumerate() {
-            let m = c.initial_mode(y[c.sensor]);
+            let m = c.initial_mode(self.thermal.signal_in(k, y));
             self.set_control_mode(k, m, work);
             work.net.switches[k] = 0;
             work.net.last_switch[k] = f64::NEG_INFINITY;
@@ -366,6 +390,11 @@ impl Scene {
         for (x, t) in y.iter_mut().zip(&self.thermal.initial) {
             *x = initial_temp.unwrap_or(*t);
         }
+        for (k, c) in self.thermal.controls.iter().enumerate() {
+            if let Some(r) = self.thermal.integral_row(k) {
+                y[r] = c.initial_integral();
+            }
+        }
         y
     }
 
@@ -393,6 +422,7 @@ impl Scene {
             sample_id: 0,
             base: None,
             base_y: vec![0.0; n],
+            base_integ: vec![0.0; self.thermal.controls.len()],
             base_to_b: 0.0,
             rhs_evals: 0,
             jac_evals: 0,
@@ -492,6 +522,7 @@ impl Scene {
         work.rhs_evals += 1;
         let n = self.nodes();
         self.thermal.boundary_temperatures(t, &mut work.net);
+        self.thermal.load_integrals(y, &mut work.net);
         let t_oil = self.oil_temp(y);
         let to_b = self.heat_balance_in(y, t_oil, work, false);
         for ((d, h), c) in dy.iter_mut().zip(&work.heat).zip(&self.thermal.capacity) {
@@ -499,6 +530,7 @@ impl Scene {
         }
         work.base = Some((t.to_bits(), work.sample_id));
         work.base_y.copy_from_slice(&y[..n]);
+        work.base_integ.copy_from_slice(&work.net.integ);
         work.base_to_b = to_b;
         let e = self.energies;
         dy[n..n + e].iter_mut().for_each(|x| *x = 0.0);
@@ -547,13 +579,14 @@ impl Scene {
         let n = self.nodes();
         work.base = None;
         self.thermal.boundary_temperatures(t, &mut work.net);
+        self.thermal.load_integrals(y, &mut work.net);
         let oil_i = self.thermal.oil;
         let t_oil = self.oil_temp(y);
         let (oil, slopes) = self.thermal.oil_properties_and_slopes(t_oil);
         self.oil_link_state(oil, &slopes, work, false);
         let to_b = self
             .thermal
-            .network_heat_jvp(&y[..n], &work.oil_g, &work.net, &v[..n], &mut work.heat);
+            .network_heat_jvp(&y[..n], &work.oil_g, &work.net, v, &mut work.heat);
         for ((o, h), c) in out.iter_mut().zip(&work.heat).zip(&self.thermal.capacity) {
             *o = h / c;
         }
@@ -561,7 +594,7 @@ impl Scene {
         out[n..n + e].iter_mut().for_each(|x| *x = 0.0);
         out[n + e] = to_b;
         self.thermal
-            .control_rate_derivative(&y[..n], &work.net, Some(&v[..n]), None, &mut out[n + e + 1..]);
+            .control_rate_derivative(&y[..n], &work.net, Some(v), None, &mut out[n + e + 1..]);
         if self.frozen_oil_temp.is_some() || v[oil_i] == 0.0 {
             return;
         }
@@ -667,6 +700,7 @@ impl Scene {
     /// this point), false when they were computed into `work.oil_g2`.
     fn oil_conductances_at(&self, t: f64, y: &[f64], work: &mut Work) -> bool {
         self.thermal.boundary_temperatures(t, &mut work.net);
+        self.thermal.load_integrals(y, &mut work.net);
         if work.holds_rhs_at(t, &y[..self.nodes()]) {
             return true;
         }
@@ -846,6 +880,7 @@ impl Scene {
     pub fn net_heat(&self, t: f64, y: &[f64], work: &mut Work, heat: &mut [f64]) -> f64 {
         work.base = None;
         self.thermal.boundary_temperatures(t, &mut work.net);
+        self.thermal.load_integrals(y, &mut work.net);
         let t_oil = self.oil_temp(y);
         let to_b = self.heat_balance_in(y, t_oil, work, false);
         heat.copy_from_slice(&work.heat);

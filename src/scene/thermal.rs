@@ -15,7 +15,7 @@ use crate::physics::thermal::{
     thermostat_opening, FluidProperties, HTable, AIR_50C, OIL_CONDUCTIVITY, OIL_SPECIFIC_HEAT,
 };
 
-use super::controls::{Action, ControlTerm, EVENTS_PER_CONTROL, ROWS_PER_CONTROL};
+use super::controls::{Action, ControlTerm, EVENTS_PER_CONTROL, ROWS_PER_CONTROL, ROWS_PER_PI};
 use super::items::{DefaultHeat, LossItem};
 
 /// Endpoint of a compiled link: a state (capacity node) or a boundary.
@@ -127,26 +127,30 @@ impl CoolerTerm {
             .map_or((1.0, 0.0), |(a, b)| thermostat_opening(th, a, b))
     }
 
-    /// Opening x, dx/dT_hot and dx/dT_sensor of its controller (whose sensor is `sensor`, 0
-    /// without one) at node temperatures `temps` with hot and cold sides `th`, `tc`.
+    /// Opening x, dx/dT_hot, dx/dT_sensor and dx/dI (a PI valve's integral) of its controller
+    /// at node temperatures `temps` with hot and cold sides `th`, `tc`, the controllers' modes
+    /// and integrals in `work`. A two-way exchanger is fully open while its cold side is the
+    /// warmer one (it heats the oil), whatever its controller: a bypass valve or a fan throttles
+    /// the cooling direction only, as a thermostat does.
     #[inline]
     fn opening_controlled(
         &self,
         controls: &[ControlTerm],
-        mode: &[u8],
+        work: &NetworkWork,
         temps: &[f64],
         th: f64,
         tc: f64,
-    ) -> (f64, f64, f64) {
+    ) -> (f64, f64, f64, f64) {
         match self.control {
+            Some(_) if self.two_way && tc > th => (1.0, 0.0, 0.0, 0.0),
             Some(c) => {
                 let k = &controls[c];
-                let (x, dx) = k.share(mode[c], temps[k.sensor]);
-                (x, 0.0, dx)
+                let (x, dxs, dxi) = k.share(work.mode[c], temps[k.sensor], work.integ[c]);
+                (x, 0.0, dxs, dxi)
             }
             None => {
                 let (x, dx) = self.opening(th, tc);
-                (x, dx, 0.0)
+                (x, dx, 0.0, 0.0)
             }
         }
     }
@@ -192,6 +196,11 @@ pub struct ThermalScene {
     coolers: Vec<CoolerTerm>,
     /// Controllers.
     pub controls: Vec<ControlTerm>,
+    /// Per controller: its index among the PI valves, when it is one.
+    pi_slot: Vec<Option<usize>>,
+    /// State row of the first PI valve's rows ([`ROWS_PER_PI`] each: its integral, time at the
+    /// lower and at the upper limit), set by the scene that lays out the state.
+    pi_row0: usize,
     /// The thermostats' opening and fully-open temperatures as switching surfaces: no mode
     /// changes the right-hand side there, but the opening's second derivative jumps (from zero
     /// to the band's), so a step across one would integrate as if the band were not there; the
@@ -222,6 +231,9 @@ pub struct NetworkWork {
     /// Time of every controller's last switch, s (−∞ before the first): the start of its
     /// minimum on or off time.
     pub last_switch: Vec<f64>,
+    /// Every controller's integral (a PI valve's I, 0 for the others) at the state being
+    /// evaluated: the scene copies it from the state before each evaluation.
+    pub integ: Vec<f64>,
 }
 
 /// The oil as the fluid of the rotating-disc correlation (Pr = μ·c_p/k).
@@ -538,6 +550,16 @@ impl ThermalScene {
         links.oil.extend(advection_links(gb, net));
         let mut coolers = cooler_terms(net);
         let controls = compile_controls(net, &mut coolers, &mut links);
+        let mut n_pi = 0;
+        let pi_slot = controls
+            .iter()
+            .map(|c| {
+                c.is_pi().then(|| {
+                    n_pi += 1;
+                    n_pi - 1
+                })
+            })
+            .collect();
         debug_assert!(net.oil_node < n);
         let mut scene = ThermalScene {
             names: net.nodes.iter().map(|x| x.name.clone()).collect(),
@@ -556,6 +578,8 @@ impl ThermalScene {
             kinks: thermostat_kinks(&coolers),
             coolers,
             controls,
+            pi_slot,
+            pi_row0: n,
             oil_model: gb.oil.clone(),
             advection_cp: net.nodes[net.oil_node].specific_heat.unwrap_or(OIL_SPECIFIC_HEAT),
             fixed_partials: Vec::new(),
@@ -600,10 +624,11 @@ impl ThermalScene {
             mode: self
                 .controls
                 .iter()
-                .map(|c| c.initial_mode(self.initial[c.sensor]))
+                .map(|c| c.initial_mode(c.signal(self.initial[c.sensor], c.initial_integral())))
                 .collect(),
             switches: vec![0; self.controls.len()],
             last_switch: vec![f64::NEG_INFINITY; self.controls.len()],
+            integ: self.controls.iter().map(ControlTerm::initial_integral).collect(),
             kink_mode: self
                 .kinks
                 .iter()
@@ -647,7 +672,7 @@ impl ThermalScene {
         for (g, l) in work.sample_g.iter_mut().zip(&self.sample) {
             let x = l
                 .control
-                .map_or(1.0, |c| self.controls[c].share(work.mode[c], 0.0).0);
+                .map_or(1.0, |c| self.controls[c].share(work.mode[c], 0.0, 0.0).0);
             *g = x * match &l.law {
                 SampleLaw::Fixed(g) => *g,
                 SampleLaw::Table { area, table } => area * table.at(op.vehicle_speed),
@@ -737,7 +762,7 @@ impl ThermalScene {
         for c in &self.coolers {
             let th = temps[c.hot];
             let tc = Self::temp(c.cold, temps, bt);
-            let x = c.opening_controlled(&self.controls, &work.mode, temps, th, tc).0;
+            let x = c.opening_controlled(&self.controls, work, temps, th, tc).0;
             let q = c.g * x * (th - tc);
             Self::flow(End::Node(c.hot), c.cold, q, heat, &mut to_b);
         }
@@ -757,10 +782,50 @@ impl ThermalScene {
         self.controls.len() * ROWS_PER_CONTROL
     }
 
-    /// Switching functions of every controller at time `time` (s) and node temperatures
-    /// `temps` in the work area's modes into `g` ([`EVENTS_PER_CONTROL`] each); `time` = +∞
-    /// leaves the minimum times aside.
-    pub fn switching_functions(&self, time: f64, temps: &[f64], work: &NetworkWork, g: &mut [f64]) {
+    /// Rows of the PI valves in the state (after the controllers' rows).
+    pub fn pi_rows(&self) -> usize {
+        self.pi_slot.iter().flatten().count() * ROWS_PER_PI
+    }
+
+    /// Lay the PI valves' rows out from state row `row` on (the scene's layout).
+    pub(crate) fn set_pi_row0(&mut self, row: usize) {
+        self.pi_row0 = row;
+    }
+
+    /// State row of controller `k`'s integral, when it is a PI valve.
+    #[inline]
+    pub fn integral_row(&self, k: usize) -> Option<usize> {
+        self.pi_slot[k].map(|j| self.pi_row0 + ROWS_PER_PI * j)
+    }
+
+    /// Controller `k`'s integral in the state `y` (0 when it is not a PI valve).
+    #[inline]
+    pub fn integral_in(&self, k: usize, y: &[f64]) -> f64 {
+        self.integral_row(k).map_or(0.0, |r| y[r])
+    }
+
+    /// Copy the PI valves' integrals of the state `y` into the work area.
+    #[inline]
+    pub fn load_integrals(&self, y: &[f64], work: &mut NetworkWork) {
+        for (k, x) in work.integ.iter_mut().enumerate() {
+            if let Some(r) = self.integral_row(k) {
+                *x = y[r];
+            }
+        }
+    }
+
+    /// Controller `k`'s signal ([`ControlTerm::signal`]) in the state `y`.
+    #[inline]
+    pub fn signal_in(&self, k: usize, y: &[f64]) -> f64 {
+        let c = &self.controls[k];
+        c.signal(y[c.sensor], self.integral_in(k, y))
+    }
+
+    /// Switching functions of every controller at time `time` (s) and state `y` (node
+    /// temperatures first, the PI valves' integrals at their rows) in the work area's modes into
+    /// `g` ([`EVENTS_PER_CONTROL`] each); `time` = +∞ leaves the minimum times aside.
+    pub fn switching_functions(&self, time: f64, y: &[f64], work: &NetworkWork, g: &mut [f64]) {
+        let temps = y;
         let nc = self.controls.len();
         let (gc, gk) = g.split_at_mut(nc * EVENTS_PER_CONTROL);
         for (k, (c, g)) in self
@@ -769,7 +834,7 @@ impl ThermalScene {
             .zip(gc.chunks_exact_mut(EVENTS_PER_CONTROL))
             .enumerate()
         {
-            c.events_at(work.mode[k], time, work.last_switch[k], temps[c.sensor], g);
+            c.events_at(work.mode[k], time, work.last_switch[k], self.signal_in(k, y), g);
         }
         for ((c, &m), g) in self
             .kinks
@@ -782,12 +847,21 @@ impl ThermalScene {
     }
 
     /// The rates of the controllers' rows at `temps`: per controller the heat it moves (W: its
-    /// cooler's or links' heat flow, its heater's power) and its share (on = 1).
+    /// cooler's or links' heat flow, its heater's power) and its share (on = 1); then per PI
+    /// valve dI/dt and its indicators at the lower and the upper limit.
     pub fn control_rates(&self, temps: &[f64], work: &NetworkWork, out: &mut [f64]) {
         out.iter_mut().for_each(|x| *x = 0.0);
         let bt = &work.boundary_t;
+        let base = self.control_rows();
         for (k, c) in self.controls.iter().enumerate() {
-            let (x, _) = c.share(work.mode[k], temps[c.sensor]);
+            let m = work.mode[k];
+            if let Some(j) = self.pi_slot[k] {
+                let r = base + ROWS_PER_PI * j;
+                out[r] = c.integral_rate(m, temps[c.sensor], work.integ[k]).0;
+                out[r + 1] = f64::from(u8::from(m == 0));
+                out[r + 2] = f64::from(u8::from(m == 2));
+            }
+            let (x, _, _) = c.share(m, temps[c.sensor], work.integ[k]);
             // Time on: a two-point controller's on-indicator (its share while off is not time
             // on), a valve's share.
             out[ROWS_PER_CONTROL * k + 1] = if c.is_two_point() {
@@ -803,7 +877,7 @@ impl ThermalScene {
             if let Some(k) = c.control {
                 let th = temps[c.hot];
                 let tc = Self::temp(c.cold, temps, bt);
-                let x = c.opening_controlled(&self.controls, &work.mode, temps, th, tc).0;
+                let x = c.opening_controlled(&self.controls, work, temps, th, tc).0;
                 out[ROWS_PER_CONTROL * k] = c.g * x * (th - tc);
             }
         }
@@ -823,21 +897,32 @@ impl ThermalScene {
         add: &mut impl FnMut(usize, usize, f64),
     ) {
         let bt = &work.boundary_t;
+        let base = self.control_rows();
         for (k, c) in self.controls.iter().enumerate() {
-            let (_, dx) = c.share(work.mode[k], temps[c.sensor]);
+            let (_, dx, dxi) = c.share(work.mode[k], temps[c.sensor], work.integ[k]);
             add(ROWS_PER_CONTROL * k + 1, c.sensor, dx);
+            if let (Some(j), Some(col)) = (self.pi_slot[k], self.integral_row(k)) {
+                let r = base + ROWS_PER_PI * j;
+                add(ROWS_PER_CONTROL * k + 1, col, dxi);
+                let (_, ds, di) = c.integral_rate(work.mode[k], temps[c.sensor], work.integ[k]);
+                add(r, c.sensor, ds);
+                add(r, col, di);
+            }
         }
         for c in &self.coolers {
             if let Some(k) = c.control {
                 let th = temps[c.hot];
                 let tc = Self::temp(c.cold, temps, bt);
-                let (x, _, dxs) = c.opening_controlled(&self.controls, &work.mode, temps, th, tc);
+                let (x, _, dxs, dxi) = c.opening_controlled(&self.controls, work, temps, th, tc);
                 let r = ROWS_PER_CONTROL * k;
                 add(r, c.hot, c.g * x);
                 if let End::Node(j) = c.cold {
                     add(r, j, -c.g * x);
                 }
                 add(r, self.controls[k].sensor, c.g * dxs * (th - tc));
+                if let Some(col) = self.integral_row(k) {
+                    add(r, col, c.g * dxi * (th - tc));
+                }
             }
         }
         for (l, g) in self.sample.iter().zip(&work.sample_g) {
@@ -878,7 +963,7 @@ impl ThermalScene {
             if let (Some(k), End::Boundary(_)) = (c.control, c.cold) {
                 let th = temps[c.hot];
                 let tc = Self::temp(c.cold, temps, bt);
-                let x = c.opening_controlled(&self.controls, &work.mode, temps, th, tc).0;
+                let x = c.opening_controlled(&self.controls, work, temps, th, tc).0;
                 out[ROWS_PER_CONTROL * k] -= c.g * x * dv(c.cold);
             }
         }
@@ -1057,7 +1142,7 @@ impl ThermalScene {
         for c in &self.coolers {
             let th = temps[c.hot];
             let tc = Self::temp(c.cold, temps, bt);
-            let (x, dx, dxs) = c.opening_controlled(&self.controls, &work.mode, temps, th, tc);
+            let (x, dx, dxs, dxi) = c.opening_controlled(&self.controls, work, temps, th, tc);
             Self::link_partials(
                 End::Node(c.hot),
                 c.cold,
@@ -1071,13 +1156,20 @@ impl ThermalScene {
                 let s = self.controls[k].sensor;
                 add(End::Node(c.hot), s, -d);
                 add(c.cold, s, d);
+                if let Some(col) = self.integral_row(k) {
+                    // The PI valve's integral column: the share follows it one to one.
+                    let d = c.g * dxi * (th - tc);
+                    add(End::Node(c.hot), col, -d);
+                    add(c.cold, col, d);
+                }
             }
         }
     }
 
-    /// Directional derivative of [`Self::network_heat`] along `v` (K), holding the oil properties
-    /// (the caller adds their T_oil dependence) and the boundary temperatures fixed: W per node
-    /// into `out`; returns the derivative of the boundary heat. Allocation-free.
+    /// Directional derivative of [`Self::network_heat`] along the state direction `v` (K on
+    /// the nodes; the PI valves' integrals at their rows), holding the oil properties (the
+    /// caller adds their T_oil dependence) and the boundary temperatures fixed: W per node into
+    /// `out`; returns the derivative of the boundary heat. Allocation-free.
     pub fn network_heat_jvp(
         &self,
         temps: &[f64],
@@ -1090,7 +1182,8 @@ impl ThermalScene {
             End::Node(i) => v[i],
             End::Boundary(_) => 0.0,
         };
-        self.heat_derivative(temps, oil_g, work, dv, out)
+        let di = |k: usize| self.integral_row(k).map_or(0.0, |r| v[r]);
+        self.heat_derivative(temps, oil_g, work, (dv, di), out)
     }
 
     /// ∂(network heat)/∂t: the response to the boundary temperatures' rates of change in
@@ -1107,17 +1200,17 @@ impl ThermalScene {
             End::Node(_) => 0.0,
             End::Boundary(j) => work.boundary_slope[j],
         };
-        self.heat_derivative(temps, oil_g, work, dv, out)
+        self.heat_derivative(temps, oil_g, work, (dv, |_| 0.0), out)
     }
 
     /// Derivative of [`Self::network_heat`] along the rates `dv` of every end (nodes and
-    /// boundaries), oil properties fixed.
+    /// boundaries) and `di` of every controller's integral, oil properties fixed.
     fn heat_derivative(
         &self,
         temps: &[f64],
         oil_g: &[f64],
         work: &NetworkWork,
-        dv: impl Fn(End) -> f64,
+        (dv, di): (impl Fn(End) -> f64, impl Fn(usize) -> f64),
         out: &mut [f64],
     ) -> f64 {
         out.iter_mut().for_each(|x| *x = 0.0);
@@ -1140,10 +1233,10 @@ impl ThermalScene {
         for c in &self.coolers {
             let th = temps[c.hot];
             let tc = Self::temp(c.cold, temps, bt);
-            let (x, dx, dxs) = c.opening_controlled(&self.controls, &work.mode, temps, th, tc);
-            let ds = c
-                .control
-                .map_or(0.0, |k| dxs * dv(End::Node(self.controls[k].sensor)));
+            let (x, dx, dxs, dxi) = c.opening_controlled(&self.controls, work, temps, th, tc);
+            let ds = c.control.map_or(0.0, |k| {
+                dxs * dv(End::Node(self.controls[k].sensor)) + dxi * di(k)
+            });
             let dq = c.g * ((x + dx * (th - tc)) * dv(End::Node(c.hot)) - x * dv(c.cold) + ds * (th - tc));
             Self::flow(End::Node(c.hot), c.cold, dq, out, &mut to_b);
         }

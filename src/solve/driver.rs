@@ -123,11 +123,14 @@ impl Driver<'_> {
             return;
         }
         let w = self.work.borrow();
+        // The shares, then every PI valve's integral.
         let row: Vec<f64> = th
             .controls
             .iter()
             .zip(&w.net.mode)
-            .map(|(c, &m)| c.share(m, y[c.sensor]).0)
+            .enumerate()
+            .map(|(k, (c, &m))| c.share(m, y[c.sensor], th.integral_in(k, y)).0)
+            .chain((0..th.controls.len()).filter_map(|k| th.integral_row(k).map(|r| y[r])))
             .collect();
         traj.controls.push(&row);
     }

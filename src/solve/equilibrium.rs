@@ -143,8 +143,10 @@ pub fn equilibrium(
     };
     let (solution, limit_cycle) = if scene.thermal.controls.is_empty() {
         (settle_steady(scene, &sys, inputs, &t0, opts)?, None)
+    } else if scene.thermal.pi_rows() > 0 {
+        with_pi(scene, inputs, &t0, opts)?
     } else {
-        controlled(scene, inputs, &t0, opts)?
+        controlled(scene, inputs, &t0, opts, None)?
     };
     let mut y = vec![0.0; scene.n_states()];
     y[..scene.nodes()].copy_from_slice(&solution.temperatures);
@@ -163,14 +165,124 @@ pub fn equilibrium(
     })
 }
 
+/// Temperatures within this of a PI valve's set point end the search for its integral, K.
+const PI_SET_TOL_K: f64 = 1e-9;
+
+/// Most equilibria solved in the search for a PI valve's integral.
+const PI_MAX_ITER: usize = 60;
+
+/// An equilibrium with a PI valve (one per network in a steady state). With its share held at
+/// u ([`Scene::with_pi_share_held`]), the equilibrium ([`controlled`]) gives its sensor's
+/// temperature T(u), which falls as u (the cooler's share) grows. The PI valve's equilibrium
+/// is the u where T(u) = set: its integral stands still only there while the share is within
+/// its limits, and the integral is then u. When T(min) is already at or below the set point,
+/// the valve rests at its lower limit (its integral stands still there, by the anti-windup),
+/// and when T(max) is still above it, at its upper limit: those equilibria are returned. The
+/// root is found by regula falsi (Illinois, [`super::bracket`]) on u.
+fn with_pi(
+    scene: &Scene,
+    inputs: Inputs,
+    t0: &[f64],
+    opts: &SteadyOptions,
+) -> Result<(SteadySolution, Option<super::limit_cycle::LimitCycle>), SteadyError> {
+    use crate::scene::controls::Law;
+    let th = &scene.thermal;
+    let pis: Vec<usize> = (0..th.controls.len())
+        .filter(|&k| th.controls[k].is_pi())
+        .collect();
+    if pis.len() > 1 {
+        return Err(SteadyError::InvalidInput(format!(
+            "{} PI valves: at most one in a steady state",
+            pis.len()
+        )));
+    }
+    let k = pis[0];
+    type Found = (SteadySolution, Option<super::limit_cycle::LimitCycle>);
+    let Law::Pi { set, min, max, .. } = th.controls[k].law else {
+        unreachable!("is_pi");
+    };
+    let sensor = th.controls[k].sensor;
+    let held = scene.with_pi_share_held(k);
+    // The equilibrium at share u and T − set there; a share at which the sensor has no
+    // equilibrium in range is a T − set of ±∞ (too hot, too cold).
+    let solve = |u: f64, start: &[f64]| -> Result<(Option<Found>, f64), SteadyError> {
+        match controlled(&held, inputs, start, opts, Some((k, u))) {
+            Ok(sol) => {
+                let g = sol.0.temperatures[sensor] - set;
+                Ok((Some(sol), g))
+            }
+            Err(SteadyError::NoEquilibriumInRange { which, .. }) => Ok((
+                None,
+                match which {
+                    BoundSide::Upper => f64::INFINITY,
+                    BoundSide::Lower => f64::NEG_INFINITY,
+                },
+            )),
+            Err(e) => Err(e),
+        }
+    };
+    let (lo, g_lo) = solve(min, t0)?;
+    if let Some(lo) = lo.filter(|l| g_lo <= PI_SET_TOL_K || l.1.is_some()) {
+        return Ok(lo);
+    }
+    let start = t0.to_vec();
+    let (hi, g_hi) = solve(max, &start)?;
+    if hi
+        .as_ref()
+        .is_some_and(|h| g_hi >= -PI_SET_TOL_K || h.1.is_some())
+    {
+        return hi.ok_or_else(|| SteadyError::Model("unreachable".into()));
+    }
+    if !(g_lo > 0.0 && g_hi < 0.0) {
+        // No equilibrium at either limit and none between them.
+        return controlled(
+            &held,
+            inputs,
+            t0,
+            opts,
+            Some((k, if g_lo < 0.0 { min } else { max })),
+        );
+    }
+    // g(u) = T(u) − set falls with u: the bracket of −g.
+    let mut br = super::bracket::Bracket::new(min, -g_lo, max, -g_hi);
+    let mut best = hi;
+    for _ in 0..PI_MAX_ITER {
+        let u = br.trial();
+        let from = best.as_ref().map_or(&start, |b| &b.0.temperatures).clone();
+        let (sol, g) = solve(u, &from)?;
+        if sol.is_some() {
+            best = sol;
+        }
+        if let Some(b) = best
+            .as_ref()
+            .filter(|_| g.abs() <= PI_SET_TOL_K || br.b - br.a <= 1e-15)
+        {
+            return Ok(b.clone());
+        }
+        br.update(u, -g);
+    }
+    let Some(best) = best else {
+        return controlled(&held, inputs, t0, opts, Some((k, min)));
+    };
+    let off = best.0.temperatures[sensor] - set;
+    Err(SteadyError::Model(format!(
+        "PI valve {}: {PI_MAX_ITER} equilibria did not bring its sensor to the set point \
+         (last {off:.3e} K off)",
+        th.controls[k].name
+    )))
+}
+
 /// With controllers: the first mode combination of the two-point controllers (the start's
 /// first) whose equilibrium no controller would leave; the valves' regions follow the solution.
-/// None: the limit cycle ([`super::limit_cycle`]).
+/// `fixed`: a PI valve's integral (controller, value) set, the valve in its proportional
+/// region at the start. None: the limit cycle
+/// ([`super::limit_cycle`]).
 fn controlled(
     scene: &Scene,
     inputs: Inputs,
     t0: &[f64],
     opts: &SteadyOptions,
+    fixed: Option<(usize, f64)>,
 ) -> Result<(SteadySolution, Option<super::limit_cycle::LimitCycle>), SteadyError> {
     use super::limit_cycle::{find_limit_cycle, mean_solution, MAX_TWO_POINT};
     let two: Vec<usize> = (0..scene.thermal.controls.len())
@@ -183,8 +295,11 @@ fn controlled(
         )));
     }
     let nc = scene.thermal.controls.len() * crate::scene::controls::EVENTS_PER_CONTROL;
-    let mut y0 = vec![0.0; scene.n_states()];
+    let mut y0 = scene.initial_state(None);
     y0[..t0.len()].copy_from_slice(t0);
+    if let Some(r) = fixed.and_then(|(k, _)| scene.thermal.integral_row(k)) {
+        y0[r] = fixed.map_or(0.0, |f| f.1);
+    }
     let start = scene.work(inputs);
     let first: usize = two
         .iter()
@@ -193,11 +308,15 @@ fn controlled(
         .sum();
     for c in (0..1usize << two.len()).map(|c| c ^ first) {
         let sys = SceneBalance::new(scene, inputs);
+        sys.y.borrow_mut().copy_from_slice(&y0);
         {
             let mut w = sys.work.borrow_mut();
             scene.initial_control_modes(&y0, &mut w);
             for (b, &k) in two.iter().enumerate() {
                 w.net.mode[k] = u8::from(c >> b & 1 == 1);
+            }
+            if let Some((k, _)) = fixed {
+                w.net.mode[k] = 1;
             }
             let m = w.net.mode.clone();
             for (k, x) in m.into_iter().enumerate() {
@@ -208,8 +327,12 @@ fn controlled(
         let mut t = t0.to_vec();
         let mut g = vec![0.0; scene.switching_count()];
         for _ in 0..4 {
-            let Ok(sol) = settle_steady(scene, &sys, inputs, &t, opts) else {
-                break;
+            let sol = match settle_steady(scene, &sys, inputs, &t, opts) {
+                Ok(sol) => sol,
+                // Without two-point controllers nothing can cycle: a node past its range is
+                // the answer.
+                Err(e @ SteadyError::NoEquilibriumInRange { .. }) if two.is_empty() => return Err(e),
+                Err(_) => break,
             };
             let mut y = y0.clone();
             y[..sol.temperatures.len()].copy_from_slice(&sol.temperatures);
@@ -231,7 +354,7 @@ fn controlled(
             }
             for (k, ct) in scene.thermal.controls.iter().enumerate() {
                 if !ct.is_two_point() {
-                    let m = ct.settle(w.net.mode[k], y[ct.sensor]);
+                    let m = ct.settle(w.net.mode[k], scene.thermal.signal_in(k, &y));
                     scene.set_control_mode(k, m, &mut w);
                 }
             }

@@ -458,15 +458,16 @@ fn drive(
         item: None,
         message: "empty input: no segment to integrate".into(),
     })?;
-    if let Some(c) = scene.thermal.controls.iter().find(|c| c.has_min_time()) {
+    if let Some(c) = scene.thermal.controls.iter().find(|c| c.is_pi()) {
         return Err(NumericalFailure {
             time: first.t0,
             node: scene.thermal.names[c.sensor].clone(),
             item: None,
             message: format!(
-                "controller {} has a minimum on or off time: the sensitivities do not carry the \
-                 switching instants across the end of a minimum time (not implemented); give it \
-                 no min_on_s or min_off_s to compute sensitivities",
+                "controller {} is a PI valve: its integral is a state the node temperatures \
+                 depend on, and the sensitivity integrator carries the node temperatures alone \
+                 (not implemented); a calibration cannot fit through it — give the cooler a \
+                 proportional valve or no controller to compute sensitivities",
                 c.name
             ),
         });

@@ -59,7 +59,8 @@ pub struct Trajectory {
     /// Segment index whose inputs each row shows.
     pub segment: Vec<usize>,
     /// Each controller's share at each row (a two-point controller: 1 on, its off fraction off;
-    /// a valve: the cooler's share), after the switches due at that instant.
+    /// a valve: the cooler's share), after the switches due at that instant; then each PI
+    /// valve's integral.
     pub controls: Rows,
     /// Switches of each controller over the run.
     pub switches: Vec<usize>,

@@ -90,7 +90,10 @@ pub fn integrate(
             if opts.record_losses { segments.len() + 1 } else { 0 },
         ),
         segment: Vec::with_capacity(segments.len() + 1),
-        controls: Rows::with_capacity(scene.thermal.controls.len(), segments.len() + 1),
+        controls: Rows::with_capacity(
+            scene.thermal.controls.len() + scene.thermal.pi_rows() / crate::scene::controls::ROWS_PER_PI,
+            segments.len() + 1,
+        ),
         switches: Vec::new(),
         events: Vec::new(),
         stats: Stats::default(),
@@ -159,13 +162,20 @@ pub fn integrate(
 }
 
 /// The absolute tolerance of every state: `atol` (K) on temperatures, `atol` × the mean node
-/// capacity (J) on energies.
+/// capacity (J) on energies, `atol` × the gain (share) on a PI valve's integral.
 pub(crate) fn state_atol(scene: &Scene, atol: f64) -> Vec<f64> {
     let n = scene.nodes();
     let mean_c = scene.thermal.capacity.iter().sum::<f64>() / n as f64;
     let mut out = vec![atol; scene.n_states()];
     for a in out.iter_mut().skip(n) {
         *a = atol * mean_c;
+    }
+    // A PI valve's integral (a share): the share `atol` K of its sensor moves.
+    let th = &scene.thermal;
+    for (k, c) in th.controls.iter().enumerate() {
+        if let Some(r) = th.integral_row(k) {
+            out[r] = atol * c.gain();
+        }
     }
     out
 }

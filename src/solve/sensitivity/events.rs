@@ -19,6 +19,22 @@
 //! The switch is located as in [`crate::solve::rosenbrock`]: regula falsi (Illinois) on the
 //! largest switching function at the end of the ROS3 step as a function of the step size; the
 //! step is cut just past the surface.
+//!
+//! The end of a minimum on or off time is a time event, τ_e = τ_s + d, with τ_s the switch that
+//! started the dwell and d the minimum time. When the sensor lies past its set point then, the
+//! controller switches at τ_e, and the same jump applies with the time event's switching-time
+//! derivative (Hiskens & Pai 2000, the event's triggering time entering the jump through
+//! dτ/dθ alone; the time event's function t − τ_s − d gives it by the implicit function theorem
+//! with ∂g/∂t = 1):
+//!
+//! ```text
+//! dτ_e/dθ_j = dτ_s/dθ_j + ∂d/∂θ_j,
+//! S_j⁺ = S_j⁻ + (f⁻ − f⁺)·dτ_e/dθ_j,
+//! ```
+//!
+//! where dτ_s/dθ_j is kept from the switch at τ_s (per controller) and ∂d/∂θ_j is the central
+//! difference of the minimum time over the scenes at θ ± δ (zero unless the minimum time is a
+//! parameter). A dwell that ends with no switch due moves nothing: no jump.
 
 use nalgebra::DVector;
 
@@ -40,6 +56,9 @@ pub(super) struct EventScratch {
     gm: Vec<f64>,
     /// A switch is due at the state just accepted.
     pub(super) due: bool,
+    /// Per controller: dτ/dθ_j of its last switch (empty before the first), the start of its
+    /// minimum on or off time.
+    dtau: Vec<Vec<f64>>,
     /// Switches made.
     pub(super) switches: usize,
 }
@@ -54,6 +73,7 @@ impl EventScratch {
             gm: vec![0.0; all],
             due: false,
             switches: 0,
+            dtau: vec![Vec::new(); scene.thermal.controls.len()],
         }
     }
 }
@@ -89,11 +109,12 @@ impl Tangent<'_> {
         }
     }
 
-    /// The largest controller switching function at node temperatures `x` (nominal scene).
-    fn margin(&mut self, x: &DVector<f64>) -> (usize, f64) {
+    /// The largest controller switching function at time `t` (s; a dwell's end is a time
+    /// event) and node temperatures `x` (nominal scene).
+    fn margin(&mut self, t: f64, x: &DVector<f64>) -> (usize, f64) {
         let e = &mut self.nominal;
         e.set_state(x.as_slice(), 0.0, x.as_slice());
-        e.scene.switching_functions(&e.y, &e.work, &mut self.ev.g);
+        e.scene.switching_functions_at(t, &e.y, &e.work, &mut self.ev.g);
         largest(&self.ev.g, self.ev.count)
     }
 
@@ -117,12 +138,12 @@ impl Tangent<'_> {
             return None;
         }
         let end = self.step_end(st);
-        let (_, fb0) = self.margin(&end);
+        let (_, fb0) = self.margin(t + st.h, &end);
         if fb0 <= 0.0 {
             return None;
         }
         let y0 = self.y.clone();
-        let fa = self.margin(&y0).1.min(0.0);
+        let fa = self.margin(t, &y0).1.min(0.0);
         let mut br = Bracket::new(0.0, fa, st.h, fb0);
         let tol = EVENT_TIME_TOL * t.abs().max(1.0);
         for _ in 0..EVENT_MAX_ITER {
@@ -131,7 +152,7 @@ impl Tangent<'_> {
             }
             let c = br.trial();
             let (trial, _) = self.step(t, c, opts.rtol, opts.atol);
-            let fc = self.margin(&self.step_end(&trial)).1;
+            let fc = self.margin(t + c, &self.step_end(&trial)).1;
             br.update(c, fc);
         }
         let b = br.b;
@@ -154,7 +175,7 @@ impl Tangent<'_> {
         self.ev.due = false;
         let y = self.y.clone();
         for _ in 0..=self.ev.count {
-            let (idx, g) = self.margin(&y);
+            let (idx, g) = self.margin(t, &y);
             if g <= 0.0 {
                 break;
             }
@@ -170,20 +191,29 @@ impl Tangent<'_> {
 
     /// Switch the controller of switching function `idx` at (t, y) and jump S.
     fn saltation(&mut self, t: f64, y: &DVector<f64>, idx: usize) -> Result<(), NumericalFailure> {
+        let k = idx / EVENTS_PER_CONTROL;
         let f_before = self.nominal_f(t, y);
-        // ∇g·f⁻ (g affine in T: the central difference with unit step is exact).
-        self.margin(&(y + &f_before));
-        let up = self.ev.g[idx];
-        self.margin(&(y - &f_before));
-        let rate = 0.5 * (up - self.ev.g[idx]);
-        if rate.is_nan() || rate.abs() <= GRAZING {
-            let why = format!(
-                "a controller's switching surface is touched, not crossed (rate {rate:.3e} K/s): \
-                 the sensitivities of the switching instant are unbounded"
-            );
-            return Err(self.failure(t, why));
-        }
-        let dtau = self.switch_time_derivatives(y, idx, rate);
+        let dwell = {
+            let e = &self.nominal;
+            e.scene.is_dwell_event(t, idx, &e.work)
+        };
+        let dtau = if dwell {
+            self.dwell_end_derivatives(k)
+        } else {
+            // ∇g·f⁻ (g affine in T: the central difference with unit step is exact).
+            self.margin(t, &(y + &f_before));
+            let up = self.ev.g[idx];
+            self.margin(t, &(y - &f_before));
+            let rate = 0.5 * (up - self.ev.g[idx]);
+            if rate.is_nan() || rate.abs() <= GRAZING {
+                let why = format!(
+                    "a controller's switching surface is touched, not crossed (rate {rate:.3e} K/s): \
+                     the sensitivities of the switching instant are unbounded"
+                );
+                return Err(self.failure(t, why));
+            }
+            self.switch_time_derivatives(y, idx, rate)
+        };
         {
             let e = &mut self.nominal;
             e.scene.switch_control(t, idx, &mut e.work);
@@ -194,11 +224,32 @@ impl Tangent<'_> {
             let mut col = self.s.column_mut(j);
             col += &jump * *d;
         }
+        self.ev.dtau[k] = dtau;
         if self.s.iter().all(|v| v.is_finite()) {
             return Ok(());
         }
         let why = "the sensitivities are not finite after a controller's switch".to_string();
         Err(self.failure(t, why))
+    }
+
+    /// dτ_e/dθ_j of the end of controller `k`'s minimum time: its last switch's dτ/dθ_j plus
+    /// the minimum time's own derivative (central difference over the scenes at θ ± δ).
+    fn dwell_end_derivatives(&self, k: usize) -> Vec<f64> {
+        let (mode, last) = {
+            let w = &self.nominal.work.net;
+            (w.mode[k], w.last_switch[k])
+        };
+        (0..self.delta.len())
+            .map(|j| {
+                let start = self.ev.dtau[k].get(j).copied().unwrap_or(0.0);
+                let end = |e: &super::Eval<'_>| e.scene.thermal.controls[k].dwell_end(mode, last);
+                let dd = match (end(&self.plus[j]), end(&self.minus[j])) {
+                    (Some(a), Some(b)) => (a - b) / (2.0 * self.delta[j]),
+                    _ => 0.0,
+                };
+                start + dd
+            })
+            .collect()
     }
 
     /// dτ/dθ_j of every direction for switching function `idx` at the state y, with

@@ -11,9 +11,25 @@
 //! - `kind = "valve"`: a proportional bypass valve on a cooler: the share of the oil through the
 //!   cooler is `(T − closed_c)/(open_c − closed_c)` limited to `[min_share, max_share]`; it scales
 //!   the cooler's ε·C_min.
+//! - `kind = "pi_valve"`: a proportional-integral bypass valve on a cooler: the share through
+//!   the cooler is `u = clamp(v, min_share, max_share)` with `v = gain_per_k·(T − set_c) + I`,
+//!   and the integral `I` (a state of the solution, in share units) follows
+//!   `dI/dt = gain_per_k/integral_time_s·(T − set_c) + (u − v)/integral_time_s`. The last term
+//!   (zero while the share is within its limits) is anti-windup by back-calculation (tracking):
+//!   at a limit the integral is pulled back by the gap between the limited and the unlimited
+//!   output, so it relaxes to the limit with the integral time and never winds up past it. The
+//!   tracking time is the integral time (the choice K_aw = 1/T_i of the back-calculation example
+//!   read at novasolver.jp/en/tools/anti-windup.html; the scheme is named as a classical one in
+//!   Caparroz, Soltesz, Hägglund & Guzmán, "Anti-windup in PID control: review, analysis, and new
+//!   tuning directions", arXiv:2606.01959, abstract read; Åström & Hägglund's books were not read
+//!   here). Conditional integration (the integral stopped at a limit) was tried and not kept:
+//!   there the vector field points into the limit from both sides while the sensor drifts back
+//!   toward the set point, and the controller chatters on the limit. `I(0)` is `initial_share`
+//!   (default `min_share`).
 //!
-//!   Optional `min_on_s` and `min_off_s` (s, 0 to [`MIN_TIME_RANGE_S`]'s upper end): a switch
-//!   requested before the controller has been on (off) that long happens when that time ends.
+//! Two-point controllers take optional `min_on_s` and `min_off_s` (s, 0 to
+//! [`MIN_TIME_RANGE_S`]'s upper end): a switch requested before the controller has been on
+//! (off) that long happens when that time ends.
 //!
 //! Equal set points (no hysteresis) are refused unless a minimum on or off time is given: the
 //! controller would switch at every step (it chatters) and no step size could follow it. With
@@ -36,15 +52,25 @@ pub enum ControlKind {
     TwoPoint,
     /// Proportional bypass valve on a cooler.
     Valve,
+    /// Proportional-integral bypass valve on a cooler.
+    PiValve,
 }
 choice!(ControlKind {
     TwoPoint = "two_point",
     Valve = "valve",
+    PiValve = "pi_valve",
 });
 
 /// Set points a controller may take, °C: the range in which the solvers evaluate the oil
 /// (`solve::equilibrium::OIL_RANGE_C`); a set point outside it could never be reached.
 pub const SET_POINT_RANGE_C: (f64, f64) = (-60.0, 200.0);
+
+/// Proportional gains a PI valve may take, 1/K (above 0; 100 per kelvin is a valve that goes
+/// from closed to open within 0.01 K, an on/off valve in all but name).
+pub const GAIN_RANGE_PER_K: (f64, f64) = (0.0, 100.0);
+
+/// Integral times a PI valve may take, s (above 0, a year at most).
+pub const INTEGRAL_TIME_RANGE_S: (f64, f64) = (0.0, 3.156e7);
 
 /// Minimum on or off times a two-point controller may take, s (a year at most).
 pub const MIN_TIME_RANGE_S: (f64, f64) = (0.0, 3.156e7);
@@ -83,6 +109,18 @@ pub struct ControlSpec {
     /// Valve: temperature at which it reaches 1 (no bypass), °C.
     #[serde(default)]
     pub open_c: Option<f64>,
+    /// PI valve: set point, °C.
+    #[serde(default)]
+    pub set_c: Option<f64>,
+    /// PI valve: proportional gain, share per kelvin (1/K).
+    #[serde(default)]
+    pub gain_per_k: Option<f64>,
+    /// PI valve: integral time, s.
+    #[serde(default)]
+    pub integral_time_s: Option<f64>,
+    /// PI valve: the integral at the start, share (default `min_share`).
+    #[serde(default)]
+    pub initial_share: Option<f64>,
     /// Valve: lowest share (leakage), 0..1 (default 0).
     #[serde(default)]
     pub min_share: Option<f64>,
@@ -164,6 +202,22 @@ pub enum ControlLaw {
         /// Highest share.
         max: f64,
     },
+    /// PI valve: share `clamp(gain·(T − set) + I, min, max)`, dI/dt = gain/ti·(T − set) while
+    /// the share is within its limits.
+    Pi {
+        /// Set point, K.
+        set: f64,
+        /// Proportional gain, 1/K.
+        gain: f64,
+        /// Integral time, s.
+        ti: f64,
+        /// Lowest share.
+        min: f64,
+        /// Highest share.
+        max: f64,
+        /// The integral at the start, share.
+        initial: f64,
+    },
 }
 
 /// A checked controller.
@@ -221,6 +275,10 @@ fn refuse_keys(p: &str, c: &ControlSpec, keys: &[&str], problems: &mut Problems)
             "heater_w" => c.heater_w.is_some(),
             "heater_node" => c.heater_node.is_some(),
             "off_fraction" => c.off_fraction.is_some(),
+            "set_c" => c.set_c.is_some(),
+            "gain_per_k" => c.gain_per_k.is_some(),
+            "integral_time_s" => c.integral_time_s.is_some(),
+            "initial_share" => c.initial_share.is_some(),
             _ => false,
         };
         if given {
@@ -242,7 +300,21 @@ fn min_time(problems: &mut Problems, path: &str, v: Option<f64>) -> Option<f64> 
 
 /// The two-point law: set points in range, distinct (hysteresis) unless a minimum time is given.
 fn two_point_law(p: &str, c: &ControlSpec, problems: &mut Problems) -> Option<ControlLaw> {
-    refuse_keys(p, c, &["closed_c", "open_c", "min_share", "max_share"], problems);
+    refuse_keys(
+        p,
+        c,
+        &[
+            "closed_c",
+            "open_c",
+            "min_share",
+            "max_share",
+            "set_c",
+            "gain_per_k",
+            "integral_time_s",
+            "initial_share",
+        ],
+        problems,
+    );
     let on = set_point(problems, &format!("{p}.on_c"), c.on_c);
     let off = set_point(problems, &format!("{p}.off_c"), c.off_c);
     let min_on = min_time(problems, &format!("{p}.min_on_s"), c.min_on_s);
@@ -268,20 +340,11 @@ fn two_point_law(p: &str, c: &ControlSpec, problems: &mut Problems) -> Option<Co
 
 /// The valve law: closed below open, shares in [0, 1] with min < max.
 fn valve_law(p: &str, c: &ControlSpec, problems: &mut Problems) -> Option<ControlLaw> {
+    refuse_keys(p, c, &NOT_VALVE_KEYS, problems);
     refuse_keys(
         p,
         c,
-        &[
-            "on_c",
-            "off_c",
-            "initial_on",
-            "min_on_s",
-            "min_off_s",
-            "link",
-            "heater_w",
-            "heater_node",
-            "off_fraction",
-        ],
+        &["set_c", "gain_per_k", "integral_time_s", "initial_share"],
         problems,
     );
     let closed = set_point(problems, &format!("{p}.closed_c"), c.closed_c);
@@ -307,6 +370,90 @@ fn valve_law(p: &str, c: &ControlSpec, problems: &mut Problems) -> Option<Contro
         open,
         min,
         max,
+    })
+}
+
+/// The keys a valve does not take (either kind).
+const NOT_VALVE_KEYS: [&str; 9] = [
+    "on_c",
+    "off_c",
+    "initial_on",
+    "min_on_s",
+    "min_off_s",
+    "link",
+    "heater_w",
+    "heater_node",
+    "off_fraction",
+];
+
+/// A value in the half-open range (lo, hi] (a gain or a time that must be positive).
+fn positive(
+    problems: &mut Problems,
+    path: &str,
+    v: Option<f64>,
+    range: (f64, f64),
+    unit: &str,
+) -> Option<f64> {
+    let Some(v) = v else {
+        problems.push(path, "", "required for this kind of controller");
+        return None;
+    };
+    let (lo, hi) = range;
+    if v.is_finite() && v > lo && v <= hi {
+        Some(v)
+    } else {
+        problems.push(path, v, format!("must lie in ({lo}, {hi}]{unit}"));
+        None
+    }
+}
+
+/// The PI valve law: set point in the oil's range, gain and integral time positive, shares in
+/// [0, 1] with min < max, the initial integral within them.
+fn pi_law(p: &str, c: &ControlSpec, problems: &mut Problems) -> Option<ControlLaw> {
+    refuse_keys(p, c, &NOT_VALVE_KEYS, problems);
+    refuse_keys(p, c, &["closed_c", "open_c"], problems);
+    let set = set_point(problems, &format!("{p}.set_c"), c.set_c);
+    let gain = positive(
+        problems,
+        &format!("{p}.gain_per_k"),
+        c.gain_per_k,
+        GAIN_RANGE_PER_K,
+        " 1/K (share per kelvin)",
+    );
+    let ti = positive(
+        problems,
+        &format!("{p}.integral_time_s"),
+        c.integral_time_s,
+        INTEGRAL_TIME_RANGE_S,
+        " s",
+    );
+    let min = share(problems, &format!("{p}.min_share"), c.min_share, 0.0);
+    let max = share(problems, &format!("{p}.max_share"), c.max_share, 1.0);
+    let mut ok = true;
+    if min.is_finite() && max.is_finite() && min >= max {
+        problems.push(format!("{p}.max_share"), max, "must be above min_share");
+        ok = false;
+    }
+    let initial = c.initial_share.unwrap_or(min);
+    if ok
+        && !problems.in_range(
+            &format!("{p}.initial_share"),
+            initial,
+            min,
+            max,
+            " (min_share to max_share)",
+        )
+    {
+        ok = false;
+    }
+    let (set, gain, ti) = (set?, gain?, ti?);
+    ok.then_some(ControlLaw::Pi {
+        set,
+        gain,
+        ti,
+        min,
+        max,
+        initial,
     })
 }
 
@@ -428,8 +575,9 @@ pub(crate) fn check_controls(
         let law = match c.kind {
             ControlKind::TwoPoint => two_point_law(&p, c, problems),
             ControlKind::Valve => valve_law(&p, c, problems),
+            ControlKind::PiValve => pi_law(&p, c, problems),
         };
-        if c.kind == ControlKind::Valve && c.cooler.is_none() {
+        if c.kind != ControlKind::TwoPoint && c.cooler.is_none() {
             problems.push(format!("{p}.cooler"), "", "a valve needs the cooler it bypasses");
             continue;
         }

@@ -1,0 +1,169 @@
+//! Sensitivities across the end of a minimum on time (`solve::sensitivity`, the saltation at a
+//! time event): a thermostatic heater on the oil of a two-node network (on at 40 °C, off at
+//! 45 °C, at least 30 s on) heats the oil past 45 °C within its minimum on time, so every
+//! switch off happens when the dwell ends, the sensor already past its set point. The
+//! sensitivities of both set points, the heater's power and the minimum on time against central
+//! differences of whole integrations at a tight tolerance: within 1e-5 relative (to the largest
+//! sensitivity of that parameter over the trace).
+
+use geartherm::scene::Scene;
+use geartherm::solve::sensitivity::{integrate_sensitivities, Direction, SensitivityOptions};
+use geartherm::solve::transient::{integrate, Method, Segment, TransientOptions};
+
+mod common;
+use common::{fzg_frozen, steady_inputs};
+
+/// on_c, off_c, heater_w, min_on_s.
+const NOMINAL: [f64; 4] = [40.0, 45.0, 1500.0, 30.0];
+const NAMES: [&str; 4] = ["on_c", "off_c", "heater_w", "min_on_s"];
+
+fn network(p: &[f64; 4]) -> String {
+    format!(
+        r#"
+[thermal]
+oil_node = "oil"
+initial_temp_c = 30.0
+[[thermal.nodes]]
+name = "oil"
+capacity_j_per_k = 2000.0
+[[thermal.nodes]]
+name = "casing"
+capacity_j_per_k = 5000.0
+[[thermal.boundaries]]
+name = "ambient"
+temp_c = 20.0
+[[thermal.links]]
+between = ["oil", "casing"]
+conductance_w_per_k = 20.0
+[[thermal.links]]
+between = ["casing", "ambient"]
+conductance_w_per_k = 10.0
+[[thermal.controls]]
+name = "heater"
+kind = "two_point"
+sensor = "oil"
+on_c = {:e}
+off_c = {:e}
+heater_w = {:e}
+min_on_s = {:e}
+"#,
+        p[0], p[1], p[2], p[3]
+    )
+}
+
+fn scene(p: &[f64; 4]) -> Scene {
+    fzg_frozen(&network(p), 40.0)
+}
+
+fn segments(n: usize, dt: f64) -> Vec<Segment> {
+    let inputs = steady_inputs(0.0, 0.0);
+    (0..n)
+        .map(|k| Segment {
+            t0: k as f64 * dt,
+            t1: (k + 1) as f64 * dt,
+            inputs,
+        })
+        .collect()
+}
+
+fn opts(rtol: f64) -> SensitivityOptions {
+    SensitivityOptions {
+        rtol,
+        atol: rtol,
+        max_steps: 10_000_000,
+        initial: None,
+    }
+}
+
+/// A parameter's step: 1e-3 K on a temperature, 1e-3 relative otherwise.
+fn step(k: usize) -> f64 {
+    if k >= 2 {
+        1e-3 * NOMINAL[k]
+    } else {
+        1e-3
+    }
+}
+
+#[test]
+fn sensitivities_across_dwell_ends_match_central_differences() {
+    let segs = segments(30, 50.0);
+    let nominal = scene(&NOMINAL);
+    // Every switch off is the end of the minimum on time (30 s after the switch on).
+    let o = TransientOptions {
+        method: Method::Ros3,
+        rtol: 1e-12,
+        atol: 1e-12,
+        ..TransientOptions::default()
+    };
+    let traj = integrate(&nominal, &segs, &o, &mut |_, _| {}).unwrap();
+    let times: Vec<f64> = traj.events.iter().map(|e| e.0).collect();
+    assert!(times.len() >= 6, "the heater must cycle: {times:?}");
+    // From 30 °C the heater starts on with no minimum time running (the start is not a switch):
+    // its first switch off is at 45 °C; every later one ends a dwell.
+    let worst = times[1..]
+        .chunks_exact(2)
+        .map(|w| (w[1] - w[0] - NOMINAL[3]).abs())
+        .fold(0.0, f64::max);
+    println!(
+        "{} switches; on → off spacing vs min_on_s: worst {worst:.2e} s",
+        times.len()
+    );
+    assert!(worst < 1e-6, "the switches off must be the dwell ends: {times:?}");
+    let pairs: Vec<(Scene, Scene)> = (0..4)
+        .map(|k| {
+            let (mut a, mut b) = (NOMINAL, NOMINAL);
+            a[k] += step(k);
+            b[k] -= step(k);
+            (scene(&a), scene(&b))
+        })
+        .collect();
+    let dirs: Vec<Direction<'_>> = pairs
+        .iter()
+        .enumerate()
+        .map(|(k, (a, b))| Direction {
+            plus: a,
+            minus: b,
+            delta: step(k),
+        })
+        .collect();
+    let tangent = integrate_sensitivities(&nominal, &dirs, &segs, &opts(1e-11)).unwrap();
+    let np = NOMINAL.len();
+    for k in 0..np {
+        // The reference's step: its truncation error grows as h² and the integration's noise
+        // (rtol 1e-12 on whole runs whose step sequences differ) as 1/h. Measured relative
+        // errors with h = (10, 3, 1, 0.1)·step: on_c 1.9e-5, 1.7e-6, 4.4e-7, 4.0e-6; off_c
+        // 4.7e-7, 1.3e-6, 5.3e-6, 2.2e-5; heater_w 2.3e-1, 3.2e-4, 3.5e-5, –; min_on_s 2.7e-1,
+        // 2.9e-4, 3.2e-5, – (quadratic: truncation). Each parameter takes its step from the
+        // flat part: (1, 3, 0.1, 0.1)·step.
+        let factor = [1.0, 3.0, 0.1, 0.1][k];
+        let h = std::env::var("CD_H")
+            .ok()
+            .and_then(|v| v.parse::<f64>().ok())
+            .unwrap_or(factor)
+            * step(k);
+        let run = |s: f64| {
+            let mut p = NOMINAL;
+            p[k] += s * h;
+            integrate_sensitivities(&scene(&p), &[], &segs, &opts(1e-12)).unwrap()
+        };
+        let (a, b) = (run(1.0), run(-1.0));
+        let (mut err, mut scale) = (0.0_f64, 0.0_f64);
+        for r in 0..tangent.times.len() {
+            for i in 0..2 {
+                let cd = (a.temps[r][i] - b.temps[r][i]) / (2.0 * h);
+                let s = tangent.sens_at(r, i, k, np);
+                err = err.max((s - cd).abs());
+                scale = scale.max(s.abs());
+            }
+        }
+        let rel = err / scale;
+        println!(
+            "{}: max |S| {scale:.4e} K per unit, relative error {rel:.2e}",
+            NAMES[k]
+        );
+        assert!(scale > 0.0, "{}: no sensitivity", NAMES[k]);
+        if std::env::var("CD_H").is_err() {
+            assert!(rel <= 1e-5, "{}: relative error {rel:.3e} > 1e-5", NAMES[k]);
+        }
+    }
+}
