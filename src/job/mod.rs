@@ -33,6 +33,7 @@ pub mod model;
 pub mod options;
 pub mod rating;
 pub mod run;
+pub mod series;
 pub mod steady;
 pub mod validate;
 
