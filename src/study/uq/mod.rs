@@ -1,6 +1,8 @@
 //! Uncertainty quantification: input distributions sampled by a quasi-random plan, run as a
 //! study, summarised by percentile bands, exceedance probabilities and Sobol' indices.
 
+pub mod estimate;
+pub mod output;
 pub mod plan;
 pub mod run;
 pub mod spec;

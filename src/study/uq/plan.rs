@@ -61,6 +61,12 @@ pub struct InputInfo {
     pub distribution: String,
     /// The assumption behind it.
     pub note: String,
+    /// The sampled number's mean (a factor's, for a relative input).
+    pub mean: f64,
+    /// Its 5th percentile.
+    pub p05: f64,
+    /// Its 95th percentile.
+    pub p95: f64,
 }
 
 /// The expanded plan: the study's parameters (one per sampled quantity), their values per
@@ -430,6 +436,9 @@ fn info(i: &InputSpec, dist: &Distribution) -> InputInfo {
             dist.describe()
         },
         note: i.note.clone().unwrap_or_default(),
+        mean: dist.mean(),
+        p05: dist.quantile(0.05),
+        p95: dist.quantile(0.95),
     }
 }
 
@@ -470,6 +479,13 @@ pub fn expand(
             for (i, p) in c.parameters.iter().enumerate() {
                 let sd = c.covariance[i][i].sqrt();
                 let coord = if k.log[i] { "ln p" } else { "p" };
+                let z = normal_quantile(0.95);
+                let at = |t: f64| if k.log[i] { t.exp() } else { t };
+                let mean = if k.log[i] {
+                    (k.mean[i] + 0.5 * sd * sd).exp()
+                } else {
+                    k.mean[i]
+                };
                 inputs.push(InputInfo {
                     path: p.clone(),
                     column: p.clone(),
@@ -478,6 +494,9 @@ pub fn expand(
                         k.mean[i]
                     ),
                     note: "calibration covariance".into(),
+                    mean,
+                    p05: at(k.mean[i] - z * sd),
+                    p95: at(k.mean[i] + z * sd),
                 });
                 params.push(param(p, false));
             }

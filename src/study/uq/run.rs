@@ -53,13 +53,15 @@ pub enum UqJob {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct UqOptions {
-    /// The job every sample is solved on.
-    pub job: UqJob,
-    /// Samples N (Saltelli's design: base points).
-    pub samples: usize,
-    /// Seed of the scrambled Sobol' points.
-    pub seed: u64,
-    /// Saltelli's design and Sobol indices.
+    /// The job every sample is solved on (None: a study file's first cycle or point, else the
+    /// WLTC).
+    pub job: Option<UqJob>,
+    /// Samples N (Saltelli's design: base points; None: a study file's `sampling.cases`, else
+    /// [`DEFAULT_SAMPLES`]).
+    pub samples: Option<usize>,
+    /// Seed of the scrambled Sobol' points and the bootstrap (None: a study file's, else 1).
+    pub seed: Option<u64>,
+    /// Saltelli's design and Sobol indices (also with a study file's `plan = "saltelli"`).
     pub sobol: bool,
     /// Percentiles of the bands, %, each in (0, 100).
     pub percentiles: Vec<f64>,
@@ -80,9 +82,9 @@ pub struct UqOptions {
 impl Default for UqOptions {
     fn default() -> Self {
         UqOptions {
-            job: UqJob::Run(RunOptions::default()),
-            samples: DEFAULT_SAMPLES,
-            seed: 1,
+            job: None,
+            samples: None,
+            seed: None,
             sobol: false,
             percentiles: DEFAULT_PERCENTILES.to_vec(),
             limits: Vec::new(),
@@ -104,30 +106,33 @@ impl UqOptions {
     /// percentiles, limits' values, confidence, bootstrap, series points).
     pub fn check(&self) -> Result<(), JobError> {
         match &self.job {
-            UqJob::Run(o) => {
+            Some(UqJob::Run(o)) => {
                 o.check()?;
             }
-            UqJob::Steady(p) => p.check()?,
+            Some(UqJob::Steady(p)) => p.check()?,
+            None => {}
         }
-        if self.samples == 0 || self.samples > MAX_UQ_SAMPLES {
+        if let Some(n) = self.samples.filter(|&n| n == 0 || n > MAX_UQ_SAMPLES) {
             return Err(option_error(
                 "samples",
-                self.samples,
+                n,
                 &format!("must lie in [1, {MAX_UQ_SAMPLES}]"),
             ));
         }
-        if self.percentiles.is_empty() {
-            return Err(option_error(
+        super::stats::quantiles::check_percentiles(&self.percentiles).map_err(|e| {
+            let shown: Vec<String> = self.percentiles.iter().map(f64::to_string).collect();
+            let message = if e.starts_with('[') {
+                format!("percentiles{e}")
+            } else {
+                format!("percentiles: {e}")
+            };
+            JobError::option(
                 "percentiles",
-                "[]",
-                "at least one percentile in (0, 100)",
-            ));
-        }
-        for &p in &self.percentiles {
-            if !(p > 0.0 && p < 100.0) {
-                return Err(option_error("percentiles", p, "each must lie in (0, 100)"));
-            }
-        }
+                shown.join(","),
+                "increasing, each in (0, 100)",
+                message,
+            )
+        })?;
         for l in &self.limits {
             if !(l.temp_c.is_finite() && l.temp_c > -273.15 && l.temp_c < 2000.0) {
                 return Err(option_error(
@@ -167,8 +172,12 @@ impl UqOptions {
 pub struct Uq {
     /// The study underneath (its cases, journal fingerprint, runner).
     pub study: Study,
-    /// The options.
+    /// The options, every `None` resolved.
     pub options: UqOptions,
+    /// The job.
+    pub job_kind: UqJob,
+    /// Seed.
+    pub seed: u64,
     /// The sampled quantities.
     pub inputs: Vec<InputInfo>,
     /// The design.
@@ -179,6 +188,8 @@ pub struct Uq {
     pub times_s: Vec<f64>,
     /// Thermal nodes of the model.
     pub nodes: Vec<String>,
+    /// The model's name.
+    pub model_name: String,
 }
 
 /// The `[uncertainty]` of a model document, if any (checked as the study file's).
@@ -207,16 +218,89 @@ pub fn read_calibration(path: &Path) -> Result<CalibrationSpec, JobError> {
         })
 }
 
+/// What a study file gives an uncertainty study: its model, its `[uncertainty]`, its first job,
+/// its sample count, seed and plan (each used where the options leave it open).
+struct FromStudy {
+    model: PathBuf,
+    uncertainty: Option<UncertaintySpec>,
+    job: Option<UqJob>,
+    sampling: Sampling,
+}
+
+/// A study file (a TOML file with a `[study]` table), parsed; None for a model file.
+fn study_file(path: &Path, text: &str) -> Result<Option<FromStudy>, JobError> {
+    let is_study = text.parse::<toml::Table>().is_ok_and(|t| t.contains_key("study"));
+    if !is_study {
+        return Ok(None);
+    }
+    let at = |e: String| JobError::invalid(format!("{}: {e}", path.display()));
+    let de = toml::de::Deserializer::parse(text).map_err(|e| at(e.message().to_string()))?;
+    let spec: StudySpec = serde_path_to_error::deserialize(de)
+        .map_err(|e| at(format!("{}: {}", e.path(), e.inner().message())))?;
+    if !spec.parameters.is_empty() {
+        return Err(at(
+            "[[parameters]]: an uncertainty study samples its [uncertainty] inputs only".into(),
+        ));
+    }
+    let job = match &spec.job {
+        JobSpec::Run { cycles, options } => cycles.first().map(|c| {
+            UqJob::Run(RunOptions {
+                cycle: c.clone(),
+                summary_only: true,
+                ..options.clone().unwrap_or_default()
+            })
+        }),
+        JobSpec::Steady { points } => points.first().cloned().map(UqJob::Steady),
+        JobSpec::Map { .. } => {
+            return Err(at(
+                "job.kind = map: an uncertainty study solves one cycle or one point".into(),
+            ))
+        }
+    };
+    Ok(Some(FromStudy {
+        model: path.parent().unwrap_or(Path::new(".")).join(&spec.study.model),
+        uncertainty: spec.uncertainty,
+        job,
+        sampling: spec.sampling,
+    }))
+}
+
 impl Uq {
-    /// Read the model file and check the study.
-    pub fn from_file(path: &Path, options: UqOptions) -> Result<Uq, JobError> {
+    /// Read a model file (its `[uncertainty]`) or a study file (its model, `[uncertainty]`,
+    /// first job and `[sampling]`) and check the study.
+    pub fn from_file(path: &Path, mut options: UqOptions) -> Result<Uq, JobError> {
         let text = job::read_text(path)?;
-        Uq::new(text, path.to_path_buf(), options)
+        let Some(s) = study_file(path, &text)? else {
+            return Uq::new(text, path.to_path_buf(), options);
+        };
+        options.job = options.job.or(s.job);
+        options.samples = options.samples.or(s.sampling.cases);
+        options.seed = options.seed.or(Some(s.sampling.seed));
+        options.sobol |= s.sampling.plan == Plan::Saltelli;
+        if options.inputs.is_none() {
+            options.inputs = s.uncertainty;
+        }
+        let model_text = job::read_text(&s.model)?;
+        Uq::new(model_text, s.model, options).map_err(|e| match e.kind {
+            job::ErrorKind::Io => e,
+            _ if e.message.starts_with("uncertainty") => e.prefixed(&path.display().to_string()),
+            _ => e,
+        })
     }
 
     /// Check the options and the uncertain inputs against the model, draw the plan.
-    pub fn new(model_text: String, model_file: PathBuf, options: UqOptions) -> Result<Uq, JobError> {
+    pub fn new(model_text: String, model_file: PathBuf, mut options: UqOptions) -> Result<Uq, JobError> {
         options.check()?;
+        let job_kind = options.job.clone().unwrap_or_else(|| {
+            UqJob::Run(RunOptions {
+                summary_only: true,
+                ..RunOptions::default()
+            })
+        });
+        options.job = Some(job_kind.clone());
+        options.samples = Some(options.samples.unwrap_or(DEFAULT_SAMPLES));
+        let seed = options.seed.unwrap_or(1);
+        options.seed = Some(seed);
         let base_model = job::Model::from_text(&model_text, &model_file, &[])?;
         let mut problems = crate::model::Problems::default();
         let base = crate::model::parse::parse_document(&model_text, &mut problems)
@@ -231,7 +315,7 @@ impl Uq {
         if options.calibration.is_some() {
             u.calibration = options.calibration.clone();
         }
-        let spec = spec_of(&options, u, &base_model);
+        let spec = spec_of(&options, &job_kind, seed, u, &base_model);
         let label = model_file.display().to_string();
         let mut study = Study::new(spec, model_text, model_file).map_err(|e| match e.kind {
             job::ErrorKind::Io => e,
@@ -242,9 +326,9 @@ impl Uq {
             .uq_plan
             .clone()
             .ok_or_else(|| JobError::invalid("uncertainty: no plan"))?;
-        let (series_names, times_s, nodes) = grid_of(&base_model, &options)?;
+        let (series_names, times_s, nodes) = grid_of(&base_model, &job_kind, options.series_points)?;
         check_limits(&options, &nodes)?;
-        if let UqJob::Run(_) = options.job {
+        if let UqJob::Run(_) = job_kind {
             study.series_points = Some(options.series_points);
         }
         // A journal of the same inputs with another series grid is another study.
@@ -255,18 +339,21 @@ impl Uq {
         Ok(Uq {
             study,
             options,
+            job_kind,
+            seed,
             inputs,
             design,
             series_names,
             times_s,
             nodes,
+            model_name: base_model.gearbox.name.clone(),
         })
     }
 }
 
 /// The study file the options amount to.
-fn spec_of(o: &UqOptions, u: UncertaintySpec, base: &job::Model) -> StudySpec {
-    let job = match &o.job {
+fn spec_of(o: &UqOptions, job: &UqJob, seed: u64, u: UncertaintySpec, base: &job::Model) -> StudySpec {
+    let job = match job {
         UqJob::Run(r) => JobSpec::Run {
             cycles: vec![r.cycle.clone()],
             options: Some(r.clone()),
@@ -284,8 +371,8 @@ fn spec_of(o: &UqOptions, u: UncertaintySpec, base: &job::Model) -> StudySpec {
         job,
         sampling: Sampling {
             plan: if o.sobol { Plan::Saltelli } else { Plan::Qmc },
-            cases: Some(o.samples),
-            seed: o.seed,
+            cases: o.samples,
+            seed,
         },
         parameters: Vec::new(),
         uncertainty: Some(u),
@@ -294,8 +381,12 @@ fn spec_of(o: &UqOptions, u: UncertaintySpec, base: &job::Model) -> StudySpec {
 }
 
 /// Series names, grid times and node names of the base model on the job.
-fn grid_of(base: &job::Model, o: &UqOptions) -> Result<(Vec<String>, Vec<f64>, Vec<String>), JobError> {
-    match &o.job {
+fn grid_of(
+    base: &job::Model,
+    job: &UqJob,
+    points: usize,
+) -> Result<(Vec<String>, Vec<f64>, Vec<String>), JobError> {
+    match job {
         UqJob::Run(r) => {
             let p = job::run::prepare(base, r)?;
             let t0 = p.segs.first().map_or(0.0, |s| s.t0);
@@ -303,7 +394,7 @@ fn grid_of(base: &job::Model, o: &UqOptions) -> Result<(Vec<String>, Vec<f64>, V
             let nodes = p.scene.thermal.names.clone();
             Ok((
                 job::series::names(&p.scene),
-                job::series::grid(t0, t1, o.series_points),
+                job::series::grid(t0, t1, points),
                 nodes,
             ))
         }
