@@ -9,5 +9,6 @@ pub mod plots;
 pub mod run;
 pub mod sources;
 pub mod study;
+pub mod uq;
 pub mod validation;
 pub mod zip;

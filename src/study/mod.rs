@@ -14,6 +14,7 @@ pub mod plan;
 pub mod runner;
 mod selection;
 pub mod spec;
+pub mod uq;
 
 use std::path::{Path, PathBuf};
 
