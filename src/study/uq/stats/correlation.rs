@@ -63,7 +63,7 @@ pub fn cholesky(a: &[Vec<f64>]) -> Result<Vec<Vec<f64>>, String> {
             if i == j {
                 let d = a[i][i] - s;
                 // Relative to the diagonal: a pivot lost to rounding is not definite either.
-                if !(d > 1e-12 * a[i][i].abs().max(1e-300)) {
+                if d.is_nan() || d <= 1e-12 * a[i][i].abs().max(1e-300) {
                     return Err(format!(
                         "not positive definite (Cholesky pivot {i} is {d:.3e}: the correlations \
                          among the first {} inputs contradict each other)",

@@ -134,8 +134,9 @@ impl BandAccumulator {
             for (s, c) in col.iter_mut().enumerate() {
                 *c = f64::from(self.values[s * self.n_times + t]);
             }
-            for (k, q) in percentiles(&mut col, ps).into_iter().enumerate() {
-                out[k][t] = q;
+            let q = percentiles(&mut col, ps);
+            for (row, v) in out.iter_mut().zip(q) {
+                row[t] = v;
             }
         }
         Ok(out)

@@ -79,7 +79,7 @@ fn estimate(y: &[f64], d: usize, idx: &[usize]) -> Option<(Vec<f64>, Vec<f64>)> 
         .sum::<f64>()
         / (2.0 * n);
     // Zero up to rounding of the mean: a constant output.
-    if !(var > (4.0 * f64::EPSILON * mean).powi(2)) {
+    if var.is_nan() || var <= (4.0 * f64::EPSILON * mean).powi(2) {
         return None;
     }
     let mut first = vec![0.0; d];
