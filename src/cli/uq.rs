@@ -35,6 +35,9 @@ pub struct UqArgs {
     /// Steady point: vehicle speed for h(v) links, km/h.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub vehicle_speed_kmh: f64,
+    /// Relative tolerance of the cycle's integration (with --cycle).
+    #[arg(long)]
+    pub rtol: Option<f64>,
     /// Samples N (with --sobol: base points, N(d + 2) runs).
     /// [default: 1000, or a study file's sampling.cases]
     #[arg(long)]
@@ -111,6 +114,7 @@ impl UqArgs {
             })),
             (None, Some(c)) => Some(UqJob::Run(RunOptions {
                 cycle: c.clone(),
+                rtol: self.rtol.unwrap_or(crate::job::run::DEFAULT_RTOL),
                 summary_only: true,
                 ..RunOptions::default()
             })),

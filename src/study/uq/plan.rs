@@ -224,12 +224,12 @@ fn check_input(i: &InputSpec, base: &toml::Table, file: &Path) -> Result<Checked
         let v = value_at(&c, bv.as_ref(), x)?;
         probe(base, file, &c.path, v).map_err(|e| {
             let what = if bv.is_none() {
-                "the key path is not in the model or"
+                "the key path is not in the model or "
             } else {
                 ""
             };
             format!(
-                "{what} the model refuses the value {x} (the distribution's {q} quantile): {}; \
+                "{what}the model refuses the value {x} (the distribution's {q} quantile): {}; \
                  narrow the distribution or truncate it to the allowed range (truncate = [lo, hi])",
                 first_line(&e)
             )
