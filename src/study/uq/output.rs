@@ -208,7 +208,12 @@ pub fn compact(uq: &Uq, dir: &Path, report: bool) -> Result<UqOutcome, JobError>
     write_all_atomic(dir, &named).map_err(|e| JobError::io(format!("{}: {e}", dir.display()), e.kind()))?;
     o.files = files.iter().map(|(n, _)| n.to_string()).collect();
     if report {
-        let figs = crate::report::plots::uq::render_uq(dir, &o.summary, o.bands.as_ref())?;
+        // The band figure is of temperatures (the energies are in the files).
+        let temps = o.bands.as_ref().map(|b| Bands {
+            series: b.series.iter().filter(|s| s.unit == "°C").cloned().collect(),
+            ..b.clone()
+        });
+        let figs = crate::report::plots::uq::render_uq(dir, &o.summary, temps.as_ref())?;
         o.files.extend(
             figs.iter()
                 .filter_map(|p| p.file_name())
