@@ -2,6 +2,7 @@
 use case as ``geartherm uq``; bad inputs raise with the key path."""
 
 import math
+import re
 import pathlib
 
 import pytest
@@ -78,7 +79,7 @@ def test_bands_match_the_normal_distribution_of_a_linear_network(tmp_path: pathl
 
 def test_a_bad_distribution_names_the_key_path(tmp_path: pathlib.Path) -> None:
     bad = [{"path": 'thermal.boundaries["ambient"].temp_c', "dist": "normal", "mean": 20.0, "sd": -1.0}]
-    with pytest.raises(geartherm.GearthermError, match=r'thermal.boundaries\\["ambient"\\].temp_c\\): sd = -1'):
+    with pytest.raises(geartherm.GearthermError, match=re.escape('thermal.boundaries["ambient"].temp_c): sd = -1')):
         linear_model().uq(standstill(tmp_path), inputs=bad, samples=8)
     with pytest.raises(geartherm.GearthermError, match="samples"):
         linear_model().uq(standstill(tmp_path), inputs=INPUTS, samples=0)
