@@ -18,7 +18,9 @@ const BIN: &str = env!("CARGO_BIN_EXE_geartherm");
 /// m(t) = m∞ + (T0 − m∞) e^(−t/τ), m∞ = 30 °C, and sd s(t) = (1 − e^(−t/τ)) s∞,
 /// s∞ = √((0.75·2)² + (0.25·4)²).
 fn linear_model(uncertainty: &str) -> String {
-    let pt6 = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("models/pt6_spur_pair.toml")).unwrap();
+    let pt6 =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("models/pt6_spur_pair.toml"))
+            .unwrap();
     let head = &pt6[..pt6.find("\n[thermal]").unwrap()];
     format!(
         "{head}\n[thermal]\noil_node = \"oil\"\ninitial_temp_c = 10.0\n\n[[thermal.nodes]]\nname = \"oil\"\ncapacity_j_per_k = 2000.0\n\n\
@@ -51,7 +53,13 @@ fn setup(uncertainty: &str) -> (tempfile::TempDir, PathBuf, PathBuf) {
 }
 
 fn uq(model: &Path, args: &[&str]) -> std::process::Output {
-    Command::new(BIN).arg("uq").arg(model).args(args).arg("--quiet").output().unwrap()
+    Command::new(BIN)
+        .arg("uq")
+        .arg(model)
+        .args(args)
+        .arg("--quiet")
+        .output()
+        .unwrap()
 }
 
 const S_INF: f64 = 1.802_775_637_731_994_6; // √(1.5² + 1²)
@@ -86,7 +94,11 @@ fn bands_and_exceedance_of_a_linear_network_match_the_normal_distribution() {
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let bands = read_bands_csv(&std::fs::read_to_string(out.join("bands.csv")).unwrap()).unwrap();
-    let oil = bands.series.iter().find(|s| s.name == "oil" && s.unit == "°C").unwrap();
+    let oil = bands
+        .series
+        .iter()
+        .find(|s| s.name == "oil" && s.unit == "°C")
+        .unwrap();
     let z95 = 1.644_853_626_951_472_2;
     let mut worst: f64 = 0.0;
     for (k, &t) in bands.time_s.iter().enumerate() {
@@ -98,7 +110,12 @@ fn bands_and_exceedance_of_a_linear_network_match_the_normal_distribution() {
             // journal's rounding and the integration's error.
             let phi = (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt();
             let tol = 2.0 * (q * (1.0 - q) / 1024.0).sqrt() / phi * sd + 2e-3;
-            assert!(err < tol, "t = {t}: p{p} {} vs {} (tolerance {tol})", oil.values[p][k], mean + z * sd);
+            assert!(
+                err < tol,
+                "t = {t}: p{p} {} vs {} (tolerance {tol})",
+                oil.values[p][k],
+                mean + z * sd
+            );
             worst = worst.max(err / sd.max(1e-9));
         }
     }
@@ -106,16 +123,37 @@ fn bands_and_exceedance_of_a_linear_network_match_the_normal_distribution() {
     let s = UqSummary::from_json(&std::fs::read_to_string(out.join("uq.json")).unwrap()).unwrap();
     let e = &s.exceedance[0];
     let exact = 1.0 - normal_cdf(1.0);
-    eprintln!("P(T > {limit:.3}) = {} [{}, {}], exact {exact:.4}", e.probability, e.lo, e.hi);
-    assert!((e.probability - exact).abs() < 0.02, "{} vs {exact}", e.probability);
+    eprintln!(
+        "P(T > {limit:.3}) = {} [{}, {}], exact {exact:.4}",
+        e.probability, e.lo, e.hi
+    );
+    assert!(
+        (e.probability - exact).abs() < 0.02,
+        "{} vs {exact}",
+        e.probability
+    );
     assert!(e.lo <= exact && exact <= e.hi);
     // Resume: the same command again solves nothing and writes the same bands.
     let again = uq(
         &m,
-        &["--cycle", cycle.to_str().unwrap(), "--samples", "1024", "--limit", &format!("oil={limit}"), "--rtol", "1e-8", "--out", out.to_str().unwrap()],
+        &[
+            "--cycle",
+            cycle.to_str().unwrap(),
+            "--samples",
+            "1024",
+            "--limit",
+            &format!("oil={limit}"),
+            "--rtol",
+            "1e-8",
+            "--out",
+            out.to_str().unwrap(),
+        ],
     );
     let text = String::from_utf8_lossy(&again.stdout);
-    assert!(text.contains("0 samples solved") && text.contains("1024 already done"), "{text}");
+    assert!(
+        text.contains("0 samples solved") && text.contains("1024 already done"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -133,22 +171,40 @@ fn a_calibrations_covariance_is_sampled_as_a_multivariate_normal() {
     let out = d.path().join("out");
     let o = uq(
         &m,
-        &["--cycle", cycle.to_str().unwrap(), "--samples", "1024", "--from-calibration", cal.to_str().unwrap(), "--out", out.to_str().unwrap()],
+        &[
+            "--cycle",
+            cycle.to_str().unwrap(),
+            "--samples",
+            "1024",
+            "--from-calibration",
+            cal.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let mut r = csv::Reader::from_path(out.join("study.csv")).unwrap();
     let h = r.headers().unwrap().clone();
     let col = |name: &str| h.iter().position(|c| c == name).unwrap();
-    let (a, b) = (col("thermal.links[\"oil-air\"].conductance_w_per_k"), col("thermal.links[\"oil-coolant\"].conductance_w_per_k"));
+    let (a, b) = (
+        col("thermal.links[\"oil-air\"].conductance_w_per_k"),
+        col("thermal.links[\"oil-coolant\"].conductance_w_per_k"),
+    );
     let rows: Vec<(f64, f64)> = r
         .records()
         .map(|x| {
             let x = x.unwrap();
-            (x[a].parse::<f64>().unwrap().ln(), x[b].parse::<f64>().unwrap().ln())
+            (
+                x[a].parse::<f64>().unwrap().ln(),
+                x[b].parse::<f64>().unwrap().ln(),
+            )
         })
         .collect();
     let n = rows.len() as f64;
-    let (ma, mb) = (rows.iter().map(|r| r.0).sum::<f64>() / n, rows.iter().map(|r| r.1).sum::<f64>() / n);
+    let (ma, mb) = (
+        rows.iter().map(|r| r.0).sum::<f64>() / n,
+        rows.iter().map(|r| r.1).sum::<f64>() / n,
+    );
     let cov = |f: &dyn Fn(&(f64, f64)) -> f64| rows.iter().map(f).sum::<f64>() / (n - 1.0);
     let vaa = cov(&|r| (r.0 - ma).powi(2));
     let vbb = cov(&|r| (r.1 - mb).powi(2));
@@ -188,35 +244,85 @@ fn bad_distributions_are_refused_naming_the_key_path_and_nothing_is_written() {
     let amb = "thermal.boundaries[\"ambient\"].temp_c";
     let g = "thermal.links[\"oil-air\"].conductance_w_per_k";
     // Negative width (sd).
-    refused(&input(amb, "dist = \"normal\"\nmean = 20.0\nsd = -1.0"), &[], &format!("{amb}): sd = -1: must be > 0"));
+    refused(
+        &input(amb, "dist = \"normal\"\nmean = 20.0\nsd = -1.0"),
+        &[],
+        &format!("{amb}): sd = -1: must be > 0"),
+    );
     // Bounds reversed.
-    refused(&input(g, "dist = \"uniform\"\nlo = 4.0\nhi = 2.0"), &[], &format!("{g}): hi = 2: must be > lo = 4 (bounds reversed)"));
-    refused(&input(g, "dist = \"normal\"\nmean = 3.0\nsd = 0.5\ntruncate = [4.0, 2.0]"), &[], "truncate: hi = 2");
+    refused(
+        &input(g, "dist = \"uniform\"\nlo = 4.0\nhi = 2.0"),
+        &[],
+        &format!("{g}): hi = 2: must be > lo = 4 (bounds reversed)"),
+    );
+    refused(
+        &input(
+            g,
+            "dist = \"normal\"\nmean = 3.0\nsd = 0.5\ntruncate = [4.0, 2.0]",
+        ),
+        &[],
+        "truncate: hi = 2",
+    );
     // A log-normal on a value that may be negative (a temperature in °C).
-    refused(&input(amb, "dist = \"lognormal\"\nmedian = 20.0\nsigma_ln = 0.1"), &[], &format!("{amb}): a log-normal on a value that may be negative"));
+    refused(
+        &input(amb, "dist = \"lognormal\"\nmedian = 20.0\nsigma_ln = 0.1"),
+        &[],
+        &format!("{amb}): a log-normal on a value that may be negative"),
+    );
     // A distribution reaching values the model refuses (a negative conductance).
-    refused(&input(g, "dist = \"normal\"\nmean = 3.0\nsd = 2.0"), &[], &format!("{g}): the model refuses the value"));
+    refused(
+        &input(g, "dist = \"normal\"\nmean = 3.0\nsd = 2.0"),
+        &[],
+        &format!("{g}): the model refuses the value"),
+    );
     // Correlations not positive definite.
     let three = format!(
         "{}{}{}",
         input(amb, "dist = \"normal\"\nmean = 20.0\nsd = 1.0"),
-        input("thermal.boundaries[\"coolant\"].temp_c", "dist = \"normal\"\nmean = 60.0\nsd = 1.0"),
+        input(
+            "thermal.boundaries[\"coolant\"].temp_c",
+            "dist = \"normal\"\nmean = 60.0\nsd = 1.0"
+        ),
         input(g, "dist = \"uniform\"\nlo = 2.0\nhi = 4.0"),
     );
-    let corr = |a: &str, b: &str, r: f64| format!("[[uncertainty.correlations]]\nbetween = ['{a}', '{b}']\nrank = {r}\n");
+    let corr = |a: &str, b: &str, r: f64| {
+        format!("[[uncertainty.correlations]]\nbetween = ['{a}', '{b}']\nrank = {r}\n")
+    };
     let bad = format!(
         "{three}{}{}{}",
         corr(amb, "thermal.boundaries[\"coolant\"].temp_c", 0.9),
         corr(amb, g, 0.9),
         corr("thermal.boundaries[\"coolant\"].temp_c", g, -0.9)
     );
-    refused(&bad, &[], "uncertainty.correlations: the rank correlation matrix is not");
+    refused(
+        &bad,
+        &[],
+        "uncertainty.correlations: the rank correlation matrix is not",
+    );
     // A key path that does not exist.
-    refused(&input("thermal.links[\"nope\"].conductance_w_per_k", "dist = \"uniform\"\nlo = 2.0\nhi = 4.0"), &[], "thermal.links[\"nope\"].conductance_w_per_k");
-    refused(&input("thermal.links[\"oil-air\"].conductance", "dist = \"uniform\"\nlo = 2.0\nhi = 4.0"), &[], "thermal.links[\"oil-air\"].conductance)");
+    refused(
+        &input(
+            "thermal.links[\"nope\"].conductance_w_per_k",
+            "dist = \"uniform\"\nlo = 2.0\nhi = 4.0",
+        ),
+        &[],
+        "thermal.links[\"nope\"].conductance_w_per_k",
+    );
+    refused(
+        &input(
+            "thermal.links[\"oil-air\"].conductance",
+            "dist = \"uniform\"\nlo = 2.0\nhi = 4.0",
+        ),
+        &[],
+        "thermal.links[\"oil-air\"].conductance)",
+    );
     // Sample counts of 0 and over the limit.
     let ok = input(g, "dist = \"uniform\"\nlo = 2.0\nhi = 4.0");
-    refused(&ok, &["--samples", "0"], "samples (--samples) = 0: must lie in [1, 1000000]");
+    refused(
+        &ok,
+        &["--samples", "0"],
+        "samples (--samples) = 0: must lie in [1, 1000000]",
+    );
     refused(&ok, &["--samples", "1000001"], "samples (--samples) = 1000001");
     refused(&ok, &["--samples", "1000000", "--sobol"], "N(d + 2)");
     // Options: a limit on a node the model lacks, percentiles out of order.

@@ -29,7 +29,9 @@ fn run_uq(
 ) -> PyResult<(String, String, String)> {
     let o: UqOptions = serde_json::from_str(options).map_err(|e| json_error("uq options", e))?;
     if let Some(n) = threads {
-        geartherm::job::limits::THREADS.check(n as f64).map_err(job_error)?;
+        geartherm::job::limits::THREADS
+            .check(n as f64)
+            .map_err(job_error)?;
     }
     let uq = Uq::new(text, PathBuf::from(file), o).map_err(job_error)?;
     let cancel = AtomicBool::new(false);
@@ -51,7 +53,10 @@ fn run_uq(
     let o = result
         .map_err(|e| py_error("io", e, Vec::new(), None))?
         .map_err(job_error)?;
-    let summary = o.summary.to_json().map_err(|e| py_error("numerical", e, Vec::new(), None))?;
+    let summary = o
+        .summary
+        .to_json()
+        .map_err(|e| py_error("numerical", e, Vec::new(), None))?;
     let bands = match &o.bands {
         Some(b) => write_bands_csv(b).map_err(|e| py_error("numerical", e, Vec::new(), None))?,
         None => String::new(),
