@@ -190,7 +190,7 @@ fn sobol(uq: &Uq, rows: &[CaseRow], outputs: &[String]) -> Result<Vec<Sensitivit
         let y = y.ok_or_else(|| {
             let missing = by_sample
                 .iter()
-                .filter(|r| r.is_none_or(|r| output(r, name).is_none()))
+                .filter(|r| !r.is_some_and(|r| output(r, name).is_some()))
                 .count();
             format!(
                 "{missing} of {} cases of the design have no {name} (failed, refused or not solved)",

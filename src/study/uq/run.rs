@@ -380,12 +380,11 @@ fn spec_of(o: &UqOptions, job: &UqJob, seed: u64, u: UncertaintySpec, base: &job
     }
 }
 
+/// Series names, grid times, node names.
+type Grid = (Vec<String>, Vec<f64>, Vec<String>);
+
 /// Series names, grid times and node names of the base model on the job.
-fn grid_of(
-    base: &job::Model,
-    job: &UqJob,
-    points: usize,
-) -> Result<(Vec<String>, Vec<f64>, Vec<String>), JobError> {
+fn grid_of(base: &job::Model, job: &UqJob, points: usize) -> Result<Grid, JobError> {
     match job {
         UqJob::Run(r) => {
             let p = job::run::prepare(base, r)?;
