@@ -13,3 +13,7 @@ cargo build --release
 rm -rf plots/at6_study
 ./target/release/geartherm study models/studies/at6_wltc_lhs.toml --out plots/at6_study --quiet > /dev/null
 rm -f plots/at6_study/journal.jsonl plots/at6_study/study.parquet   # the table is study.csv
+rm -rf plots/at6_uq plots/at6_uq_sobol
+./target/release/geartherm uq models/studies/at6_wltc_uq.toml --limit sump=85 --out plots/at6_uq --report --quiet > /dev/null
+./target/release/geartherm uq models/studies/at6_wltc_uq.toml --sobol --samples 128 --out plots/at6_uq_sobol --report --quiet > /dev/null
+rm -f plots/at6_uq/journal.jsonl plots/at6_uq/*.parquet plots/at6_uq_sobol/journal.jsonl plots/at6_uq_sobol/*.parquet plots/at6_uq_sobol/bands.*

@@ -177,7 +177,9 @@ fn study(row: &Row, text: &str) -> Option<Outcome> {
             range: None,
             scale: None,
             levels: None,
+            factors: false,
         }],
+        uncertainty: None,
         outputs: OutputSpec::default(),
     };
     let s = match Study::new(spec, text.to_string(), root().join(MODEL)) {

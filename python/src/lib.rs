@@ -17,6 +17,7 @@ use pyo3::prelude::*;
 use serde::{Deserialize, Serialize};
 
 mod study;
+mod uq;
 
 /// The Python exception of a failure, built by `geartherm.errors._from_native` (the classes are
 /// plain Python classes there, so they import from `geartherm` and pickle with their fields).
@@ -464,6 +465,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Model>()?;
     m.add_function(wrap_pyfunction!(fmu::export_fmu, m)?)?;
     study::register(m)?;
+    uq::register(m)?;
     m.add_function(wrap_pyfunction!(oils, m)?)?;
     m.add_function(wrap_pyfunction!(cycles, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;

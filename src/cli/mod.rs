@@ -21,6 +21,7 @@ mod steady;
 mod study;
 #[cfg(test)]
 mod tests;
+mod uq;
 mod validate;
 
 pub use output::Failure;
@@ -103,6 +104,10 @@ pub enum Command {
     /// Read a measured trace as `calibrate` does: rows, rows dropped for empty cells, the
     /// segments its gaps in time cut it into.
     Trace(calibrate::TraceArgs),
+    /// Uncertainty study: the model's [uncertainty] inputs sampled quasi-randomly, run as a
+    /// study (resumable); percentile bands over time, exceedance probabilities of limits, Sobol
+    /// indices; writes uq.json, bands.csv, bands.parquet, study.csv (with --report the figures).
+    Uq(uq::UqArgs),
     /// Export the model as an FMI 2.0 co-simulation FMU (Linux x86-64, self-contained).
     Fmu(fmu::FmuArgs),
 }
@@ -147,5 +152,6 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         Command::Calibrate(a) => calibrate::calibrate(&a),
         Command::Trace(a) => calibrate::trace(&a),
         Command::Fmu(a) => fmu::fmu(&a),
+        Command::Uq(a) => uq::uq(&a),
     }
 }

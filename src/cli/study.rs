@@ -61,10 +61,10 @@ fn stdout_error(e: &std::io::Error) -> Failure {
 }
 
 /// Set by SIGINT: no new case starts; the running ones finish and are journaled.
-static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+pub(super) static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
 /// Exit status of a command ended by SIGINT (128 + 2).
-const EXIT_INTERRUPTED: i32 = 130;
+pub(super) const EXIT_INTERRUPTED: i32 = 130;
 
 #[cfg(unix)]
 extern "C" fn on_sigint(_: libc::c_int) {
@@ -76,7 +76,7 @@ extern "C" fn on_sigint(_: libc::c_int) {
 }
 
 /// Ctrl-C stops the study cleanly (the default again once the study is over).
-fn catch_sigint() {
+pub(super) fn catch_sigint() {
     #[cfg(unix)]
     unsafe {
         libc::signal(libc::SIGINT, on_sigint as *const () as libc::sighandler_t);
@@ -85,7 +85,7 @@ fn catch_sigint() {
 
 /// Ctrl-C at its default again (after the cases: a Ctrl-C during the compaction ends the
 /// process, the journals already hold every case).
-fn release_sigint() {
+pub(super) fn release_sigint() {
     #[cfg(unix)]
     unsafe {
         libc::signal(libc::SIGINT, libc::SIG_DFL);

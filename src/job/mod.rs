@@ -34,6 +34,7 @@ pub mod options;
 pub mod rating;
 pub mod run;
 pub mod spread;
+pub mod series;
 pub mod steady;
 pub mod validate;
 

@@ -214,9 +214,20 @@ pub fn run(m: &Model, o: &RunOptions, progress: &mut dyn FnMut(usize, usize)) ->
 /// Integrate a prepared run and check its result (the second half of [`run`], for a front end
 /// that locks its output directory in between).
 pub fn solve(m: &Model, p: &Prepared, progress: &mut dyn FnMut(usize, usize)) -> Result<RunResult, JobError> {
+    solve_keeping(m, p, progress).map(|(r, _)| r)
+}
+
+/// [`solve`], also returning the integrated trajectory (for outputs derived from its states,
+/// e.g. [`super::series`]).
+pub fn solve_keeping(
+    m: &Model,
+    p: &Prepared,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<(RunResult, Trajectory), JobError> {
     let traj = integrate(&p.scene, &p.segs, &p.opts, progress)
         .map_err(|e| JobError::numerical(format!("{}: {e}", m.label())))?;
-    finish(m, p, &traj)
+    let r = finish(m, p, &traj)?;
+    Ok((r, traj))
 }
 
 /// The post-solve checks and the outputs of an integrated run.

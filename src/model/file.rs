@@ -5,7 +5,9 @@ use serde::{Deserialize, Serialize};
 
 use super::sections::*;
 
-/// The top-level keys a model file may have: its sections, in the order of [`ModelFile`].
+/// The top-level keys a model file may have: its sections, in the order of [`ModelFile`], then
+/// `uncertainty` (the uncertain inputs `geartherm uq` samples; no field of the model: the study
+/// layer reads and checks it, every other command only checks that it is a table).
 pub const SECTIONS: &[&str] = &[
     "model",
     "oil",
@@ -26,6 +28,7 @@ pub const SECTIONS: &[&str] = &[
     "bearings",
     "seals",
     "circuit",
+    "uncertainty",
 ];
 
 /// The whole model file.

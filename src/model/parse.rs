@@ -231,6 +231,16 @@ pub fn parse_table(mut table: Table, problems: &mut Problems) -> Option<ModelFil
     }
     check_names(&Value::Table(table.clone()), "", problems);
     let before = problems.len();
+    // `[uncertainty]` is read by `geartherm uq` (the study layer checks its inputs).
+    if let Some(u) = table.remove("uncertainty") {
+        if !u.is_table() {
+            problems.push(
+                "uncertainty",
+                describe(&u),
+                "must be a table ([[uncertainty.inputs]], read by `geartherm uq`)",
+            );
+        }
+    }
     let model = section::<model::ModelMeta>(&mut table, "model", true, problems);
     let oil = section::<oil::OilSpec>(&mut table, "oil", true, problems);
     let members = array::<members::MemberSpec>(&mut table, "members", false, problems);

@@ -12,5 +12,6 @@ pub mod spread;
 pub mod stats_de;
 pub mod study;
 pub mod timeseries;
+pub mod uq;
 pub mod validation;
 pub mod zip;

@@ -41,6 +41,11 @@ pub struct CaseRow {
     /// Outputs with units in their names (`energy_total_j`, `temp_max_sump_c`, …); absent on
     /// failure; None for an undefined value (e.g. efficiency without output power).
     pub outputs: Vec<(String, Option<f64>)>,
+    /// An uncertainty study's time series of the case on the study's grid (node temperatures
+    /// rounded to 0.001 °C, energies per source to 0.1 J), one vector per series; absent
+    /// otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub series: Option<Vec<Vec<f64>>>,
 }
 
 /// Journal file name of a shard (`None`: the whole study).
@@ -379,6 +384,7 @@ mod tests {
 
     fn row(i: usize, ok: bool) -> CaseRow {
         CaseRow {
+            series: None,
             case: format!("{i:05}-wltc"),
             sample: i,
             job: "wltc".into(),

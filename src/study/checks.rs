@@ -187,7 +187,7 @@ pub(super) fn paths_in_schema(
         let Err(e) = overrides::get(base, path) else {
             continue;
         };
-        if p.scale.is_some() {
+        if p.scale.is_some() || p.factors {
             return Err(JobError::invalid(format!("parameters[{k}].path: {e}")));
         }
         let value = match samples.first().map(|s| &s[k]) {

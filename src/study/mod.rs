@@ -14,6 +14,7 @@ pub mod plan;
 pub mod runner;
 mod selection;
 pub mod spec;
+pub mod uq;
 
 use std::path::{Path, PathBuf};
 
@@ -81,10 +82,15 @@ pub struct Study {
     pub fingerprint: String,
     /// The table's output columns (the same for every case, whatever its overrides).
     pub outputs: Vec<String>,
+    /// Grid points of the time series a run case keeps in its row (an uncertainty study's
+    /// bands; [`crate::job::series`]); None: no series.
+    pub series_points: Option<usize>,
+    /// An uncertainty plan's sampled quantities and design (None for other plans).
+    pub uq_plan: Option<(Vec<uq::plan::InputInfo>, uq::plan::Design)>,
 }
 
 /// FNV-1a, 64 bit: a stable fingerprint (the same on every platform and version).
-fn fnv1a(parts: &[&[u8]]) -> u64 {
+pub(crate) fn fnv1a(parts: &[&[u8]]) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for p in parts {
         for &b in *p {
@@ -127,6 +133,39 @@ fn scaled(v: &Value, f: f64) -> Result<Value, String> {
     }
 }
 
+/// An uncertainty plan's sampled quantities and design.
+type UqPlan = Option<(Vec<uq::plan::InputInfo>, uq::plan::Design)>;
+
+/// The samples of a study's plan: an `[uncertainty]` plan (qmc, saltelli) expands its inputs
+/// into the parameters (the study's `[[parameters]]` must then be empty), any other plan samples
+/// the parameters.
+fn sampled(
+    mut spec: StudySpec,
+    base: &toml::Table,
+    model_file: &Path,
+) -> Result<(StudySpec, Vec<Vec<ParamValue>>, UqPlan), JobError> {
+    let invalid = JobError::invalid;
+    match (&spec.uncertainty, spec.sampling.plan) {
+        (Some(u), spec::Plan::Qmc | spec::Plan::Saltelli) => {
+            if !spec.parameters.is_empty() {
+                return Err(invalid(
+                    "[[parameters]] and [uncertainty] together: an uncertainty plan samples its inputs only",
+                ));
+            }
+            let e = uq::plan::expand(u, &spec.sampling, base, model_file)?;
+            spec.parameters = e.params;
+            Ok((spec, e.samples, Some((e.inputs, e.design))))
+        }
+        (Some(_), _) => Err(invalid(
+            "[uncertainty] needs sampling.plan = \"qmc\" or \"saltelli\" (its inputs are sampled from their distributions)",
+        )),
+        (None, _) => {
+            let s = plan::samples(&spec.parameters, &spec.sampling).map_err(JobError::invalid)?;
+            Ok((spec, s, None))
+        }
+    }
+}
+
 impl Study {
     /// Read a study file; its `study.model` is resolved relative to the study file. Every
     /// message after the first line names the study file.
@@ -156,8 +195,8 @@ impl Study {
         let mut problems = model::Problems::default();
         let base = model::parse::parse_document(&model_text, &mut problems)
             .ok_or_else(|| invalid(format!("{}: not a TOML document", model_file.display())))?;
+        let (spec, samples, uq_plan) = sampled(spec, &base, &model_file)?;
         let paths = checks::parameter_paths(&spec.parameters)?;
-        let samples = plan::samples(&spec.parameters, &spec.sampling).map_err(invalid)?;
         checks::paths_in_schema(
             &spec.parameters,
             &paths,
@@ -191,6 +230,8 @@ impl Study {
             jobs,
             fingerprint,
             outputs,
+            series_points: None,
+            uq_plan,
         })
     }
 
@@ -226,7 +267,7 @@ impl Study {
     /// Column name of parameter `j` (a scale parameter's value is the factor).
     pub fn column(&self, j: usize) -> String {
         let p = &self.spec.parameters[j];
-        if p.scale.is_some() {
+        if p.scale.is_some() || p.factors {
             format!("{} (scale)", p.path)
         } else {
             p.path.clone()
@@ -242,7 +283,7 @@ impl Study {
             let base = overrides::get(&self.base, &self.paths[j]).ok();
             let (value, shown) = match v {
                 ParamValue::Text(s) => (Value::String(s.clone()), v.clone()),
-                ParamValue::Number(f) if p.scale.is_some() => {
+                ParamValue::Number(f) if p.scale.is_some() || p.factors => {
                     let b = base.ok_or_else(|| format!("{}: not in the model", p.path))?;
                     (scaled(&b, *f).map_err(|e| format!("{}: {e}", p.path))?, v.clone())
                 }
@@ -300,6 +341,7 @@ impl Study {
             status: "ok".into(),
             message: String::new(),
             outputs: Vec::new(),
+            series: None,
         };
         let result =
             std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| self.solve(c, per_case, &mut row)));
@@ -317,6 +359,7 @@ impl Study {
                 row.status = if e.is_invalid() { "invalid" } else { "failed" }.into();
                 row.message = e.to_string();
                 row.outputs.clear();
+                row.series = None;
                 (row, Vec::new())
             }
         }
@@ -328,7 +371,14 @@ impl Study {
         let m = job::Model::from_document(self.base.clone(), &self.model_file, &ovs)?;
         match self.case_job(c, per_case) {
             Job::Run(o) => {
-                let r = job::run::run(&m, &o, &mut |_, _| {})?;
+                let r = match self.series_points {
+                    Some(points) => {
+                        let (r, s) = job::series::run_with_series(&m, &o, points)?;
+                        row.series = Some(uq::run::rounded(&s));
+                        r
+                    }
+                    None => job::run::run(&m, &o, &mut |_, _| {})?,
+                };
                 row.outputs = run_outputs(&r.summary);
                 let files = if per_case { r.files()? } else { Vec::new() };
                 Ok(files.into_iter().map(|(n, b)| (n.to_string(), b)).collect())

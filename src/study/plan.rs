@@ -84,6 +84,9 @@ pub fn check_param(p: &ParamSpec) -> Result<(), String> {
             return Err(format!("parameter {}: values must be finite", p.path));
         }
     }
+    if p.factors && p.values.is_none() {
+        return Err(format!("parameter {}: factors = true needs values", p.path));
+    }
     if let Some([lo, hi]) = interval(p) {
         if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
             return Err(format!(
@@ -221,6 +224,11 @@ pub fn samples(params: &[ParamSpec], s: &Sampling) -> Result<Vec<Vec<ParamValue>
     match s.plan {
         Plan::Grid => grid(params),
         Plan::List => list(params),
+        Plan::Qmc | Plan::Saltelli => Err(
+            "sampling.plan: the qmc and saltelli plans sample the [uncertainty] inputs; \
+                                           the study file has no [uncertainty]"
+                .into(),
+        ),
         Plan::Lhs => {
             let n = s.cases.ok_or("sampling: the lhs plan needs `cases`")?;
             if n == 0 || n > MAX_SAMPLES {
@@ -243,6 +251,7 @@ mod tests {
             range: Some([lo, hi]),
             scale: None,
             levels: None,
+            factors: false,
         }
     }
 
@@ -253,6 +262,7 @@ mod tests {
             range: None,
             scale: None,
             levels: None,
+            factors: false,
         }
     }
 

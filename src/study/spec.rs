@@ -47,8 +47,12 @@ pub struct StudySpec {
     /// How parameter values are combined into cases.
     #[serde(default)]
     pub sampling: Sampling,
-    /// The parameters.
+    /// The parameters (none with an `[uncertainty]` plan: its inputs are the parameters).
+    #[serde(default)]
     pub parameters: Vec<ParamSpec>,
+    /// Uncertain inputs (distributions on key paths) sampled by the `qmc` and `saltelli` plans.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uncertainty: Option<super::uq::spec::UncertaintySpec>,
     /// Outputs beyond the table.
     #[serde(default)]
     pub outputs: OutputSpec,
@@ -107,6 +111,12 @@ pub enum Plan {
     Lhs,
     /// Explicit list: parameter i of case k is `values[k]` (all lists of equal length).
     List,
+    /// `cases` quasi-random samples of the `[uncertainty]` inputs (scrambled Sobol' points
+    /// through each input's inverse CDF).
+    Qmc,
+    /// Saltelli's design for Sobol indices of the `[uncertainty]` inputs: `cases` base points,
+    /// `cases`·(d + 2) samples.
+    Saltelli,
 }
 
 /// `[sampling]`.
@@ -116,10 +126,10 @@ pub struct Sampling {
     /// Plan.
     #[serde(default)]
     pub plan: Plan,
-    /// Samples (lhs).
+    /// Samples (lhs, qmc; the base points of saltelli).
     #[serde(default)]
     pub cases: Option<usize>,
-    /// Seed (lhs).
+    /// Seed (lhs, qmc, saltelli).
     #[serde(default = "default_seed")]
     pub seed: u64,
 }
@@ -156,6 +166,9 @@ pub struct ParamSpec {
     /// Grid points of a range or scale (default 3).
     #[serde(default)]
     pub levels: Option<usize>,
+    /// With `values`: the values are factors multiplying the model's value, as a scale's.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub factors: bool,
 }
 
 /// `[outputs]`.

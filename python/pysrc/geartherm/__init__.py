@@ -42,6 +42,8 @@ if TYPE_CHECKING:
     import pandas
     import polars
 
+    from .uq import UqResult
+
 __all__ = [
     "CalibrationResult",
     "Model",
@@ -735,6 +737,54 @@ class Model:
                 o[k] = v
         return CalibrationResult(*self._m.calibrate(text, label, o))
 
+
+    def uq(
+        self,
+        cycle: Optional[str] = None,
+        *,
+        point: Optional[Mapping[str, object]] = None,
+        inputs: Optional[Sequence[Mapping[str, object]]] = None,
+        correlations: Optional[Sequence[Mapping[str, object]]] = None,
+        samples: Optional[int] = None,
+        seed: Optional[int] = None,
+        sobol: bool = False,
+        percentiles: Sequence[float] = (5.0, 50.0, 95.0),
+        limits: Optional[Mapping[str, float]] = None,
+        series_points: int = 201,
+        confidence: float = 0.95,
+        bootstrap: int = 200,
+        calibration: Optional[Mapping[str, object]] = None,
+        out: Optional[Union[str, "os.PathLike[str]"]] = None,
+        threads: Optional[int] = None,
+    ) -> "UqResult":
+        """Uncertainty study: the uncertain inputs sampled quasi-randomly, the cycle (or the
+        steady ``point``: ``dict(gear=, speed_rpm=, torque_nm=)``) solved for every sample by the
+        study runner, percentile bands, exceedance probabilities of ``limits`` (node → °C) and,
+        with ``sobol=True``, Sobol indices (docs/uq.md; the same checks as ``geartherm uq``).
+
+        ``inputs``: dicts as ``[[uncertainty.inputs]]`` (``path``, ``dist``, its parameters,
+        ``truncate``, ``relative``, ``note``); None: the model file's ``[uncertainty]``.
+        ``out``: a directory journaled as ``geartherm uq --out`` writes it (resume).
+        The model's overrides are not applied (the model file's text is sampled).
+
+        Returns
+        -------
+        UqResult
+            ``.bands`` (columns per series and percentile), ``.exceedance``, ``.sobol``,
+            ``.samples`` DataFrames and ``.summary`` (``uq.json``).
+        """
+        from .uq import run_uq
+
+        pt = None
+        if point is not None:
+            p = dict(point)
+            pt = _point(str(p["gear"]), float(p["speed_rpm"]), float(p["torque_nm"]), float(p.get("vehicle_speed_kmh", 0.0)), None)  # type: ignore[arg-type]
+        return run_uq(
+            self.text, self._m.file, cycle=cycle, point=pt, inputs=inputs, correlations=correlations,
+            samples=samples, seed=seed, sobol=sobol, percentiles=percentiles, limits=limits,
+            series_points=series_points, confidence=confidence, bootstrap=bootstrap,
+            calibration=calibration, out=out, threads=threads,
+        )
 
     def __reduce__(self) -> Tuple[type, Tuple["_native.Model"]]:
         return (Model, (self._m,))

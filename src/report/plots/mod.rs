@@ -38,6 +38,7 @@ pub mod rating;
 pub mod study;
 pub mod style;
 pub mod temperatures;
+pub mod uq;
 pub mod validation;
 pub mod work_precision;
 
