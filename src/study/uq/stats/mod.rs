@@ -9,13 +9,15 @@
 
 pub mod correlation;
 pub mod dist;
+pub mod estimate;
 pub mod lowdisc;
 pub mod quantiles;
 mod rng;
 pub mod sobol;
 
 pub use dist::{normal_cdf, normal_quantile, DistError, Distribution};
+pub use estimate::Estimate;
 pub use lowdisc::sobol_points;
 pub use quantiles::{exceedance, percentiles, BandAccumulator};
 pub use rng::{mix64, Rng};
-pub use sobol::{saltelli_rows, sobol_indices, Estimate, SobolIndices};
+pub use sobol::{saltelli_rows, sobol_indices, SobolIndices};

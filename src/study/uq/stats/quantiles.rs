@@ -17,7 +17,7 @@
 //! the count's variance is smaller than binomial, so the interval is conservative there.
 
 use super::dist::normal_quantile;
-use super::sobol::Estimate;
+use super::estimate::Estimate;
 
 /// Type-7 percentiles `ps` (in percent, 0–100) of `values`, which are sorted in place. NaN for
 /// every p when `values` is empty or holds a non-finite value, or for a p outside [0, 100]
@@ -216,6 +216,84 @@ mod tests {
         assert!(b.push(&[1.0]).is_err());
         assert!(b.push(&[1.0, f64::INFINITY]).is_err());
         assert!(BandAccumulator::new(3).bands(&[50.0]).is_err());
+    }
+
+    /// The step response of a linear two-node network (C1 dT1/dt = Q − G12 (T1 − T2),
+    /// C2 dT2/dt = G12 (T1 − T2) − G2a (T2 − Ta), both nodes starting at Ta) is
+    /// T_i(t) = Ta + Q g_i(t) with g(t) = M⁻¹ (e^{Mt} − I) b (M the 2×2 system matrix,
+    /// b = (1/C1, 0)); with Q ~ N(μ_Q, σ_Q²) and Ta ~ N(μ_a, σ_a²) independent, T_i(t) is normal
+    /// with mean μ_a + μ_Q g_i and variance σ_a² + σ_Q² g_i². The bands of the accumulator over
+    /// 2^14 scrambled Sobol' samples must match those normal quantiles at every time, within one
+    /// Monte-Carlo standard error of a quantile.
+    #[test]
+    fn bands_of_a_linear_two_node_network_match_the_analytic_distribution() {
+        let (c1, c2, g12, g2a): (f64, f64, f64, f64) = (2.0e4, 5.0e4, 20.0, 10.0);
+        let m = [[-g12 / c1, g12 / c1], [g12 / c2, -(g12 + g2a) / c2]];
+        let (tr, det) = (m[0][0] + m[1][1], m[0][0] * m[1][1] - m[0][1] * m[1][0]);
+        let disc = (tr * tr / 4.0 - det).sqrt();
+        let (l1, l2) = (tr / 2.0 + disc, tr / 2.0 - disc);
+        // g(t) = M⁻¹ (e^{Mt} − I) b, e^{Mt} by Sylvester's formula for distinct eigenvalues.
+        let g = |t: f64| -> [f64; 2] {
+            let (e1, e2) = ((l1 * t).exp(), (l2 * t).exp());
+            let ex = |i: usize, j: usize| {
+                let id = if i == j { 1.0 } else { 0.0 };
+                (e1 * (m[i][j] - l2 * id) - e2 * (m[i][j] - l1 * id)) / (l1 - l2)
+            };
+            let v = [(ex(0, 0) - 1.0) / c1, ex(1, 0) / c1];
+            let inv = [[m[1][1] / det, -m[0][1] / det], [-m[1][0] / det, m[0][0] / det]];
+            [
+                inv[0][0] * v[0] + inv[0][1] * v[1],
+                inv[1][0] * v[0] + inv[1][1] * v[1],
+            ]
+        };
+        let times: Vec<f64> = (0..=40).map(|k| k as f64 * 300.0).collect();
+        let q = Distribution::Normal {
+            mean: 500.0,
+            sd: 50.0,
+        };
+        let ta = Distribution::Normal { mean: 30.0, sd: 3.0 };
+        let mut acc = [
+            BandAccumulator::new(times.len()),
+            BandAccumulator::new(times.len()),
+        ];
+        let n = 1usize << 14;
+        for u in sobol_points(n, 2, Some(21)).unwrap() {
+            let (qv, tv) = (q.quantile(u[0]), ta.quantile(u[1]));
+            for (node, a) in acc.iter_mut().enumerate() {
+                let series: Vec<f64> = times.iter().map(|&t| tv + qv * g(t)[node]).collect();
+                a.push(&series).unwrap();
+            }
+        }
+        let ps = [5.0, 50.0, 95.0];
+        for (node, a) in acc.iter().enumerate() {
+            let bands = a.bands(&ps).unwrap();
+            for (k, &t) in times.iter().enumerate() {
+                let gi = g(t)[node];
+                let exact = Distribution::Normal {
+                    mean: 30.0 + 500.0 * gi,
+                    sd: (9.0 + 2500.0 * gi * gi).sqrt(),
+                };
+                let sd = (9.0 + 2500.0 * gi * gi).sqrt();
+                for (j, p) in ps.iter().enumerate() {
+                    let want = exact.quantile(p / 100.0);
+                    let err = (bands[j][k] - want).abs();
+                    // One standard error of a Monte-Carlo quantile of n independent samples,
+                    // σ √(p(1−p)/n) / φ(z_p): the scrambled points must do at least as well
+                    // (a wrong band is off by kelvins).
+                    let pf = p / 100.0;
+                    let z = normal_quantile(pf);
+                    let phi = (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt();
+                    let tol = sd * (pf * (1.0 - pf) / n as f64).sqrt() / phi;
+                    assert!(
+                        err < tol,
+                        "node {node}, t = {t} s, p{p}: {} vs {want} (tolerance {tol})",
+                        bands[j][k]
+                    );
+                }
+            }
+        }
+        // The network has warmed: node 1 at 12 000 s is well above the ambient's spread.
+        assert!(g(12_000.0)[0] > 0.1);
     }
 
     #[test]
