@@ -171,5 +171,8 @@ fn the_covariance_is_written_and_bad_options_refused() {
     assert!((got - want).abs() <= 1e-12 * want.abs(), "{got} {want}");
     o.residuals = "ar2".into();
     let e = calibrate::calibrate(&m, &text, &trace, &o).unwrap_err();
-    assert!(e.exit_code() == 1 && e.to_string().contains("--residuals"), "{e}");
+    assert!(
+        e.exit_code() == 1 && e.to_string().contains("residuals = ar2"),
+        "{e}"
+    );
 }

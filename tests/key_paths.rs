@@ -253,6 +253,11 @@ fn every_wrongly_typed_value_is_reported_at_its_full_key_path() {
         "launch.lockup",
         "pump.line_pressure",
     ]) {
+        // `[uncertainty]` is parsed by `geartherm uq` (the study layer), not by the model's
+        // own parse, which only checks that it is a table: tests/uq_cli.rs holds its cases.
+        if *section == "uncertainty" {
+            continue;
+        }
         assert!(
             paths.iter().any(|p| p.starts_with(section)),
             "no value of {section} walked"

@@ -33,8 +33,8 @@ pub mod model;
 pub mod options;
 pub mod rating;
 pub mod run;
-pub mod spread;
 pub mod series;
+pub mod spread;
 pub mod steady;
 pub mod validate;
 
