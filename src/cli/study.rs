@@ -104,42 +104,7 @@ pub fn study(a: &StudyArgs) -> Result<(), Failure> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("studies").join(&study.spec.study.name));
-    let b = progress_bar(
-        cases.len(),
-        "{msg} [{bar:40}] {pos}/{len} cases, {per_sec}, ETA {eta}",
-        study.spec.study.name.clone(),
-        a.quiet,
-    );
-    catch_sigint();
-    let solved = runner::run(&study, &selection, Some(&dir), &INTERRUPTED, &|_| {
-        if let Some(b) = &b {
-            b.inc(1);
-        }
-    });
-    release_sigint();
-    let (tally, _) = solved?;
-    if let Some(b) = &b {
-        b.finish_and_clear();
-    }
-    emit(&format!(
-        "{} cases solved in {:.2} s ({:.2} cases/s on {} threads), {} already done\n",
-        tally.solved,
-        tally.wall_s,
-        tally.rate(),
-        tally.threads,
-        tally.already_done
-    ))?;
-    if tally.cancelled {
-        return Err(Failure {
-            code: EXIT_INTERRUPTED,
-            message: format!(
-                "interrupted: {} of {} cases journaled in {}; run the same command again to resume",
-                tally.already_done + tally.solved,
-                tally.cases,
-                dir.display()
-            ),
-        });
-    }
+    solve_journaled(&study, &selection, cases.len(), &dir, a.quiet, "cases")?;
     if let Some((i, n)) = selection.journal_shard() {
         return emit(&format!(
             "shard {i}/{n} done; run `geartherm study {} --out {}` once every shard finished to merge them\n",
@@ -164,4 +129,54 @@ pub fn study(a: &StudyArgs) -> Result<(), Failure> {
         failed.len(),
         c.files.join(", ")
     ))
+}
+
+/// Solve the selected cases of `study` into the journal in `dir` with a progress bar (unless
+/// `quiet`) and Ctrl-C caught; print the tally, counting in `noun` ("cases", "samples"). An
+/// interruption is a failure that says how to resume.
+pub(super) fn solve_journaled(
+    study: &Study,
+    selection: &Selection,
+    n_cases: usize,
+    dir: &std::path::Path,
+    quiet: bool,
+    noun: &str,
+) -> Result<(), Failure> {
+    let b = progress_bar(
+        n_cases,
+        &format!("{{msg}} [{{bar:40}}] {{pos}}/{{len}} {noun}, {{per_sec}}, ETA {{eta}}"),
+        study.spec.study.name.clone(),
+        quiet,
+    );
+    catch_sigint();
+    let solved = runner::run(study, selection, Some(dir), &INTERRUPTED, &|_| {
+        if let Some(b) = &b {
+            b.inc(1);
+        }
+    });
+    release_sigint();
+    let (tally, _) = solved?;
+    if let Some(b) = &b {
+        b.finish_and_clear();
+    }
+    emit(&format!(
+        "{} {noun} solved in {:.2} s ({:.2} {noun}/s on {} threads), {} already done\n",
+        tally.solved,
+        tally.wall_s,
+        tally.rate(),
+        tally.threads,
+        tally.already_done
+    ))?;
+    if tally.cancelled {
+        return Err(Failure {
+            code: EXIT_INTERRUPTED,
+            message: format!(
+                "interrupted: {} of {} {noun} journaled in {}; run the same command again to resume",
+                tally.already_done + tally.solved,
+                tally.cases,
+                dir.display()
+            ),
+        });
+    }
+    Ok(())
 }

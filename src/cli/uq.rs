@@ -6,13 +6,12 @@
 use std::path::PathBuf;
 
 use crate::job::{RunOptions, SteadyOptions};
-use crate::study::runner;
 use crate::study::uq::output::{compact, UqOutcome};
 use crate::study::uq::run::{read_calibration, Limit, Uq, UqJob, UqOptions, DEFAULT_SERIES_POINTS};
 use crate::study::Selection;
 
-use super::output::{emit, progress_bar, warn, Failure};
-use super::study::{catch_sigint, release_sigint, EXIT_INTERRUPTED, INTERRUPTED};
+use super::output::{emit, warn, Failure};
+use super::study::solve_journaled;
 
 /// Arguments of `uq`.
 #[derive(clap::Args, Debug)]
@@ -188,42 +187,7 @@ pub fn uq(a: &UqArgs) -> Result<(), Failure> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("uq").join(&uq.study.spec.study.name));
-    let b = progress_bar(
-        cases.len(),
-        "{msg} [{bar:40}] {pos}/{len} samples, {per_sec}, ETA {eta}",
-        uq.study.spec.study.name.clone(),
-        a.quiet,
-    );
-    catch_sigint();
-    let solved = runner::run(&uq.study, &selection, Some(&dir), &INTERRUPTED, &|_| {
-        if let Some(b) = &b {
-            b.inc(1);
-        }
-    });
-    release_sigint();
-    let (tally, _) = solved?;
-    if let Some(b) = &b {
-        b.finish_and_clear();
-    }
-    emit(&format!(
-        "{} samples solved in {:.2} s ({:.2} samples/s on {} threads), {} already done\n",
-        tally.solved,
-        tally.wall_s,
-        tally.rate(),
-        tally.threads,
-        tally.already_done
-    ))?;
-    if tally.cancelled {
-        return Err(Failure {
-            code: EXIT_INTERRUPTED,
-            message: format!(
-                "interrupted: {} of {} samples journaled in {}; run the same command again to resume",
-                tally.already_done + tally.solved,
-                tally.cases,
-                dir.display()
-            ),
-        });
-    }
+    solve_journaled(&uq.study, &selection, cases.len(), &dir, a.quiet, "samples")?;
     if let Some((i, n)) = selection.journal_shard() {
         return emit(&format!(
             "shard {i}/{n} done; run the same command without --shard once every shard finished to merge them\n"
