@@ -183,6 +183,8 @@ def run_args(rng, v, case):
         args += ["--initial-temp-c", v(["-30", "23", "120"])]
     if rng.random() < 0.1:
         args += ["--frozen-viscosity-c", v(["-60", "-40", "0", "40", "199"])]
+    if rng.random() < 0.2:
+        args += ["--spread"]
     return args
 
 
