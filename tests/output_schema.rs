@@ -24,8 +24,8 @@ use std::process::{Command, Output};
 
 use geartherm::report::map::{map_csv, MapMeta};
 use geartherm::report::plots::data::{read_bench, read_json, read_map, read_run};
-use geartherm::scene::Source;
 use geartherm::report::run::Summary;
+use geartherm::scene::Source;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -284,7 +284,11 @@ fn map_csv_reads_back(dir: &Path) {
     let mut by_file_order = rows.clone();
     let text = fs::read_to_string(dir.join("map.csv")).unwrap();
     // The grid holds the rows torque-major; the file is speed-major.
-    by_file_order.sort_by(|a, b| a.speed_rpm.total_cmp(&b.speed_rpm).then(a.torque_nm.total_cmp(&b.torque_nm)));
+    by_file_order.sort_by(|a, b| {
+        a.speed_rpm
+            .total_cmp(&b.speed_rpm)
+            .then(a.torque_nm.total_cmp(&b.torque_nm))
+    });
     assert_eq!(by_file_order.len(), text.lines().count() - 1);
     assert_eq!(map_csv(&by_file_order), text, "{}", dir.display());
 }
@@ -326,7 +330,10 @@ fn a_map_directory_of_the_oldest_format_reads_with_todays_names() {
     assert_eq!((cell.speed_rpm, cell.torque_nm), (300.0, 0.0));
     // `total_loss_w` and `<source>_w` read as `loss_total_w` and `loss_<source>_w`.
     assert_eq!(cell.loss_total_w, Some(first[3].parse().unwrap()));
-    assert_eq!(cell.loss_w[Source::Churning.index()], Some(first[4].parse().unwrap()));
+    assert_eq!(
+        cell.loss_w[Source::Churning.index()],
+        Some(first[4].parse().unwrap())
+    );
     assert_eq!(cell.loss_w[Source::Sliding.index()], Some(0.0));
     // A source the version did not write has no value; a column it did not write is empty.
     assert_eq!(cell.loss_w[Source::Bearing.index()], None);
