@@ -119,8 +119,8 @@ type Point = (f64, f64, Vec<f64>, Vec<f64>);
 /// The importer's side of a WLTC co-simulation at communication step `step`: per 1 s sample,
 /// its inputs and its communication points.
 fn plan(p: &run::Prepared, step: f64) -> Vec<(Inputs, Vec<Point>)> {
-    let nb = p.scene.thermal.boundary_names.len();
-    let at = |k, t| p.scene.thermal.boundary_temperature_at(k, t).unwrap();
+    let nb = p.scene.thermal().boundary_names.len();
+    let at = |k, t| p.scene.thermal().boundary_temperature_at(k, t).unwrap();
     p.segs
         .iter()
         .map(|seg| {
@@ -156,7 +156,7 @@ fn refs(fm: &FmuModel) -> Refs {
             vr(Role::VehicleSpeed),
         ],
         gear: vr(Role::Gear),
-        boundaries: (0..fm.scene.thermal.boundary_names.len())
+        boundaries: (0..fm.scene.thermal().boundary_names.len())
             .map(|b| vr(Role::Boundary(b)))
             .collect(),
         outputs: (0..fm.scene.nodes())

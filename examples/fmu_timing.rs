@@ -35,8 +35,8 @@ type Points = Vec<(f64, f64, Vec<(f64, f64)>)>;
 /// clock starts (the boundary values are read from the run's series): per segment its inputs
 /// and communication points.
 fn plan(p: &run::Prepared, step: f64) -> Vec<(Inputs, Points)> {
-    let nb = p.scene.thermal.boundary_names.len();
-    let at = |k, t| p.scene.thermal.boundary_temperature_at(k, t).unwrap();
+    let nb = p.scene.thermal().boundary_names.len();
+    let at = |k, t| p.scene.thermal().boundary_temperature_at(k, t).unwrap();
     p.segs
         .iter()
         .map(|seg| {
@@ -65,7 +65,7 @@ fn cosim(fm: &Arc<FmuModel>, p: &run::Prepared, step: f64) -> (f64, usize) {
         vr(Role::VehicleSpeed),
         vr(Role::Gear),
     );
-    let boundaries: Vec<u32> = (0..p.scene.thermal.boundary_names.len())
+    let boundaries: Vec<u32> = (0..p.scene.thermal().boundary_names.len())
         .map(|b| vr(Role::Boundary(b)))
         .collect();
     let plan = plan(p, step);

@@ -4,12 +4,13 @@ scene. The scene is compiled for its scenario (states, ambient, frozen viscosity
 recorded: scene::Needs); a job, solver, test or benchmark that writes a field of a Scene (or of
 its thermal or loss part) after the compile is reported with file and line.
 
-The fields `skipped`, `energy_slot`, `frozen_oil_temp`, `energies`, `item_energies` and
-`oil_temp_clamp` are private to src/scene/ (the compiler refuses a write); `losses` and
-`thermal` are public for reading, and this check finds a write into them: a statement that
-assigns through a scene variable (a name containing `scene` or `sc`, or any name the file binds
-to a `Scene`: `let x: Scene`, `let x = Scene::compile…`, a parameter `x: &mut Scene`), a
-mutable borrow of a scene part (`&mut x.thermal`), or `std::mem::{swap, replace, take}` on one.
+Every field of a Scene is private to src/scene/ (the compiler refuses a write from elsewhere);
+`losses` and `thermal` are read through `Scene::losses()` and `Scene::thermal()`, which return
+shared references. This check finds what would still be a patch if a field were opened again: a
+statement that assigns through a scene variable (a name containing `scene` or `sc`, or any name
+the file binds to a `Scene`: `let x: Scene`, `let x = Scene::compile…`, a parameter
+`x: &mut Scene`), a mutable borrow of a scene part (`&mut x.thermal`), or
+`std::mem::{swap, replace, take}` on one, and any call of `set_boundary_fixed`.
 
 Run from the repository root: python3 scripts/scene_patches.py (exit 1 on any finding);
 `--self-test` checks the patterns on written examples.
@@ -62,7 +63,7 @@ def line_findings(text: str):
 
 
 def findings(root: pathlib.Path):
-    for top in ("src", "tests", "benches", "python/src"):
+    for top in ("src", "tests", "benches", "examples", "python/src"):
         for f in sorted((root / top).rglob("*.rs")):
             rel = f.relative_to(root).as_posix()
             if rel.startswith("src/scene/"):
@@ -80,6 +81,7 @@ SELF_TEST = [
     ("let n = scene.thermal.names.len();\nlet m = &model.thermal;", 0),
     ("let mut gb = model;\ngb.thermal.ambient_c = 3.0;", 0),
     ("if scene.thermal.oil == 2 {}", 0),
+    ("let n = scene.thermal().names.len();\nlet it = &scene.losses().items[0];", 0),
 ]
 
 

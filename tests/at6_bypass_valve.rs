@@ -42,11 +42,11 @@ fn the_valve_leaves_the_warm_up_heating_alone() {
     let base = model::load(std::path::Path::new("models/at6_lepelletier.toml")).unwrap();
     let (s0, segs) = wltc_scene(&base);
     let (s1, _) = wltc_scene(&variant());
-    assert_eq!(s1.thermal.controls.len(), 1);
+    assert_eq!(s1.thermal().controls.len(), 1);
     let first: Vec<Segment> = segs.iter().filter(|s| s.t1 <= 600.0).copied().collect();
     let a = integrate(&s0, &first, &opts(None), &mut |_, _| {}).unwrap();
     let b = integrate(&s1, &first, &opts(None), &mut |_, _| {}).unwrap();
-    let sump = s0.thermal.names.iter().position(|n| n == "sump").unwrap();
+    let sump = s0.thermal().names.iter().position(|n| n == "sump").unwrap();
     let mut worst: f64 = 0.0;
     let mut sump_max: f64 = f64::MIN;
     for (ya, yb) in a.states.iter().zip(&b.states) {

@@ -62,7 +62,7 @@ fn two_way_exchanger_heats_cold_oil_and_cools_hot_oil_through_its_thermostat() {
 #[test]
 fn at6_has_clutch_drag_pump_and_converter_items_that_heat_the_oil() {
     let (gb, scene) = scene_of("models/at6_lepelletier.toml");
-    let items = &scene.losses.items;
+    let items = &scene.losses().items;
     let names = |s: Source| -> Vec<&str> {
         items
             .iter()
@@ -93,7 +93,7 @@ fn at6_has_clutch_drag_pump_and_converter_items_that_heat_the_oil() {
         ),
         (0.0, 0.0)
     );
-    let oil = scene.thermal.oil_properties(40.0 + KELVIN_OFFSET);
+    let oil = scene.thermal().oil_properties(40.0 + KELVIN_OFFSET);
     let w3 = &gb.gear_states[third].solution.speeds;
     let m = |n: &str| gb.members.iter().position(|x| x.name == n).unwrap();
     for (e, slip) in [
@@ -109,7 +109,7 @@ fn at6_has_clutch_drag_pump_and_converter_items_that_heat_the_oil() {
             .iter()
             .position(|c| c.name == format!("{e}_feed"))
             .unwrap();
-        pack.oil_flow = scene.losses.circuit.flow(feed, &work.terms.circuit, oil.rho).0;
+        pack.oil_flow = scene.losses().circuit.flow(feed, &work.terms.circuit, oil.rho).0;
         assert!(pack.oil_flow > 0.0);
         let want = pack.drag(slip * 2000.0 * RPM, oil.mu, oil.rho).power;
         assert!(
@@ -145,10 +145,10 @@ fn at6_has_clutch_drag_pump_and_converter_items_that_heat_the_oil() {
         .filter(|(i, _)| i.source == Source::ClutchDrag)
         .all(|(_, w)| *w == 0.0));
     // all three default to the oil node
-    let oil = scene.thermal.oil;
+    let oil = scene.thermal().oil;
     for (k, it) in items.iter().enumerate() {
         if matches!(it.source, Source::ClutchDrag | Source::Pump | Source::Converter) {
-            assert_eq!(scene.thermal.heat[k], vec![(oil, 1.0)], "{}", it.name);
+            assert_eq!(scene.thermal().heat[k], vec![(oil, 1.0)], "{}", it.name);
         }
     }
 }
@@ -167,7 +167,7 @@ fn cold_oil_drags_more() {
         let y = scene.initial_state(Some(t_c + KELVIN_OFFSET));
         scene.evaluate_losses(&y, &mut work);
         scene
-            .losses
+            .losses()
             .items
             .iter()
             .zip(&work.q)
@@ -299,7 +299,7 @@ fn at6_gearbox_loss(
     scene.evaluate_losses(&y, &mut work);
     let mut by = [0.0; 3]; // gears+bearings+seals, clutch drag, pump
     let mut total = 0.0;
-    for (it, q) in scene.losses.items.iter().zip(&work.q) {
+    for (it, q) in scene.losses().items.iter().zip(&work.q) {
         match it.source {
             Source::Converter => continue,
             Source::ClutchDrag => by[1] += q,

@@ -244,7 +244,7 @@ fn loss_multipliers_scale_their_items() {
         let mut w = s.work(inputs);
         let y = s.initial_state(Some(330.0));
         s.evaluate_losses(&y, &mut w);
-        (s.losses.items.clone(), w.q)
+        (s.losses().items.clone(), w.q)
     };
     let (items, q0) = q(&base);
     let (_, q1) = q(&scaled);

@@ -24,15 +24,15 @@ fn at6() -> (model::Gearbox, Scene) {
 fn the_at6_has_advection_links_and_fed_meshes() {
     let (gb, sc) = at6();
     // PS1 and RAV feeds (their set nodes), five packs and the output bearings (shafts_clutches).
-    assert_eq!(sc.thermal.advection_link_count(), 8);
+    assert_eq!(sc.thermal().advection_link_count(), 8);
     assert_eq!(gb.circuit.consumers.len(), 8);
     for s in [Source::Pocketing, Source::Fling, Source::Windage] {
-        assert!(sc.losses.items.iter().any(|i| i.source == s), "{s:?}");
+        assert!(sc.losses().items.iter().any(|i| i.source == s), "{s:?}");
     }
     // every external planet mesh is fed, none is left out for an unknown density
-    assert!(sc.losses.warnings.iter().all(|w| !w.range.contains("unknown")));
+    assert!(sc.losses().warnings.iter().all(|w| !w.range.contains("unknown")));
     let pocketing = sc
-        .losses
+        .losses()
         .items
         .iter()
         .filter(|i| i.source == Source::Pocketing)
@@ -81,7 +81,7 @@ fn at6_wltc_with_advection_closes_the_energy_balance_and_pockets_delivered_oil()
 #[test]
 fn steady_state_equals_a_long_transient_with_advection_links() {
     let (gb, sc) = at6();
-    assert!(sc.thermal.advection_link_count() > 0);
+    assert!(sc.thermal().advection_link_count() > 0);
     for gear in ["1", "4"] {
         let inp = Inputs {
             state: gb.state_index(gear).unwrap(),
@@ -105,7 +105,7 @@ fn steady_state_equals_a_long_transient_with_advection_links() {
         };
         let traj = integrate(&sc, &segs, &o, &mut |_, _| {}).unwrap();
         let last = traj.states.last().unwrap();
-        let oil = sc.thermal.oil;
+        let oil = sc.thermal().oil;
         let start_gap = (traj.states[0][oil] - eq.solution.temperatures[oil]).abs();
         assert!(start_gap > 1.0);
         let worst = eq
@@ -286,8 +286,8 @@ fn the_advection_links_carry_the_oil_nodes_specific_heat() {
         };
         let eq = equilibrium(&sc, inp, None, &SteadyOptions::default()).unwrap();
         let t = &eq.solution.temperatures;
-        let set = sc.thermal.names.iter().position(|n| n == "ravigneaux").unwrap();
-        t[set] - t[sc.thermal.oil]
+        let set = sc.thermal().names.iter().position(|n| n == "ravigneaux").unwrap();
+        t[set] - t[sc.thermal().oil]
     };
     let base = gap(&[]);
     let doubled = gap(&[

@@ -74,7 +74,7 @@ fn scene(l: Law) -> (Scene, Inputs, [f64; 2]) {
     let y = scene.initial_state(None);
     scene.evaluate_losses(&y, &mut w);
     let mut src = [0.0; 2];
-    for (q, dest) in w.q.iter().zip(&scene.thermal.heat) {
+    for (q, dest) in w.q.iter().zip(&scene.thermal().heat) {
         for &(node, f) in dest {
             src[node] += f * q;
         }

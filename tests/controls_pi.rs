@@ -82,7 +82,7 @@ fn source(scene: &Scene, torque: f64) -> f64 {
     let y = scene.initial_state(None);
     scene.evaluate_losses(&y, &mut w);
     let mut src = vec![0.0; scene.nodes()];
-    for (q, dest) in w.q.iter().zip(&scene.thermal.heat) {
+    for (q, dest) in w.q.iter().zip(&scene.thermal().heat) {
         for &(node, f) in dest {
             src[node] += f * q;
         }
@@ -190,7 +190,7 @@ fn step_response_from_cold_settles_on_the_set_point_on_ros3_and_bdf() {
         let traj = run(&scene, &segs, method, rtol);
         let last = traj.states.last().unwrap();
         let share_col = 0;
-        let integ_col = scene.thermal.controls.len();
+        let integ_col = scene.thermal().controls.len();
         let (mut peak, mut share_lo, mut share_hi) = (f64::MIN, f64::MAX, f64::MIN);
         for (y, c) in traj.states.iter().zip(&traj.controls) {
             peak = peak.max(y[0] - KELVIN_OFFSET);
@@ -250,7 +250,7 @@ fn the_integral_stands_still_at_saturation_and_the_valve_recovers() {
         inputs: light,
     }));
     let traj = run(&scene, &segs, Method::Ros3, 1e-10);
-    let integ_col = scene.thermal.controls.len();
+    let integ_col = scene.thermal().controls.len();
     let mut at_max = Vec::new();
     for ((c, y), t) in traj.controls.iter().zip(&traj.states).zip(&traj.times) {
         if (c[0] - 0.3).abs() < 1e-12 && *t <= 20_000.0 {
@@ -279,7 +279,7 @@ fn the_integral_stands_still_at_saturation_and_the_valve_recovers() {
         .fold(f64::MIN, f64::max);
     let (_, i_end, hot) = *at_max.last().unwrap();
     let k20 = traj.times.iter().position(|t| *t == 20_000.0).unwrap();
-    let ks = scene.control_row_index() + scene.thermal.control_rows();
+    let ks = scene.control_row_index() + scene.thermal().control_rows();
     let (y20, end) = (&traj.states[k20], traj.states.last().unwrap());
     let (t_lo, t_hi) = (y20[ks + 1], y20[ks + 2]);
     println!(
@@ -316,7 +316,7 @@ fn jacobian_with_the_integral_column_matches_products_and_differences() {
     let mut y = scene.initial_state(None);
     y[0] = SET_C + 1.0 + KELVIN_OFFSET;
     y[1] = 45.0 + KELVIN_OFFSET;
-    let row = scene.thermal.integral_row(0).unwrap();
+    let row = scene.thermal().integral_row(0).unwrap();
     y[row] = 0.3;
     scene.initial_control_modes(&y, &mut work);
     assert_eq!(work.net.mode[0], 1, "the valve between its limits");

@@ -82,8 +82,8 @@ fn drive_model(fm: Arc<FmuModel>, p: &run::Prepared, step: f64) -> (f64, f64) {
         for j in 0..n_sub {
             let t0 = seg.t0 + (seg.t1 - seg.t0) * j as f64 / n_sub as f64;
             let t1 = seg.t0 + (seg.t1 - seg.t0) * (j + 1) as f64 / n_sub as f64;
-            for b in 0..p.scene.thermal.boundary_names.len() {
-                let at = |t| p.scene.thermal.boundary_temperature_at(b, t).unwrap();
+            for b in 0..p.scene.thermal().boundary_names.len() {
+                let at = |t| p.scene.thermal().boundary_temperature_at(b, t).unwrap();
                 inst.set(vr(Role::Boundary(b)), at(t0)).unwrap();
                 inst.set_derivative(vr(Role::Boundary(b)), 1, (at(t1) - at(t0)) / (t1 - t0))
                     .unwrap();

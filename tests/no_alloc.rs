@@ -77,8 +77,8 @@ fn sample_switch_right_hand_side_and_jacobian_product_allocate_nothing() {
         let mut ft = vec![0.0; y.len()];
         let before = allocs();
         for k in 0..20 {
-            y[scene.thermal.oil] += 0.5 * k as f64; // new T_oil: the Jacobian column is recomputed
-                                                    // a new sample: per-sample conductances and loss terms are recomputed
+            y[scene.thermal().oil] += 0.5 * k as f64; // new T_oil: the Jacobian column is recomputed
+                                                      // a new sample: per-sample conductances and loss terms are recomputed
             let sample = Inputs {
                 input_speed: 250.0 + k as f64,
                 input_torque: if k % 2 == 0 { 150.0 } else { -40.0 },
@@ -198,8 +198,8 @@ cooler = "pi_cooler"
 "#;
     let gb = model::from_str(&format!("{text}\n{extra}"), std::path::Path::new("m.toml")).unwrap();
     let scene = Scene::compile(&gb).unwrap();
-    assert_eq!(scene.thermal.controls.len(), 4);
-    assert!(scene.thermal.integral_row(3).is_some());
+    assert_eq!(scene.thermal().controls.len(), 4);
+    assert!(scene.thermal().integral_row(3).is_some());
     let inputs = Inputs {
         state: 0,
         input_speed: 250.0,
@@ -214,7 +214,7 @@ cooler = "pi_cooler"
     let (mut v, mut jv) = (vec![0.0; y.len()], vec![0.0; y.len()]);
     let before = allocs();
     for k in 0..20 {
-        y[scene.thermal.oil] += 3.0; // through the valve's band and the set points
+        y[scene.thermal().oil] += 3.0; // through the valve's band and the set points
         v[k % y.len()] = 1.0;
         scene.jvp(k as f64, &y, &v, &mut work, &mut jv);
         scene.rhs(k as f64, &y, &mut work, &mut dy);

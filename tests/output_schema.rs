@@ -8,8 +8,13 @@
 //!   the results in memory.
 //! - map: `map.json` read as `report::map::MapMeta` gives the same JSON value; `report DIR` draws the
 //!   same heat maps and `report.md` as `map` did.
-//! - bench: `bench.csv` read into `solve::work_precision::BenchRow`s; `report DIR` draws the same
-//!   `work_precision.png` as `bench` did.
+//! - map: `map.csv` read as `report::map::MapRow`s and written again gives the same bytes.
+//! - bench: `bench.json` read as `report::bench::BenchResult`, `bench.csv` into its
+//!   `solve::work_precision::BenchRow`s; `report DIR` draws the same `work_precision.png` as
+//!   `bench` did.
+//! - map and bench directories written by the previous binary read back, and `report DIR` draws
+//!   the figures that binary drew; a map of the oldest format (`total_loss_w`, `<source>_w`)
+//!   reads with today's names.
 //! - rating, study, calibrate and validate directories hold none of these files: `report`
 //!   refuses them (exit 1) and writes nothing.
 
@@ -17,9 +22,10 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use geartherm::report::map::MapMeta;
-use geartherm::report::plots::data::{read_bench, read_json, read_run};
+use geartherm::report::map::{map_csv, MapMeta};
+use geartherm::report::plots::data::{read_bench, read_json, read_map, read_run};
 use geartherm::report::run::Summary;
+use geartherm::scene::Source;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -139,6 +145,7 @@ fn map_and_bench_directories_read_back_with_the_writers_types() {
     let meta: MapMeta = read_json(&map.join("map.json")).unwrap();
     assert_eq!(serde_json::to_value(&meta).unwrap(), json(&map.join("map.json")));
     assert_eq!(meta.points, 9);
+    map_csv_reads_back(&map);
     report_redraws(
         &map,
         &d.path().join("map_again"),
@@ -167,7 +174,12 @@ fn map_and_bench_directories_read_back_with_the_writers_types() {
         "--out",
         b,
     ]);
-    let (rows, _) = read_bench(&bench).unwrap();
+    let result = read_bench(&bench).unwrap();
+    let file = json(&bench.join("bench.json"));
+    assert_eq!(result.model, file["model"].as_str().unwrap());
+    assert_eq!(result.cycle, file["cycle"].as_str().unwrap());
+    assert_eq!(result.default.solver, file["default"]["solver"].as_str().unwrap());
+    let rows = result.rows;
     let lines = fs::read_to_string(bench.join("bench.csv"))
         .unwrap()
         .lines()
@@ -263,4 +275,73 @@ fn a_run_directory_of_an_earlier_format_reads_with_todays_names() {
         )),
         "{md}"
     );
+}
+
+/// `map.csv` of `dir` read with the writer's type and written again: the same bytes.
+fn map_csv_reads_back(dir: &Path) {
+    let grid = read_map(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+    let rows: Vec<_> = grid.cells.into_iter().flatten().collect();
+    let mut by_file_order = rows.clone();
+    let text = fs::read_to_string(dir.join("map.csv")).unwrap();
+    // The grid holds the rows torque-major; the file is speed-major.
+    by_file_order.sort_by(|a, b| {
+        a.speed_rpm
+            .total_cmp(&b.speed_rpm)
+            .then(a.torque_nm.total_cmp(&b.torque_nm))
+    });
+    assert_eq!(by_file_order.len(), text.lines().count() - 1);
+    assert_eq!(map_csv(&by_file_order), text, "{}", dir.display());
+}
+
+#[test]
+fn map_and_bench_directories_of_the_previous_binary_read_back() {
+    let map = root().join("tests/fixtures/map_main_c9b66ad");
+    map_csv_reads_back(&map);
+    let meta: MapMeta = read_json(&map.join("map.json")).unwrap();
+    assert_eq!(serde_json::to_value(&meta).unwrap(), json(&map.join("map.json")));
+    let d = tempfile::tempdir().unwrap();
+    report_redraws(
+        &map,
+        &d.path().join("map"),
+        &["map.csv", "map.json"],
+        &["map_efficiency.png", "report.md"],
+    );
+    let bench = root().join("tests/fixtures/bench_main_c9b66ad");
+    let result = read_bench(&bench).unwrap();
+    assert_eq!(result.model, "FZG C-type test gearbox");
+    assert_eq!(result.rows.len(), 4);
+    assert_eq!(result.pareto.len(), 4);
+    assert!(result.reference.agreement_k > 0.0 && result.reference.methods[1] == "bdf");
+    report_redraws(
+        &bench,
+        &d.path().join("bench"),
+        &["bench.csv", "bench.json"],
+        &["work_precision.png"],
+    );
+}
+
+#[test]
+fn a_map_directory_of_the_oldest_format_reads_with_todays_names() {
+    let fixture = root().join("tests/fixtures/map_d379aa5");
+    let grid = read_map(&fixture).unwrap();
+    let text = fs::read_to_string(fixture.join("map.csv")).unwrap();
+    let first: Vec<&str> = text.lines().nth(1).unwrap().split(',').collect();
+    let cell = grid.cell(0, 0).unwrap();
+    assert_eq!((cell.speed_rpm, cell.torque_nm), (300.0, 0.0));
+    // `total_loss_w` and `<source>_w` read as `loss_total_w` and `loss_<source>_w`.
+    assert_eq!(cell.loss_total_w, Some(first[3].parse().unwrap()));
+    assert_eq!(
+        cell.loss_w[Source::Churning.index()],
+        Some(first[4].parse().unwrap())
+    );
+    assert_eq!(cell.loss_w[Source::Sliding.index()], Some(0.0));
+    // A source the version did not write has no value; a column it did not write is empty.
+    assert_eq!(cell.loss_w[Source::Bearing.index()], None);
+    assert_eq!(cell.limit_cycle_period_s, None);
+    assert_eq!(grid.cells.iter().flatten().count(), 9);
+    let d = tempfile::tempdir().unwrap();
+    inputs(&fixture, d.path(), &["map.csv", "map.json"]);
+    ok(&["report", d.path().to_str().unwrap()]);
+    let md = fs::read_to_string(d.path().join("report.md")).unwrap();
+    assert!(md.contains("| Total loss | 2.9 … 12.7 W |"), "{md}");
 }

@@ -41,7 +41,7 @@ fn check_cache(gb: &model::Gearbox, label: &str) -> f64 {
                     state,
                     input_speed: w,
                     input_torque: torque,
-                    oil: net.thermal.oil_properties(t_c + 273.15),
+                    oil: net.thermal().oil_properties(t_c + 273.15),
                 };
                 scene.evaluate(&op, &mut full);
                 scene.evaluate_cached(&op, &terms, &mut cached);
@@ -97,7 +97,7 @@ fn cached_terms_for_another_sample_are_not_used() {
         state: 0,
         input_speed: 200.0,
         input_torque: 120.0,
-        oil: net.thermal.oil_properties(330.0),
+        oil: net.thermal().oil_properties(330.0),
     };
     let (mut a, mut b) = (vec![0.0; scene.len()], vec![0.0; scene.len()]);
     scene.evaluate(&op, &mut a);

@@ -152,7 +152,7 @@ fn the_analytic_time_derivative_matches_a_central_difference_of_the_rhs() {
     let (scene, segs) = wltc("models/at6_lepelletier.toml");
     let mut work = scene.work(segs[400].inputs);
     let mut y = scene.initial_state(None);
-    y[scene.thermal.oil] += 30.0; // the coolant exchanger between the oil and a warmer coolant
+    y[scene.thermal().oil] += 30.0; // the coolant exchanger between the oil and a warmer coolant
     let n_s = scene.n_states();
     let (mut ft, mut f1, mut f0) = (vec![0.0; n_s], vec![0.0; n_s], vec![0.0; n_s]);
     let d = 1e-3;
@@ -170,7 +170,7 @@ fn the_analytic_time_derivative_matches_a_central_difference_of_the_rhs() {
     scene.time_derivative(300.0, &y, &mut work, &mut ft);
     scene.rhs(300.0 + d, &y, &mut work, &mut f1);
     scene.rhs(300.0, &y, &mut work, &mut f0);
-    let oil = scene.thermal.oil;
+    let oil = scene.thermal().oil;
     let fd = (f1[oil] - f0[oil]) / d;
     assert!(
         (ft[oil] - fd).abs() <= 1e-6 * fd.abs().max(1e-12),

@@ -30,7 +30,7 @@ fn fifty_patch_wall_runs_the_wltc_sparse_with_the_energy_balance_closed() {
 
     // The sump pool wets the first 3 of 10 columns: those patches run warmer than the dry ones
     // while the oil heats the case (mid-cycle), the last dry column the coolest.
-    let names = &scene.thermal.names;
+    let names = &scene.thermal().names;
     let col_mean = |y: &[f64], i: usize| -> f64 {
         let v: Vec<f64> = (0..along)
             .map(|j| {
@@ -70,13 +70,13 @@ fn evenly_split_mesh_reproduces_the_lumped_housing() {
     let o = opts(LinearAlgebra::Auto);
     let a = integrate(&s0, &segs, &o, &mut |_, _| {}).unwrap();
     let b = integrate(&s1, &segs, &o, &mut |_, _| {}).unwrap();
-    let h0 = s0.thermal.names.iter().position(|n| n == "housing").unwrap();
-    let oil = s0.thermal.oil;
-    assert_eq!(oil, s1.thermal.oil);
+    let h0 = s0.thermal().names.iter().position(|n| n == "housing").unwrap();
+    let oil = s0.thermal().oil;
+    assert_eq!(oil, s1.thermal().oil);
     let mut worst = 0.0f64;
     for (ya, yb) in a.states.iter().zip(&b.states) {
         worst = worst.max((ya[oil] - yb[oil]).abs());
-        for (i, name) in s1.thermal.names.iter().enumerate() {
+        for (i, name) in s1.thermal().names.iter().enumerate() {
             if name.starts_with("housing_") {
                 worst = worst.max((ya[h0] - yb[i]).abs());
             }

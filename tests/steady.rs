@@ -62,7 +62,7 @@ fn steady_state_equals_a_long_transient() {
         let last = traj.states.last().unwrap();
         // The transient starts at the model's initial temperatures, far from the equilibrium, so
         // agreement is not the start value echoed back.
-        let start_gap = (traj.states[0][sc.thermal.oil] - eq.solution.temperatures[sc.thermal.oil]).abs();
+        let start_gap = (traj.states[0][sc.thermal().oil] - eq.solution.temperatures[sc.thermal().oil]).abs();
         assert!(
             start_gap > 1.0,
             "{path}: transient starts only {start_gap} K away"
@@ -76,7 +76,7 @@ fn steady_state_equals_a_long_transient() {
             .fold(0.0, f64::max);
         println!(
             "{path}: oil {:.4} °C steady (transient starts {start_gap:.1} K away), |steady − transient(60 h)| max {worst:.2e} K, {} Newton iterations",
-            eq.solution.temperatures[sc.thermal.oil] - KELVIN_OFFSET,
+            eq.solution.temperatures[sc.thermal().oil] - KELVIN_OFFSET,
             eq.solution.iterations
         );
         assert!(worst < 1e-6, "{path}: {worst}");
@@ -107,7 +107,7 @@ fn newton_converges_from_ambient_on_a_10_by_10_grid() {
                 iters += eq.solution.iterations;
                 ptc += eq.solution.ptc_iterations;
                 worst_res = worst_res.max(eq.solution.residual_w);
-                let oil = eq.solution.temperatures[sc.thermal.oil] - KELVIN_OFFSET;
+                let oil = eq.solution.temperatures[sc.thermal().oil] - KELVIN_OFFSET;
                 assert!(oil > 20.0 && oil < 200.0, "{path}: oil {oil}");
             }
         }

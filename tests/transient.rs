@@ -226,7 +226,7 @@ fn at6_wltc_cold_start_warms_up_with_viscosity_feedback() {
     let (scene, coupled) = at6_wltc(None);
     let (_, frozen) = at6_wltc(Some(23.0 + KELVIN_OFFSET));
     let bal = energy_balance(&scene, &coupled);
-    let oil = scene.thermal.oil;
+    let oil = scene.thermal().oil;
     let t0 = coupled.states[0][oil] - KELVIN_OFFSET;
     let t1 = coupled.states.last().unwrap()[oil] - KELVIN_OFFSET;
     let fb = energy_balance(&scene, &frozen);

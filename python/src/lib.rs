@@ -238,7 +238,7 @@ impl Model {
         let r = py
             .detach(|| in_process_pool(|| job::map::map(&m, &o, &|| {})))
             .map_err(job_error)?;
-        Ok(r.csv)
+        Ok(r.csv())
     }
 
     /// A thermal rating (a mapping of `job::RatingOptions` in): the `rating.json` document.

@@ -98,7 +98,7 @@ pub fn bench(args: &BenchArgs) -> Result<(), Failure> {
     for (name, bytes) in r.files()? {
         out.write(name, &bytes)?;
     }
-    crate::report::plots::render_bench(out.path()).map_err(|e| io_failure(format!("plot: {e}")))?;
+    crate::report::plots::render_bench(out.path(), &r).map_err(|e| io_failure(format!("plot: {e}")))?;
     emit(&format!(
         "{}\n{}\n",
         out.target().join("bench.csv").display(),

@@ -47,10 +47,10 @@ pub fn report(a: &ReportArgs) -> Result<(), Failure> {
         written.extend(plots::render_run_dir(out.path()).map_err(failure)?);
     }
     if out.path().join("map.csv").is_file() {
-        written.extend(plots::render_map(out.path()).map_err(failure)?);
+        written.extend(plots::render_map_dir(out.path()).map_err(failure)?);
     }
     if out.path().join("bench.csv").is_file() {
-        written.push(plots::render_bench(out.path()).map_err(failure)?);
+        written.push(plots::render_bench_dir(out.path()).map_err(failure)?);
     }
     let text: String = written
         .iter()

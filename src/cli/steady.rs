@@ -201,7 +201,8 @@ pub fn map(a: &MapArgs) -> Result<(), Failure> {
         out.write(name, &bytes)?;
     }
     if !a.no_plots {
-        crate::report::plots::render_map(out.path()).map_err(|e| io_failure(format!("plot: {e}")))?;
+        crate::report::plots::render_map(out.path(), &r.rows, &r.meta)
+            .map_err(|e| io_failure(format!("plot: {e}")))?;
     }
     emit(&format!(
         "{n} points ({} converged, {:.1} iterations on average) in {:.3} s on {} threads; outputs in {}\n",

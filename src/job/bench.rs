@@ -3,9 +3,9 @@
 
 use serde::{Deserialize, Serialize};
 
+pub use crate::report::bench::{BenchResult, BenchRow, DefaultOnFront, Reference};
 use crate::solve::transient::{Method, DEFAULT_ATOL, DEFAULT_METHOD, DEFAULT_RTOL};
 use crate::solve::work_precision::{pareto, reference, sweep, to_csv};
-pub use crate::solve::work_precision::{BenchRow, Reference};
 
 use super::limits;
 use super::run::{method, prepare, RunOptions};
@@ -70,44 +70,6 @@ impl BenchOptions {
     }
 }
 
-/// What the study found.
-#[derive(Debug, Clone, Serialize)]
-pub struct BenchResult {
-    /// Model name.
-    pub model: String,
-    /// Cycle name.
-    pub cycle: String,
-    /// The reference and its self-check.
-    pub reference: Reference,
-    /// The product's default and whether it is on the Pareto fronts.
-    pub default: DefaultOnFront,
-    /// Every (solver, tolerance) point.
-    pub rows: Vec<BenchRow>,
-    /// Whether each row is on the Pareto front of (wall time, max error).
-    pub pareto: Vec<bool>,
-    /// Nodes of the network.
-    pub nodes: usize,
-    /// Loss items.
-    pub items: usize,
-    /// Cycle samples.
-    pub samples: usize,
-}
-
-/// The default setting and the fronts it lies on.
-#[derive(Debug, Clone, Serialize)]
-pub struct DefaultOnFront {
-    /// Default solver.
-    pub solver: &'static str,
-    /// Default relative tolerance.
-    pub rtol: f64,
-    /// Default absolute tolerance, K.
-    pub atol: f64,
-    /// On the front among all solvers.
-    pub on_pareto_front: bool,
-    /// On the front among the implicit solvers (the default must handle stiff networks).
-    pub on_implicit_pareto_front: bool,
-}
-
 impl BenchResult {
     /// The files of a bench directory: `bench.csv` and `bench.json`.
     pub fn files(&self) -> Result<Vec<(&'static str, Vec<u8>)>, JobError> {
@@ -164,7 +126,7 @@ pub fn bench(
         cycle: p.cycle.name.clone(),
         reference: info,
         default: DefaultOnFront {
-            solver: DEFAULT_METHOD.name(),
+            solver: DEFAULT_METHOD.name().to_string(),
             rtol: DEFAULT_RTOL,
             atol: DEFAULT_ATOL,
             on_pareto_front: default_on_front,

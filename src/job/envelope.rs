@@ -150,9 +150,9 @@ impl Envelope {
     /// The envelope of `scene` (its oil and its nodes).
     pub fn of(scene: &Scene) -> Envelope {
         Envelope {
-            oil: OilRange::of(scene.thermal.oil_model()),
-            oil_node: scene.thermal.oil,
-            names: scene.thermal.names.clone(),
+            oil: OilRange::of(scene.thermal().oil_model()),
+            oil_node: scene.thermal().oil,
+            names: scene.thermal().names.clone(),
         }
     }
 
@@ -216,7 +216,7 @@ fn largest_item(scene: &Scene, seg: &Segment, y: &[f64]) -> Option<String> {
         w.q.iter()
             .enumerate()
             .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))?;
-    let it = &scene.losses.items[k];
+    let it = &scene.losses().items[k];
     Some(format!("{}:{} ({q:.3e} W)", it.source.as_str(), it.name))
 }
 

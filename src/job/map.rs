@@ -103,26 +103,29 @@ impl MapOptions {
     }
 }
 
-pub use crate::report::map::MapMeta;
+pub use crate::report::map::{MapMeta, MapRow};
 
-/// A finished map: `map.csv` text and `map.json` contents.
+/// A finished map: the rows of `map.csv` and the contents of `map.json`, the types their files
+/// are written and read with.
 #[derive(Debug, Clone)]
 pub struct MapResult {
-    /// The `map.csv` text.
-    pub csv: String,
+    /// The rows of `map.csv`, one per grid point, speed-major.
+    pub rows: Vec<MapRow>,
     /// The `map.json` contents.
     pub meta: MapMeta,
 }
 
 impl MapResult {
+    /// The `map.csv` text.
+    pub fn csv(&self) -> String {
+        crate::report::map::map_csv(&self.rows)
+    }
+
     /// The files of a map's output directory: `map.csv` and `map.json`.
     pub fn files(&self) -> Result<Vec<(&'static str, Vec<u8>)>, JobError> {
         let json = serde_json::to_vec_pretty(&self.meta)
             .map_err(|e| JobError::numerical(format!("cannot serialise map.json: {e}")))?;
-        Ok(vec![
-            ("map.csv", self.csv.clone().into_bytes()),
-            ("map.json", json),
-        ])
+        Ok(vec![("map.csv", self.csv().into_bytes()), ("map.json", json)])
     }
 }
 
@@ -184,7 +187,10 @@ pub fn solve(
         .sum();
     let n = points.len();
     Ok(MapResult {
-        csv: crate::report::map::map_csv(&points, scene.thermal.oil),
+        rows: points
+            .iter()
+            .map(|p| MapRow::of(p, scene.thermal().oil))
+            .collect(),
         meta: MapMeta {
             model: m.gearbox.name.clone(),
             gear: o.gear.clone(),
@@ -204,23 +210,23 @@ fn warnings(
     state: usize,
     points: &[MapPoint],
 ) -> Vec<crate::scene::RangeWarning> {
-    let mut log = crate::scene::RangeLog::new(&scene.losses);
+    let mut log = crate::scene::RangeLog::new(scene.losses());
     for p in points {
         if let Some(e) = &p.equilibrium {
             log.check(
-                &scene.losses,
+                scene.losses(),
                 &crate::scene::OperatingPoint {
                     state,
                     input_speed: rpm_to_rad_s(p.speed_rpm),
                     input_torque: p.torque_nm,
                     oil: scene
-                        .thermal
-                        .oil_properties(e.solution.temperatures[scene.thermal.oil]),
+                        .thermal()
+                        .oil_properties(e.solution.temperatures[scene.thermal().oil]),
                 },
             );
         }
     }
-    log.warnings(&scene.losses)
+    log.warnings(scene.losses())
 }
 
 fn failures(scene: &crate::scene::Scene, points: &[MapPoint]) -> Vec<String> {

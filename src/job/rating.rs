@@ -315,7 +315,7 @@ fn point(
         speed_rpm: rpm,
         rated_torque_nm: s.torque,
         rated_power_w: s.payload.power,
-        oil_temp_c: k_to_c(s.payload.solution.temperatures[p.scene.thermal.oil]),
+        oil_temp_c: k_to_c(s.payload.solution.temperatures[p.scene.thermal().oil]),
         total_loss_w: eq.total_loss_w,
         efficiency: eq.efficiency,
         status: s.status,
@@ -327,7 +327,7 @@ fn point(
 
 /// The range warnings over every rated point, one per item and range.
 fn warnings(p: &Prepared, points: &[RatingPoint]) -> Vec<RangeWarning> {
-    let losses = &p.scene.losses;
+    let losses = p.scene.losses();
     let mut log = RangeLog::new(losses);
     for r in points {
         log.check(
@@ -336,7 +336,7 @@ fn warnings(p: &Prepared, points: &[RatingPoint]) -> Vec<RangeWarning> {
                 state: p.state,
                 input_speed: rpm_to_rad_s(r.speed_rpm),
                 input_torque: r.rated_torque_nm,
-                oil: p.scene.thermal.oil_properties(c_to_k(r.oil_temp_c)),
+                oil: p.scene.thermal().oil_properties(c_to_k(r.oil_temp_c)),
             },
         );
     }

@@ -171,7 +171,7 @@ pub fn prepare(m: &Model, o: &RunOptions) -> Result<Prepared, JobError> {
         .map_err(|e| JobError::invalid(format!("{}: {e}", m.label())))?;
     let spread = o
         .spread
-        .then(|| SpreadScene::compile(&m.gearbox, &needs, &scene.losses));
+        .then(|| SpreadScene::compile(&m.gearbox, &needs, scene.losses()));
     Ok(Prepared {
         scene,
         cycle,
@@ -259,10 +259,10 @@ fn finish(m: &Model, p: &Prepared, traj: &Trajectory) -> Result<RunResult, JobEr
         )));
     }
     let csv = p.opts.record_losses.then(|| {
-        let work = std::cell::RefCell::new(p.scene.thermal.work());
+        let work = std::cell::RefCell::new(p.scene.thermal().work());
         let bt = |t: f64| {
             let mut w = work.borrow_mut();
-            p.scene.thermal.boundary_temperatures(t, &mut w);
+            p.scene.thermal().boundary_temperatures(t, &mut w);
             w.boundary_t.clone()
         };
         timeseries_csv(&p.scene, traj, &rows, &bt)

@@ -4,6 +4,7 @@
 //! An uncertainty study keeps these per case for its percentile bands: one grid for every case,
 //! so the bands are taken across cases at equal times.
 
+use crate::physics::units::k_to_c;
 use crate::scene::{Scene, Source};
 use crate::solve::transient::Trajectory;
 
@@ -17,7 +18,7 @@ pub const POINTS: (usize, usize) = (2, 100_000);
 /// `energy_<source>_j` for each source.
 pub fn names(scene: &Scene) -> Vec<String> {
     let mut v: Vec<String> = scene
-        .thermal
+        .thermal()
         .names
         .iter()
         .map(|n| format!("temp_{n}_c"))
@@ -54,7 +55,7 @@ pub fn sample(scene: &Scene, traj: &Trajectory, times: &[f64]) -> Vec<Vec<f64>> 
     let row = |k: usize| {
         let y = &traj.states[k];
         let e = scene.loss_energy_by_source(y);
-        let mut v: Vec<f64> = y[..nodes].iter().map(|t| t - 273.15).collect();
+        let mut v: Vec<f64> = y[..nodes].iter().map(|&t| k_to_c(t)).collect();
         v.extend(Source::ALL.iter().map(|s| e[s.index()]));
         v
     };

@@ -29,11 +29,11 @@ pub fn along_run(
     segs: &[Segment],
     traj: &Trajectory,
 ) -> Vec<SourceSpread> {
-    let mut work = spread.work(&scene.losses);
+    let mut work = spread.work(scene.losses());
     let oil = |r: usize| {
         traj.states
             .get(r)
-            .map(|y| scene.thermal.oil_properties(scene.oil_temp(y)))
+            .map(|y| scene.thermal().oil_properties(scene.oil_temp(y)))
     };
     for r in 0..traj.times.len().saturating_sub(1) {
         let dt = traj.times[r + 1] - traj.times[r];
@@ -47,9 +47,9 @@ pub fn along_run(
             continue;
         }
         let inputs: Inputs = seg.inputs;
-        spread.accumulate(&scene.losses, &inputs, [start, end], dt, &mut work);
+        spread.accumulate(scene.losses(), &inputs, [start, end], dt, &mut work);
     }
-    let mut out = spread.source_energies(&scene.losses, &work);
+    let mut out = spread.source_energies(scene.losses(), &work);
     for s in &mut out {
         for m in &mut s.models {
             if m.j.is_some_and(|j| !j.is_finite()) {

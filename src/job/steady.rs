@@ -4,7 +4,6 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
-use crate::physics::oil::KELVIN_OFFSET;
 use crate::report::sources::SourceValues;
 use crate::scene::{Inputs, Needs, OperatingPoint, RangeLog, RangeWarning, Scene};
 use crate::solve::equilibrium::{equilibrium, Equilibrium};
@@ -127,7 +126,7 @@ pub struct LimitCycleReport {
 fn cycle_report(scene: &Scene, c: &crate::solve::limit_cycle::LimitCycle) -> LimitCycleReport {
     let by_node = |v: &[f64]| -> BTreeMap<String, f64> {
         scene
-            .thermal
+            .thermal()
             .names
             .iter()
             .zip(v)
@@ -202,28 +201,28 @@ pub(crate) fn result(
     eq: &Equilibrium,
 ) -> SteadyResult {
     let temperatures_c = scene
-        .thermal
+        .thermal()
         .names
         .iter()
         .zip(&eq.solution.temperatures)
         .map(|(n, t)| (n.clone(), k_to_c(*t)))
         .collect();
     let losses_w = scene
-        .losses
+        .losses()
         .items
         .iter()
         .zip(&eq.losses)
         .map(|(it, q)| (format!("{}:{}", it.source.as_str(), it.name), *q))
         .collect();
-    let mut log = RangeLog::new(&scene.losses);
-    let t_oil = eq.solution.temperatures[scene.thermal.oil];
+    let mut log = RangeLog::new(scene.losses());
+    let t_oil = eq.solution.temperatures[scene.thermal().oil];
     log.check(
-        &scene.losses,
+        scene.losses(),
         &OperatingPoint {
             state,
             input_speed: rpm_to_rad_s(o.speed_rpm),
             input_torque: o.torque_nm,
-            oil: scene.thermal.oil_properties(t_oil),
+            oil: scene.thermal().oil_properties(t_oil),
         },
     );
     SteadyResult {
@@ -240,7 +239,7 @@ pub(crate) fn result(
         ptc_iterations: eq.solution.ptc_iterations,
         method: eq.solution.method,
         residual_w: eq.solution.residual_w,
-        warnings: log.warnings(&scene.losses),
+        warnings: log.warnings(scene.losses()),
         limit_cycle: eq.limit_cycle.as_ref().map(|c| cycle_report(scene, c)),
         spread: None,
     }
@@ -265,13 +264,13 @@ fn spread(
         input_speed: at.input_speed,
         input_torque: at.input_torque,
         oil: scene
-            .thermal
+            .thermal()
             .oil_properties(scene.oil_temp(&eq.solution.temperatures)),
     };
     Some(super::spread::at_point(
         &m.gearbox,
         &needs,
-        &scene.losses,
+        scene.losses(),
         &eq.losses,
         &op,
     ))
@@ -279,12 +278,12 @@ fn spread(
 
 /// Every number of an equilibrium finite and its residual small, else the first failure named.
 pub fn check_equilibrium(scene: &Scene, eq: &Equilibrium) -> Result<(), String> {
-    for (n, t) in scene.thermal.names.iter().zip(&eq.solution.temperatures) {
+    for (n, t) in scene.thermal().names.iter().zip(&eq.solution.temperatures) {
         if !t.is_finite() {
             return Err(format!("temperature of node {n} is not finite"));
         }
     }
-    for (it, q) in scene.losses.items.iter().zip(&eq.losses) {
+    for (it, q) in scene.losses().items.iter().zip(&eq.losses) {
         if !q.is_finite() {
             return Err(format!(
                 "loss item {}:{} is not finite",
@@ -318,7 +317,7 @@ pub fn check_envelope(envelope: &Envelope, eq: &Equilibrium) -> Result<(), Strin
 
 /// A steady-solver failure in words, with node names.
 pub fn describe(scene: &Scene, e: &SteadyError) -> String {
-    let name = |i: usize| scene.thermal.names.get(i).cloned().unwrap_or_default();
+    let name = |i: usize| scene.thermal().names.get(i).cloned().unwrap_or_default();
     match e {
         SteadyError::NoEquilibriumInRange {
             node,
@@ -330,7 +329,7 @@ pub fn describe(scene: &Scene, e: &SteadyError) -> String {
              temperature than the cooling removes heat",
             name(*node),
             k_to_c(*bound_k),
-            temperature_k - KELVIN_OFFSET
+            k_to_c(*temperature_k)
         ),
         SteadyError::Singular { nodes } => format!(
             "node(s) {} have no thermal path to a boundary",

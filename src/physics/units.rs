@@ -10,6 +10,24 @@ pub const KELVIN_OFFSET: f64 = 273.15;
 /// Metres per millimetre.
 pub const M_PER_MM: f64 = 1e-3;
 
+/// Millimetres per metre.
+pub const MM_PER_M: f64 = 1e3;
+
+/// Micrometres per metre.
+pub const UM_PER_M: f64 = 1e6;
+
+/// N·m per N·mm (a moment in N·mm times this is in N·m).
+pub const N_M_PER_N_MM: f64 = 1e-3;
+
+/// mm²/s (cSt) per m²/s.
+pub const MM2_S_PER_M2_S: f64 = 1e6;
+
+/// mPa·s (cP) per Pa·s.
+pub const MPA_S_PER_PA_S: f64 = 1e3;
+
+/// Kilometres per hour per metre per second; [`m_s_to_kmh`] multiplies by 3.6.
+pub const KMH_PER_M_S: f64 = 3.6;
+
 /// Radians per second per revolution per minute (π/30); [`rpm_to_rad_s`] multiplies by π and
 /// divides by 30 in that order.
 pub const RAD_S_PER_RPM: f64 = PI / 30.0;
@@ -37,6 +55,11 @@ pub fn rad_s_to_rpm(w: f64) -> f64 {
     w * 30.0 / PI
 }
 
+/// m/s → km/h (`v * 3.6`).
+pub fn m_s_to_kmh(v: f64) -> f64 {
+    v * KMH_PER_M_S
+}
+
 /// km/h → m/s (`kmh / 3.6`).
 pub fn kmh_to_m_s(kmh: f64) -> f64 {
     kmh / 3.6
@@ -56,6 +79,7 @@ mod tests {
                 (x * std::f64::consts::PI / 30.0).to_bits()
             );
             assert_eq!(kmh_to_m_s(x).to_bits(), (x / 3.6).to_bits());
+            assert_eq!(m_s_to_kmh(x).to_bits(), (x * 3.6).to_bits());
             assert_eq!(
                 rad_s_to_rpm(x).to_bits(),
                 (x * 30.0 / std::f64::consts::PI).to_bits()

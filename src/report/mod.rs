@@ -1,5 +1,6 @@
 //! Reports: text/JSON summaries, run outputs (CSV, JSON) and PNG plots.
 pub mod bearing_info;
+pub mod bench;
 pub mod calibration;
 pub mod files;
 pub mod info;

@@ -157,13 +157,13 @@ pub fn control_summaries(scene: &Scene, traj: &Trajectory) -> Vec<ControlSummary
     let dur = traj.times.last().copied().unwrap_or(0.0) - traj.times.first().copied().unwrap_or(0.0);
     let rows = crate::scene::controls::ROWS_PER_CONTROL;
     scene
-        .thermal
+        .thermal()
         .controls
         .iter()
         .enumerate()
         .map(|(k, c)| {
             let r = r0 + rows * k;
-            let pi = scene.thermal.integral_row(k);
+            let pi = scene.thermal().integral_row(k);
             let at = |j: usize| pi.map(|p| y1[p + j] - y0[p + j]);
             ControlSummary {
                 name: c.name.clone(),
@@ -231,20 +231,20 @@ pub fn launch_summary(times: &[f64], rows: &[RowInputs]) -> Option<LaunchSummary
 
 /// Range warnings over the output rows of a run (gear state by name, oil temperature of the row).
 pub fn run_warnings(scene: &Scene, traj: &Trajectory, rows: &[RowInputs]) -> Vec<RangeWarning> {
-    let mut log = RangeLog::new(&scene.losses);
+    let mut log = RangeLog::new(scene.losses());
     for (r, y) in rows.iter().zip(&traj.states) {
-        let Some(state) = scene.losses.state_names.iter().position(|n| *n == r.gear) else {
+        let Some(state) = scene.losses().state_names.iter().position(|n| *n == r.gear) else {
             continue;
         };
         let op = OperatingPoint {
             state,
             input_speed: rpm_to_rad_s(r.input_speed_rpm),
             input_torque: r.input_torque_nm,
-            oil: scene.thermal.oil_properties(scene.oil_temp(y)),
+            oil: scene.thermal().oil_properties(scene.oil_temp(y)),
         };
-        log.check(&scene.losses, &op);
+        log.check(scene.losses(), &op);
     }
-    log.warnings(&scene.losses)
+    log.warnings(scene.losses())
 }
 
 /// Build the summary of a run.
@@ -269,7 +269,7 @@ pub fn summary(
     let per_source = SourceValues::new(by, "", true);
     // Per-item energies only when the scene integrates them (an output that can be switched off).
     let items = scene
-        .losses
+        .losses()
         .items
         .iter()
         .enumerate()
@@ -310,7 +310,7 @@ pub fn summary(
             hi = hi.max(v);
         }
         temps.insert(
-            scene.thermal.names[i].clone(),
+            scene.thermal().names[i].clone(),
             TempStats {
                 min: lo,
                 max: hi,
@@ -319,7 +319,7 @@ pub fn summary(
         );
     }
     let mut nodes: Vec<NodeInfo> = scene
-        .thermal
+        .thermal()
         .names
         .iter()
         .map(|x| NodeInfo {
@@ -327,7 +327,7 @@ pub fn summary(
             boundary: false,
         })
         .collect();
-    nodes.extend(scene.thermal.boundary_names.iter().map(|x| NodeInfo {
+    nodes.extend(scene.thermal().boundary_names.iter().map(|x| NodeInfo {
         name: x.clone(),
         boundary: true,
     }));
@@ -351,7 +351,7 @@ pub fn summary(
         energy_efficiency: crate::physics::efficiency::efficiency(out_e, by.iter().sum()),
         temperatures_c: temps,
         nodes,
-        oil_node: scene.thermal.names[scene.thermal.oil].clone(),
+        oil_node: scene.thermal().names[scene.thermal().oil].clone(),
         skipped: scene.skipped().to_vec(),
         frozen_viscosity: scene.frozen_oil_temp().is_some(),
         warnings: run_warnings(scene, traj, rows),
@@ -405,17 +405,17 @@ pub fn timeseries(
         t.push_num("engine_torque_nm", e(&|e| e.torque_nm));
         t.push_num("lockup", e(&|e| f64::from(u8::from(e.lockup))));
     }
-    for (i, name) in scene.thermal.names.iter().enumerate() {
+    for (i, name) in scene.thermal().names.iter().enumerate() {
         t.push_num(format!("temp_{name}_c"), col(&|k| k_to_c(traj.states[k][i])));
     }
     let bt: Vec<Vec<f64>> = traj.times.iter().map(|x| boundary_temps(*x)).collect();
-    for (j, name) in scene.thermal.boundary_names.iter().enumerate() {
+    for (j, name) in scene.thermal().boundary_names.iter().enumerate() {
         t.push_num(
             format!("temp_{name}_c"),
             col(&|k| bt[k].get(j).map_or(f64::NAN, |v| k_to_c(*v))),
         );
     }
-    for (i, it) in scene.losses.items.iter().enumerate() {
+    for (i, it) in scene.losses().items.iter().enumerate() {
         t.push_num(
             format!("loss_{}_{}_w", it.source.as_str(), it.name),
             col(&|k| traj.losses[k][i]),
@@ -425,7 +425,7 @@ pub fn timeseries(
         t.push_num(format!("loss_{}_{name}_w", source.as_str()), vec![0.0; m]);
     }
     let by: Vec<PerSource> = (0..m)
-        .map(|k| sum_by_source(&scene.losses.items, &traj.losses[k]))
+        .map(|k| sum_by_source(&scene.losses().items, &traj.losses[k]))
         .collect();
     for s in Source::ALL {
         t.push_num(format!("loss_{}_w", s.as_str()), col(&|k| by[k][s.index()]));
@@ -436,7 +436,7 @@ pub fn timeseries(
     });
     t.push_num("loss_total_w", total);
     t.push_num("efficiency", eff);
-    for (j, c) in scene.thermal.controls.iter().enumerate() {
+    for (j, c) in scene.thermal().controls.iter().enumerate() {
         t.push_num(
             format!("control_{}", c.name),
             col(&|k| {
@@ -449,8 +449,8 @@ pub fn timeseries(
         );
     }
     // A PI valve's integral follows the controllers' shares in the trajectory's control rows.
-    let n = scene.thermal.controls.len();
-    let pis = scene.thermal.controls.iter().filter(|c| c.is_pi());
+    let n = scene.thermal().controls.len();
+    let pis = scene.thermal().controls.iter().filter(|c| c.is_pi());
     for (j, c) in pis.enumerate() {
         t.push_num(
             format!("control_{}_integral", c.name),
@@ -478,7 +478,7 @@ pub fn skipped_items(scene: &Scene) -> Vec<(Source, String)> {
             let source = Source::ALL.into_iter().find(|x| x.as_str() == src)?;
             let name = rest.split_once(' ')?.1;
             let present = scene
-                .losses
+                .losses()
                 .items
                 .iter()
                 .any(|it| it.source == source && it.name == name);
@@ -494,7 +494,7 @@ pub fn skipped_items(scene: &Scene) -> Vec<(Source, String)> {
 fn input_shaft_torque(scene: &Scene, r: &RowInputs, losses: &[f64]) -> f64 {
     let w_in = rpm_to_rad_s(r.input_speed_rpm);
     let shaft_loss: f64 = scene
-        .losses
+        .losses()
         .items
         .iter()
         .zip(losses)
@@ -525,12 +525,12 @@ pub fn check_finite(
         {
             return Err(format!(
                 "temperature of node {} at t = {t} s is not finite",
-                scene.thermal.names[i]
+                scene.thermal().names[i]
             ));
         }
         if let Some(q) = traj.losses.get(k) {
             if let Some(i) = q.iter().position(|v| !v.is_finite()) {
-                let it = &scene.losses.items[i];
+                let it = &scene.losses().items[i];
                 return Err(format!(
                     "loss item {}:{} at t = {t} s is not finite",
                     it.source.as_str(),

@@ -52,10 +52,10 @@ fn oil_step(t_oil: f64) -> f64 {
 /// The compiled scene.
 #[derive(Debug, Clone)]
 pub struct Scene {
-    /// Loss items.
-    pub losses: LossScene,
-    /// Thermal network.
-    pub thermal: ThermalScene,
+    /// Loss items (read through [`Scene::losses`]).
+    pub(in crate::scene) losses: LossScene,
+    /// Thermal network (read through [`Scene::thermal`]).
+    pub(in crate::scene) thermal: ThermalScene,
     /// What the compile step left out and why ([`Scene::skipped`]).
     skipped: Vec<Skipped>,
     /// Oil temperature used for the oil properties instead of the oil node's (K); `None` for the
@@ -166,6 +166,36 @@ impl Scene {
             }
         }
         s
+    }
+
+    /// The loss items (read only: the compile builds them for the scenario).
+    pub fn losses(&self) -> &LossScene {
+        &self.losses
+    }
+
+    /// The thermal network (read only: the compile builds it for the scenario). Outside the
+    /// compile step the parts cannot be replaced or written:
+    ///
+    /// ```compile_fail
+    /// fn patch(s: &mut geartherm::scene::system::Scene) {
+    ///     s.thermal = s.thermal().clone();
+    /// }
+    /// ```
+    ///
+    /// ```compile_fail
+    /// fn patch(s: &mut geartherm::scene::system::Scene) {
+    ///     s.losses.items.clear();
+    /// }
+    /// ```
+    pub fn thermal(&self) -> &ThermalScene {
+        &self.thermal
+    }
+
+    /// Make boundary `index` go linearly from `temp0` at `t0` to `temp1` at `t1` (K): a
+    /// co-simulation's boundary input over one communication step (the FMU's inputs, the one
+    /// change a compiled scene takes; [`ThermalScene::set_boundary_ramp`]).
+    pub(crate) fn set_boundary_ramp(&mut self, index: usize, from: (f64, f64), to: (f64, f64)) {
+        self.thermal.set_boundary_ramp(index, from, to);
     }
 
     /// The temperature the oil properties are frozen at (K), when the scenario freezes them.

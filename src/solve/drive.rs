@@ -3,6 +3,7 @@
 
 use crate::cycle::{schedule_with_launch, CycleError, DriveCycle, GearTable, Schedule};
 use crate::model::Gearbox;
+use crate::physics::units::m_s_to_kmh;
 use crate::scene::Inputs;
 
 use super::trajectory::{Segment, Trajectory};
@@ -77,7 +78,7 @@ pub fn row_inputs(gb: &Gearbox, sched: &Schedule, traj: &Trajectory) -> Vec<RowI
         .map(|&k| {
             let iv = &sched.intervals[k];
             RowInputs {
-                vehicle_speed_kmh: iv.vehicle_speed * 3.6,
+                vehicle_speed_kmh: m_s_to_kmh(iv.vehicle_speed),
                 gear: gb.gear_states[iv.gear].name.clone(),
                 input_speed_rpm: iv.input_speed * 30.0 / std::f64::consts::PI,
                 input_torque_nm: iv.input_torque,

@@ -29,12 +29,12 @@ impl Driver<'_> {
 
     /// True when some boundary temperature moves (then f depends on t).
     pub(crate) fn boundaries_move(&self) -> bool {
-        self.scene.thermal.boundaries_move()
+        self.scene.thermal().boundaries_move()
     }
 
     /// True when ∂f/∂t = 0 on the step from `t` (no boundary temperature moves there).
     pub(crate) fn time_rate_vanishes(&self, t: f64) -> bool {
-        self.scene.thermal.boundaries_still_at(t)
+        self.scene.thermal().boundaries_still_at(t)
     }
 
     /// ∂f/∂t at (t, y).
@@ -71,7 +71,7 @@ impl Driver<'_> {
     /// Count a switch of switching function `idx` at time `t`.
     pub(crate) fn log_event(&self, t: f64, idx: usize) {
         let k = idx / crate::scene::controls::EVENTS_PER_CONTROL;
-        if k < self.scene.thermal.controls.len() {
+        if k < self.scene.thermal().controls.len() {
             self.events.set(self.events.get() + 1);
             self.event_log.borrow_mut().push((t, k));
         }
@@ -118,7 +118,7 @@ impl Driver<'_> {
 
     /// The controllers' shares at state `y` into the row.
     fn record_controls(&self, traj: &mut Trajectory, y: &[f64]) {
-        let th = &self.scene.thermal;
+        let th = self.scene.thermal();
         if th.controls.is_empty() {
             return;
         }
@@ -183,18 +183,18 @@ impl Driver<'_> {
                 let rb = dy[b].abs() / (self.atol[b] + self.opts.rtol * y[b].abs());
                 ra.total_cmp(&rb)
             })
-            .unwrap_or(self.scene.thermal.oil);
+            .unwrap_or(self.scene.thermal().oil);
         let item =
             w.q.iter()
                 .enumerate()
                 .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
                 .map(|(k, _)| {
-                    let it = &self.scene.losses.items[k];
+                    let it = &self.scene.losses().items[k];
                     format!("{}:{}", it.source.as_str(), it.name)
                 });
         NumericalFailure {
             time: t,
-            node: self.scene.thermal.names[node].clone(),
+            node: self.scene.thermal().names[node].clone(),
             item,
             message,
         }

@@ -55,7 +55,7 @@ impl HeatBalance for SceneBalance<'_> {
         let mut w = self.work.borrow_mut();
         self.scene.net_heat(STEADY_TIME, &y, &mut w, out);
         if let Some(k) = w.q.iter().position(|q| !q.is_finite()) {
-            let it = &self.scene.losses.items[k];
+            let it = &self.scene.losses().items[k];
             return Err(format!(
                 "loss item {}:{} is not finite at oil temperature {:.2} °C",
                 it.source.as_str(),
@@ -79,7 +79,7 @@ impl HeatBalance for SceneBalance<'_> {
             self.scene.jvp(STEADY_TIME, &y, &v, &mut w, &mut o);
             for i in 0..n {
                 // jvp gives d(dT/dt)/dT = J / C for the temperature rows.
-                jac[(i, j)] = o[i] * self.scene.thermal.capacity[i];
+                jac[(i, j)] = o[i] * self.scene.thermal().capacity[i];
             }
         }
         if jac.iter().any(|x| !x.is_finite()) {
@@ -89,11 +89,11 @@ impl HeatBalance for SceneBalance<'_> {
     }
 
     fn capacities(&self) -> &[f64] {
-        &self.scene.thermal.capacity
+        &self.scene.thermal().capacity
     }
 
     fn bounds(&self, i: usize) -> (f64, f64) {
-        let (lo, hi) = if i == self.scene.thermal.oil {
+        let (lo, hi) = if i == self.scene.thermal().oil {
             OIL_RANGE_C
         } else {
             NODE_RANGE_C
@@ -132,18 +132,18 @@ pub fn equilibrium(
     let t0: Vec<f64> = match start {
         Some(s) => s.to_vec(),
         None => {
-            let mut w = scene.thermal.work();
-            scene.thermal.boundary_temperatures(STEADY_TIME, &mut w);
-            let amb = scene.thermal.ambient.map(|a| w.boundary_t[a]);
+            let mut w = scene.thermal().work();
+            scene.thermal().boundary_temperatures(STEADY_TIME, &mut w);
+            let amb = scene.thermal().ambient.map(|a| w.boundary_t[a]);
             match amb {
                 Some(a) => vec![a; scene.nodes()],
-                None => scene.thermal.initial.clone(),
+                None => scene.thermal().initial.clone(),
             }
         }
     };
-    let (solution, limit_cycle) = if scene.thermal.controls.is_empty() {
+    let (solution, limit_cycle) = if scene.thermal().controls.is_empty() {
         (settle_steady(scene, &sys, inputs, &t0, opts)?, None)
-    } else if scene.thermal.pi_rows() > 0 {
+    } else if scene.thermal().pi_rows() > 0 {
         with_pi(scene, inputs, &t0, opts)?
     } else {
         controlled(scene, inputs, &t0, opts, None)?
@@ -152,7 +152,7 @@ pub fn equilibrium(
     y[..scene.nodes()].copy_from_slice(&solution.temperatures);
     let mut w = scene.work(inputs);
     scene.evaluate_losses(&y, &mut w);
-    let by = crate::scene::sum_by_source(&scene.losses.items, &w.q);
+    let by = crate::scene::sum_by_source(&scene.losses().items, &w.q);
     let power = inputs.input_torque * inputs.input_speed;
     let total: f64 = by.iter().sum();
     Ok(Equilibrium {
@@ -186,7 +186,7 @@ fn with_pi(
     opts: &SteadyOptions,
 ) -> Result<(SteadySolution, Option<super::limit_cycle::LimitCycle>), SteadyError> {
     use crate::scene::controls::Law;
-    let th = &scene.thermal;
+    let th = scene.thermal();
     let pis: Vec<usize> = (0..th.controls.len())
         .filter(|&k| th.controls[k].is_pi())
         .collect();
@@ -285,8 +285,8 @@ fn controlled(
     fixed: Option<(usize, f64)>,
 ) -> Result<(SteadySolution, Option<super::limit_cycle::LimitCycle>), SteadyError> {
     use super::limit_cycle::{find_limit_cycle, mean_solution, MAX_TWO_POINT};
-    let two: Vec<usize> = (0..scene.thermal.controls.len())
-        .filter(|&k| scene.thermal.controls[k].is_two_point())
+    let two: Vec<usize> = (0..scene.thermal().controls.len())
+        .filter(|&k| scene.thermal().controls[k].is_two_point())
         .collect();
     if two.len() > MAX_TWO_POINT {
         return Err(SteadyError::InvalidInput(format!(
@@ -294,10 +294,10 @@ fn controlled(
             two.len()
         )));
     }
-    let nc = scene.thermal.controls.len() * crate::scene::controls::EVENTS_PER_CONTROL;
+    let nc = scene.thermal().controls.len() * crate::scene::controls::EVENTS_PER_CONTROL;
     let mut y0 = scene.initial_state(None);
     y0[..t0.len()].copy_from_slice(t0);
-    if let Some(r) = fixed.and_then(|(k, _)| scene.thermal.integral_row(k)) {
+    if let Some(r) = fixed.and_then(|(k, _)| scene.thermal().integral_row(k)) {
         y0[r] = fixed.map_or(0.0, |f| f.1);
     }
     let start = scene.work(inputs);
@@ -344,7 +344,7 @@ fn controlled(
             // A valve in the wrong region: take the solution's and solve again; a two-point
             // controller that would switch: this combination has no equilibrium.
             let valves_only = scene
-                .thermal
+                .thermal()
                 .controls
                 .iter()
                 .enumerate()
@@ -352,9 +352,9 @@ fn controlled(
             if !valves_only {
                 break;
             }
-            for (k, ct) in scene.thermal.controls.iter().enumerate() {
+            for (k, ct) in scene.thermal().controls.iter().enumerate() {
                 if !ct.is_two_point() {
-                    let m = ct.settle(w.net.mode[k], scene.thermal.signal_in(k, &y));
+                    let m = ct.settle(w.net.mode[k], scene.thermal().signal_in(k, &y));
                     scene.set_control_mode(k, m, &mut w);
                 }
             }
@@ -414,7 +414,7 @@ fn transient_fallback(
         initial_temp: None,
         ..TransientOptions::default()
     };
-    let clamped = scene.clone().with_oil_temp_clamp(sys.bounds(scene.thermal.oil));
+    let clamped = scene.clone().with_oil_temp_clamp(sys.bounds(scene.thermal().oil));
     let mut last = t0.to_vec();
     // One segment at a time, checking the limits between them.
     for seg in &segs {

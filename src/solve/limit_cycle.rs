@@ -55,8 +55,7 @@ pub fn find_limit_cycle(scene: &Scene, inputs: Inputs, t0: &[f64]) -> Result<Lim
     };
     let fail =
         |e: super::transient::NumericalFailure| SteadyError::Model(format!("limit-cycle search failed: {e}"));
-    let mut start = scene.clone();
-    start.thermal.initial = t0.to_vec();
+    let start = scene.clone().with_initial(t0.to_vec());
     // Segments of growing length until some controller has switched at least 5 times.
     let (mut t, mut len) = (0.0, 60.0);
     let mut segs = Vec::new();
@@ -71,11 +70,11 @@ pub fn find_limit_cycle(scene: &Scene, inputs: Inputs, t0: &[f64]) -> Result<Lim
         len *= 2.0;
         let traj = integrate(&start, &segs, &o, &mut |_, _| {}).map_err(fail)?;
         events = traj.events;
-        if (0..scene.thermal.controls.len()).any(|k| periods_agree(&events, k)) {
+        if (0..scene.thermal().controls.len()).any(|k| periods_agree(&events, k)) {
             break;
         }
     }
-    let Some((k, times)) = (0..scene.thermal.controls.len())
+    let Some((k, times)) = (0..scene.thermal().controls.len())
         .map(|k| {
             (
                 k,
@@ -133,7 +132,7 @@ pub fn find_limit_cycle(scene: &Scene, inputs: Inputs, t0: &[f64]) -> Result<Lim
         }
     }
     Ok(LimitCycle {
-        controller: scene.thermal.controls[k].name.clone(),
+        controller: scene.thermal().controls[k].name.clone(),
         period_s: period,
         mean_k: mean,
         min_k: lo,

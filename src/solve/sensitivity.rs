@@ -261,7 +261,7 @@ impl<'s> Tangent<'s> {
         let y = self.y.clone();
         let f1 = self.nominal_f(t, &y);
         let w = self.jac.iteration_matrix(&mut self.nominal, t, gh, n);
-        let thermal = &self.nominal.scene.thermal;
+        let thermal = self.nominal.scene.thermal();
         let ft_on = thermal.boundaries_move() && !thermal.boundaries_still_at(t);
         let ft = if ft_on {
             self.nominal.time_derivative(t);
@@ -386,7 +386,7 @@ impl<'s> Tangent<'s> {
     }
 
     fn failure(&self, t: f64, message: String) -> NumericalFailure {
-        let th = &self.nominal.scene.thermal;
+        let th = self.nominal.scene.thermal();
         let node = self.y.iter().position(|v| !v.is_finite()).unwrap_or(th.oil);
         NumericalFailure {
             time: t,
@@ -454,14 +454,14 @@ fn drive(
 ) -> Result<SensitivityTrajectory, NumericalFailure> {
     let first = segments.first().ok_or_else(|| NumericalFailure {
         time: 0.0,
-        node: scene.thermal.names[scene.thermal.oil].clone(),
+        node: scene.thermal().names[scene.thermal().oil].clone(),
         item: None,
         message: "empty input: no segment to integrate".into(),
     })?;
-    if let Some(c) = scene.thermal.controls.iter().find(|c| c.is_pi()) {
+    if let Some(c) = scene.thermal().controls.iter().find(|c| c.is_pi()) {
         return Err(NumericalFailure {
             time: first.t0,
-            node: scene.thermal.names[c.sensor].clone(),
+            node: scene.thermal().names[c.sensor].clone(),
             item: None,
             message: format!(
                 "controller {} is a PI valve: its integral is a state the node temperatures \

@@ -92,7 +92,7 @@ pub struct NumericalFailure {
 pub fn stored_values(scene: &Scene, segments: &[Segment], opts: &TransientOptions) -> usize {
     let per_row = scene.n_states()
         + if opts.record_losses {
-            scene.losses.items.len()
+            scene.losses().items.len()
         } else {
             0
         };
@@ -155,7 +155,9 @@ pub fn energy_balance(scene: &Scene, traj: &Trajectory) -> EnergyBalance {
         }
     };
     let lost = scene.loss_energy(y1) - scene.loss_energy(y0);
-    let stored: f64 = (0..n).map(|i| scene.thermal.capacity[i] * (y1[i] - y0[i])).sum();
+    let stored: f64 = (0..n)
+        .map(|i| scene.thermal().capacity[i] * (y1[i] - y0[i]))
+        .sum();
     let b = scene.boundary_energy_index();
     let to_b = y1[b] - y0[b];
     let scale = lost

@@ -51,7 +51,7 @@ pub fn integrate(
     let start = Instant::now();
     let first = segments.first().ok_or_else(|| NumericalFailure {
         time: 0.0,
-        node: scene.thermal.names[scene.thermal.oil].clone(),
+        node: scene.thermal().names[scene.thermal().oil].clone(),
         item: None,
         message: "empty input: no segment to integrate".into(),
     })?;
@@ -69,7 +69,7 @@ pub fn integrate(
     }
     let fail_build = |e: diffsol::error::DiffsolError| NumericalFailure {
         time: first.t0,
-        node: scene.thermal.names[scene.thermal.oil].clone(),
+        node: scene.thermal().names[scene.thermal().oil].clone(),
         item: None,
         message: format!("could not set up the solver: {e}"),
     };
@@ -91,7 +91,7 @@ pub fn integrate(
         ),
         segment: Vec::with_capacity(segments.len() + 1),
         controls: Rows::with_capacity(
-            scene.thermal.controls.len() + scene.thermal.pi_rows() / crate::scene::controls::ROWS_PER_PI,
+            scene.thermal().controls.len() + scene.thermal().pi_rows() / crate::scene::controls::ROWS_PER_PI,
             segments.len() + 1,
         ),
         switches: Vec::new(),
@@ -165,13 +165,13 @@ pub fn integrate(
 /// capacity (J) on energies, `atol` × the gain (share) on a PI valve's integral.
 pub(crate) fn state_atol(scene: &Scene, atol: f64) -> Vec<f64> {
     let n = scene.nodes();
-    let mean_c = scene.thermal.capacity.iter().sum::<f64>() / n as f64;
+    let mean_c = scene.thermal().capacity.iter().sum::<f64>() / n as f64;
     let mut out = vec![atol; scene.n_states()];
     for a in out.iter_mut().skip(n) {
         *a = atol * mean_c;
     }
     // A PI valve's integral (a share): the share `atol` K of its sensor moves.
-    let th = &scene.thermal;
+    let th = scene.thermal();
     for (k, c) in th.controls.iter().enumerate() {
         if let Some(r) = th.integral_row(k) {
             out[r] = atol * c.gain();

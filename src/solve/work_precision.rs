@@ -2,7 +2,7 @@
 //! tight tolerance, then every solver over a range of tolerances, with errors against the
 //! reference on the output grid, wall time (median of repeats) and work counters.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::scene::Scene;
 
@@ -47,7 +47,8 @@ pub struct BenchRow {
 }
 
 /// The reference and its self-check.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(default)]
 pub struct Reference {
     /// Tolerance used.
     pub rtol: f64,

@@ -48,7 +48,7 @@ fn steady_names<'a>(nodes: impl IntoIterator<Item = &'a String>) -> Vec<String> 
 /// its overrides).
 pub(super) fn output_columns(jobs: &[Job], base: &job::Model) -> Result<Vec<String>, JobError> {
     let scene = base.compile(&crate::scene::Needs::default())?;
-    let nodes = &scene.thermal.names;
+    let nodes = &scene.thermal().names;
     let mut cols = Vec::new();
     if jobs.iter().any(|j| matches!(j, Job::Run(_))) {
         cols.extend(run_names(nodes));

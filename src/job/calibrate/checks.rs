@@ -14,10 +14,10 @@ use super::problem::Problem;
 /// node, the solid nodes' range for the others (exit 1, naming file, line, column and value).
 pub fn measured_in_envelope(m: &Model, pr: &Problem<'_>) -> Result<(), JobError> {
     let scene = pr.scene_at(&pr.start())?;
-    let oil = OilRange::of(scene.thermal.oil_model());
+    let oil = OilRange::of(scene.thermal().oil_model());
     let (lo, hi) = NODE_RANGE_C;
     for (c, &node) in pr.trace.measured.iter().zip(&pr.channels) {
-        let is_oil = node == scene.thermal.oil;
+        let is_oil = node == scene.thermal().oil;
         let bad = c.values_c.iter().position(|&v| {
             if is_oil {
                 !oil.contains(v)

@@ -105,9 +105,7 @@ fn apply_lines(fm: &FmuModel, lines: &[(f64, f64)], scene: &mut Scene, t: f64, s
         _ => None,
     });
     for (b, &(x, d)) in boundaries.zip(lines) {
-        scene
-            .thermal
-            .set_boundary_ramp(b, (t, x), (t + span, x + d * span));
+        scene.set_boundary_ramp(b, (t, x), (t + span, x + d * span));
     }
 }
 
@@ -486,12 +484,12 @@ impl Instance {
         stepper.set_inputs(scene, inputs);
         let q = stepper.losses(scene);
         let y = stepper.state();
-        let by = sum_by_source(&scene.losses.items, &q);
+        let by = sum_by_source(&scene.losses().items, &q);
         let total: f64 = q.iter().sum();
         // The losses supplied through the input shaft: not the converter's slip or an
         // engine-driven pump, paid ahead of it (as `timeseries.csv`'s input torque).
         let shaft: f64 = scene
-            .losses
+            .losses()
             .items
             .iter()
             .zip(&q)

@@ -133,7 +133,7 @@ impl FmuModel {
         }
         let model = Model::from_text(&self.payload.text, Path::new(&self.payload.file), &ovs)?;
         let scene = model.compile(&needs())?;
-        if scene.n_states() != self.scene.n_states() || scene.thermal.names != self.scene.thermal.names {
+        if scene.n_states() != self.scene.n_states() || scene.thermal().names != self.scene.thermal().names {
             return Err(JobError::invalid(
                 "the parameters change the model's structure (its nodes or loss items): not allowed in an FMU",
             ));

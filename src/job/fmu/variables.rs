@@ -163,7 +163,7 @@ fn inputs(t: &mut Table, gb: &Gearbox, scene: &Scene) {
         0.0,
         format!("gear-state index: {}", states.join(", ")),
     );
-    let th = &scene.thermal;
+    let th = scene.thermal();
     for (k, name) in th.boundary_names.iter().enumerate() {
         let t0 = th.boundary_temperature_at(k, 0.0).unwrap_or(f64::NAN);
         t.input(
@@ -177,7 +177,7 @@ fn inputs(t: &mut Table, gb: &Gearbox, scene: &Scene) {
 }
 
 fn parameters(t: &mut Table, scene: &Scene, params: &[(String, f64)]) {
-    let th = &scene.thermal;
+    let th = scene.thermal();
     for (k, name) in th.names.iter().enumerate() {
         let d = format!("initial temperature of node {name}");
         t.parameter(
@@ -199,7 +199,7 @@ fn parameters(t: &mut Table, scene: &Scene, params: &[(String, f64)]) {
 }
 
 fn outputs(t: &mut Table, scene: &Scene) {
-    for (k, name) in scene.thermal.names.iter().enumerate() {
+    for (k, name) in scene.thermal().names.iter().enumerate() {
         t.output(
             format!("T.{name}"),
             Role::NodeTemp(k),
@@ -262,6 +262,6 @@ fn outputs(t: &mut Table, scene: &Scene) {
 pub fn sources(scene: &Scene) -> Vec<Source> {
     Source::ALL
         .into_iter()
-        .filter(|s| scene.losses.items.iter().any(|it| it.source == *s))
+        .filter(|s| scene.losses().items.iter().any(|it| it.source == *s))
         .collect()
 }

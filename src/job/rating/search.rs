@@ -274,7 +274,7 @@ impl Point<'_> {
         match solved {
             Ok(eq) => {
                 check_equilibrium(self.scene, &eq)?;
-                let f = eq.solution.temperatures[self.scene.thermal.oil] - self.limit_k;
+                let f = eq.solution.temperatures[self.scene.thermal().oil] - self.limit_k;
                 Ok(Some((eq, f)))
             }
             // No equilibrium inside the valid range: with positive losses the oil would run past

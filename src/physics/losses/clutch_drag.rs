@@ -194,7 +194,7 @@ mod tests {
     use super::*;
     use approx::assert_relative_eq;
 
-    const RPM: f64 = PI / 30.0;
+    use crate::physics::units::RAD_S_PER_RPM;
 
     /// A 6HP-size brake pack: 4 friction plates (8 interfaces), 75–90 mm, 0.15 mm clearance per
     /// interface, 1 L/min lubrication.
@@ -308,8 +308,8 @@ mod tests {
         let wc = p.critical_slip(mu, rho);
         assert_relative_eq!(p.critical_slip(4.0 * mu, rho), 2.0 * wc, max_relative = 1e-12);
         // cold oil (5× the viscosity) drags much more at a typical open-pack slip of 1500 rpm
-        let hot = p.drag(1500.0 * RPM, 0.01, 840.0).power;
-        let cold = p.drag(1500.0 * RPM, 0.05, 860.0).power;
+        let hot = p.drag(1500.0 * RAD_S_PER_RPM, 0.01, 840.0).power;
+        let cold = p.drag(1500.0 * RAD_S_PER_RPM, 0.05, 860.0).power;
         assert!(cold > 3.0 * hot, "{cold} vs {hot}");
         // no oil flow: no film beyond r_i, only the mist shears
         q = p;
@@ -448,7 +448,7 @@ mod tests {
             };
             let wc = p.critical_slip(mu, rho);
             for (n, t_peer) in RPMS.iter().zip(want) {
-                let w = n * RPM;
+                let w = n * RAD_S_PER_RPM;
                 let t = p.drag(w, mu, rho).torque;
                 if w <= wc {
                     // complete film: the same Couette torque (to the recorded digits)

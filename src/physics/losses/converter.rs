@@ -220,9 +220,8 @@ pub fn locked(wt: f64, tt: f64, slip: f64) -> ConverterPoint {
 pub(crate) mod tests {
     use super::*;
     use approx::assert_relative_eq;
-    use std::f64::consts::PI;
 
-    const RPM: f64 = PI / 30.0;
+    use crate::physics::units::RAD_S_PER_RPM;
 
     /// The converter of ADVISOR's TX_AUTO4 data files (JDM & Associates "Drive_line", 1998):
     /// speed ratio, torque ratio, and impeller speed (rpm) at 100 N·m impeller torque
@@ -245,7 +244,10 @@ pub(crate) mod tests {
     pub(crate) fn jdm() -> Converter {
         Converter::new(
             JDM_SR.to_vec(),
-            JDM_RPM_AT_100NM.iter().map(|n| n * RPM / 10.0).collect(),
+            JDM_RPM_AT_100NM
+                .iter()
+                .map(|n| n * RAD_S_PER_RPM / 10.0)
+                .collect(),
             JDM_TR.to_vec(),
         )
         .unwrap()
@@ -257,9 +259,9 @@ pub(crate) mod tests {
         // impeller speed n and 100 N·m at every tabulated speed ratio.
         let c = jdm();
         for k in 1..JDM_SR.len() {
-            let wp = JDM_RPM_AT_100NM[k] * RPM;
+            let wp = JDM_RPM_AT_100NM[k] * RAD_S_PER_RPM;
             let (wt, tt) = (JDM_SR[k] * wp, JDM_TR[k] * 100.0);
-            let p = c.open(wt, tt, 600.0 * RPM);
+            let p = c.open(wt, tt, 600.0 * RAD_S_PER_RPM);
             assert_relative_eq!(p.impeller_speed, wp, max_relative = 1e-9);
             assert_relative_eq!(p.impeller_torque, 100.0, max_relative = 1e-9);
             assert_relative_eq!(p.speed_ratio, JDM_SR[k], max_relative = 1e-9);
@@ -271,10 +273,10 @@ pub(crate) mod tests {
             );
         }
         // Stall at 1444 rpm absorbs 100 N·m and delivers 200 N·m.
-        let p = c.open(0.0, 50.0, 1444.0 * RPM);
+        let p = c.open(0.0, 50.0, 1444.0 * RAD_S_PER_RPM);
         assert_relative_eq!(p.impeller_torque, 100.0, max_relative = 1e-12);
         assert_relative_eq!(p.turbine_torque, 200.0, max_relative = 1e-12);
-        assert_relative_eq!(p.loss, 100.0 * 1444.0 * RPM, max_relative = 1e-12);
+        assert_relative_eq!(p.loss, 100.0 * 1444.0 * RAD_S_PER_RPM, max_relative = 1e-12);
     }
 
     /// The Illinois root agrees with plain bisection to 1e-12 over turbine speeds and demands
@@ -326,8 +328,8 @@ pub(crate) mod tests {
         assert!(p.speed_ratio > 0.95 && p.speed_ratio < 1.0, "{p:?}");
         assert!(p.loss < 0.05 * 5.0 * 250.0);
         // below idle: engine at idle, creep torque above the demand
-        let p = c.open(20.0, 1.0, 750.0 * RPM);
-        assert_eq!(p.impeller_speed, 750.0 * RPM);
+        let p = c.open(20.0, 1.0, 750.0 * RAD_S_PER_RPM);
+        assert_eq!(p.impeller_speed, 750.0 * RAD_S_PER_RPM);
         assert!(p.turbine_torque > 1.0);
         // coasting above idle: no slip; at standstill: stall at idle
         let p = c.open(200.0, 0.0, 80.0);
@@ -339,8 +341,8 @@ pub(crate) mod tests {
             max_relative = 1e-12
         );
         // lock-up with slip
-        let l = locked(200.0, 150.0, 30.0 * RPM);
-        assert_relative_eq!(l.loss, 150.0 * 30.0 * RPM, max_relative = 1e-12);
+        let l = locked(200.0, 150.0, 30.0 * RAD_S_PER_RPM);
+        assert_relative_eq!(l.loss, 150.0 * 30.0 * RAD_S_PER_RPM, max_relative = 1e-12);
         assert_eq!(locked(200.0, -10.0, 1.0).loss, 0.0);
         assert!(Converter::new(vec![0.1, 0.5], vec![1.0, 2.0], vec![2.0, 1.0]).is_err());
         assert!(Converter::new(vec![0.0, 1.0], vec![1.0, 2.0], vec![2.0, 1.0]).is_err());

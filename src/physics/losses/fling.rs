@@ -27,7 +27,7 @@ mod tests {
     fn fling_power_is_the_angular_momentum_flux_times_the_speed() {
         // 1 L/min of ATF (845 kg/m³) flung out to 60 mm at 3000 rpm.
         let m = 845.0 * 1e-3 / 60.0;
-        let w = 3000.0 * std::f64::consts::PI / 30.0;
+        let w = crate::physics::units::rpm_to_rad_s(3000.0);
         let torque = m * w * 0.06 * 0.06;
         assert!((fling_power(m, w, 0.06) - torque * w).abs() < 1e-12);
         assert_eq!(fling_power(m, -w, 0.06), fling_power(m, w, 0.06));

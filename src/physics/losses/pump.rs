@@ -64,7 +64,7 @@ mod tests {
     use super::*;
     use approx::assert_relative_eq;
 
-    const RPM: f64 = PI / 30.0;
+    use crate::physics::units::RAD_S_PER_RPM;
     const CC: f64 = 1e-6;
     const BAR: f64 = 1e5;
 
@@ -81,14 +81,14 @@ mod tests {
     fn reproduces_the_published_flow_example() {
         // hydraulic-calculator (npm, README "pumpFlow"): 20 cc/rev at 1500 rpm with efficiency
         // 0.95 → 28.5 L/min.
-        let p = pump(20.0, 10.0, 0.95, 1.0).point(1500.0 * RPM, 0.0);
+        let p = pump(20.0, 10.0, 0.95, 1.0).point(1500.0 * RAD_S_PER_RPM, 0.0);
         assert_relative_eq!(p.flow * 60_000.0, 28.5, max_relative = 1e-12);
     }
 
     #[test]
     fn drive_torque_and_power_by_the_data_sheet_formula() {
         // Data-sheet form T[N·m] = V[cm³]·Δp[bar]/(20·π·η_hm): 16 cm³, 15 bar, η_hm 0.85.
-        let p = pump(16.0, 15.0, 0.9, 0.85).point(2000.0 * RPM, 0.0);
+        let p = pump(16.0, 15.0, 0.9, 0.85).point(2000.0 * RAD_S_PER_RPM, 0.0);
         assert_relative_eq!(p.torque, 16.0 * 15.0 / (20.0 * PI * 0.85), max_relative = 1e-12);
         // P[kW] = T·n/9549
         assert_relative_eq!(
@@ -101,35 +101,43 @@ mod tests {
     #[test]
     fn units_and_scaling() {
         let base = pump(16.0, 10.0, 0.9, 0.8);
-        let a = base.point(1000.0 * RPM, 50.0);
+        let a = base.point(1000.0 * RAD_S_PER_RPM, 50.0);
         // power ∝ speed, ∝ pressure, ∝ displacement, ∝ 1/η_hm; flow ∝ η_v·speed
         assert_relative_eq!(
-            base.point(2000.0 * RPM, 50.0).power,
+            base.point(2000.0 * RAD_S_PER_RPM, 50.0).power,
             2.0 * a.power,
             max_relative = 1e-12
         );
         assert_relative_eq!(
-            pump(16.0, 20.0, 0.9, 0.8).point(1000.0 * RPM, 50.0).power,
+            pump(16.0, 20.0, 0.9, 0.8)
+                .point(1000.0 * RAD_S_PER_RPM, 50.0)
+                .power,
             2.0 * a.power,
             max_relative = 1e-12
         );
         assert_relative_eq!(
-            pump(32.0, 10.0, 0.9, 0.8).point(1000.0 * RPM, 50.0).power,
+            pump(32.0, 10.0, 0.9, 0.8)
+                .point(1000.0 * RAD_S_PER_RPM, 50.0)
+                .power,
             2.0 * a.power,
             max_relative = 1e-12
         );
         assert_relative_eq!(
-            pump(16.0, 10.0, 0.9, 0.4).point(1000.0 * RPM, 50.0).power,
+            pump(16.0, 10.0, 0.9, 0.4)
+                .point(1000.0 * RAD_S_PER_RPM, 50.0)
+                .power,
             2.0 * a.power,
             max_relative = 1e-12
         );
         assert_relative_eq!(
-            pump(16.0, 10.0, 0.45, 0.8).point(1000.0 * RPM, 50.0).flow,
+            pump(16.0, 10.0, 0.45, 0.8)
+                .point(1000.0 * RAD_S_PER_RPM, 50.0)
+                .flow,
             0.5 * a.flow,
             max_relative = 1e-12
         );
         assert_eq!(base.point(0.0, 50.0).power, 0.0);
-        assert_eq!(base.point(-1000.0 * RPM, 50.0), a);
+        assert_eq!(base.point(-1000.0 * RAD_S_PER_RPM, 50.0), a);
         // the line pressure follows the torque table
         let mut p = base.clone();
         p.line_pressure = Curve::new(vec![0.0, 400.0], vec![5.0 * BAR, 17.0 * BAR]).unwrap();

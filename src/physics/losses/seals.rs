@@ -11,6 +11,8 @@
 //! gives no temperature dependence: the loss is independent of the oil temperature here, and the
 //! lip is taken as running in, lubricated and without pressure differential.
 
+use crate::physics::units::{rad_s_to_rpm, MM_PER_M};
+
 /// Seal-loss law.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum SealLaw {
@@ -38,8 +40,8 @@ impl LipSeal {
         match self.law {
             SealLaw::Iso14179 => {
                 // P = k d² n with n = ω·30/π → M = P/ω = k d² · 30/π.
-                let d = self.shaft_diameter * 1e3;
-                ISO14179_SEAL * d * d * 30.0 / std::f64::consts::PI
+                let d = self.shaft_diameter * MM_PER_M;
+                rad_s_to_rpm(ISO14179_SEAL * d * d)
             }
             SealLaw::Torque(m) => m,
         }
@@ -62,7 +64,7 @@ mod tests {
             shaft_diameter: 0.05,
             law: SealLaw::Iso14179,
         };
-        let w = 3000.0 * std::f64::consts::PI / 30.0;
+        let w = crate::physics::units::rpm_to_rad_s(3000.0);
         assert!((s.power(w) - 57.675).abs() < 1e-9);
         // Quadratic in the diameter, linear in the speed.
         let s2 = LipSeal {

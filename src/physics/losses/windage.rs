@@ -63,7 +63,7 @@ impl GearWindage {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::f64::consts::PI;
+    use crate::physics::units::rpm_to_rad_s;
 
     fn gear() -> ChurningGear {
         // FZG C wheel-like: z 24, m 4.5 mm, b 14 mm.
@@ -93,7 +93,7 @@ mod tests {
         let cfg = ChurningConfig::default();
         let s = GearWindage::new(ChurningModel::Seetharaman, &cfg, &gear()).unwrap();
         let t = GearWindage::new(ChurningModel::Stavytskyi, &cfg, &gear()).unwrap();
-        let w = |rpm: f64| rpm * PI / 30.0;
+        let w = |rpm: f64| rpm_to_rad_s(rpm);
         let (a, b) = (s.power(w(3000.0)), s.power(w(6000.0)));
         assert!(a > 0.0 && b > 2.0 * a, "{a} {b}");
         let (c, d) = (t.power(w(3000.0)), t.power(w(6000.0)));

@@ -1,6 +1,7 @@
 //! What the figures draw from run, map and bench outputs, read with the writers' types: a run's
 //! [`Summary`] and [`Timeseries`] (`report::run`, `report::timeseries`), a map's
-//! [`MapMeta`] (`report::map`), a bench's [`BenchRow`]s (`solve::work_precision`).
+//! [`MapRow`]s and [`MapMeta`] (`report::map`), a bench's [`BenchResult`] (`report::bench`) and
+//! [`BenchRow`]s (`solve::work_precision`). The writers draw from the same values in memory.
 //!
 //! Missing numeric values (empty fields) become `f64::NAN` and are skipped by the plots;
 //! anything that is not a number, a wrong field count or a missing required column is an error
@@ -13,7 +14,8 @@ use serde::Deserialize;
 
 use super::style::Source;
 use super::PlotError;
-pub use crate::report::map::MapMeta;
+pub use crate::report::bench::BenchResult;
+pub use crate::report::map::{MapMeta, MapRow};
 pub use crate::report::run::Summary;
 use crate::report::timeseries::{parse_num, Timeseries};
 use crate::scene::N_SOURCES;
@@ -308,35 +310,6 @@ pub fn read_run(dir: &Path) -> Result<(Summary, Timeseries), PlotError> {
     Ok((summary, table))
 }
 
-/// One row of `map.csv`.
-#[derive(Clone, Debug, Deserialize)]
-pub struct MapRow {
-    /// Input speed, rpm.
-    pub speed_rpm: f64,
-    /// Input torque, N·m.
-    pub torque_nm: f64,
-    /// Efficiency P_out/(P_out + P_loss) at the equilibrium, fraction (empty without one).
-    pub efficiency: Option<f64>,
-    /// Total loss at the equilibrium, W.
-    #[serde(rename = "loss_total_w")]
-    pub total_loss_w: Option<f64>,
-    /// Churning loss at the equilibrium, W.
-    #[serde(rename = "loss_churning_w")]
-    pub churning_w: Option<f64>,
-    /// Pocketing loss at the equilibrium, W.
-    #[serde(rename = "loss_pocketing_w")]
-    pub pocketing_w: Option<f64>,
-    /// Sliding (mesh friction) loss at the equilibrium, W.
-    #[serde(rename = "loss_sliding_w")]
-    pub sliding_w: Option<f64>,
-    /// Equilibrium temperature of the oil node, °C.
-    pub oil_temp_c: Option<f64>,
-    /// Iterations the steady solver took (Newton and pseudo-transient together).
-    pub iterations: Option<f64>,
-    /// True when the steady solver converged at this point.
-    pub converged: bool,
-}
-
 /// A map on its (speed × torque) grid. Cell (i, j) = speed i, torque j; `None` = no point.
 pub struct MapGrid {
     /// The map's `map.json`.
@@ -353,6 +326,14 @@ impl MapGrid {
     /// The row at speed index `i` and torque index `j`, if the map has that point.
     pub fn cell(&self, i: usize, j: usize) -> Option<&MapRow> {
         self.cells[j * self.speeds_rpm.len() + i].as_ref()
+    }
+
+    /// The grid of a map's rows and `map.json` (`path` names `map.csv` in errors): every value
+    /// finite, efficiencies in [0, 1], at least one row, a grid the heat maps can draw
+    /// ([`check_grid`]).
+    pub fn new(rows: Vec<MapRow>, meta: MapMeta, path: &Path) -> Result<MapGrid, PlotError> {
+        check_rows(&rows, path)?;
+        grid(rows, meta, path)
     }
 }
 
@@ -410,30 +391,15 @@ fn check_grid(path: &Path, speeds: &[f64], torques: &[f64]) -> Result<(), PlotEr
     Ok(())
 }
 
-/// Read `map.csv` and `map.json` of the map output directory `dir` onto their grid.
-pub fn read_map(dir: &Path) -> Result<MapGrid, PlotError> {
-    let path = dir.join("map.csv");
-    let mut rdr = open_csv(&path)?;
-    let mut rows = Vec::new();
-    for r in rdr.deserialize::<MapRow>() {
-        let r = r.map_err(|e| csv_err(&path, e))?;
-        let cells = [
-            Some(r.speed_rpm),
-            Some(r.torque_nm),
-            r.efficiency,
-            r.total_loss_w,
-            r.churning_w,
-            r.pocketing_w,
-            r.sliding_w,
-            r.oil_temp_c,
-            r.iterations,
-        ];
-        if cells.iter().flatten().any(|v| !v.is_finite()) {
+/// Every value of `rows` finite, every efficiency in [0, 1], at least one row.
+fn check_rows(rows: &[MapRow], path: &Path) -> Result<(), PlotError> {
+    for (k, r) in rows.iter().enumerate() {
+        if r.numbers().any(|v| !v.is_finite()) {
             return Err(PlotError::Csv {
-                path,
+                path: path.to_path_buf(),
                 msg: format!(
                     "row {} ({} rpm, {} N m) holds a value that is not a finite number",
-                    rows.len() + 2,
+                    k + 2,
                     r.speed_rpm,
                     r.torque_nm
                 ),
@@ -441,32 +407,35 @@ pub fn read_map(dir: &Path) -> Result<MapGrid, PlotError> {
         }
         if let Some(e) = r.efficiency.filter(|e| !is_efficiency(*e)) {
             return Err(PlotError::Csv {
-                path,
+                path: path.to_path_buf(),
                 msg: format!(
                     "row {}, column `efficiency`: {} {NOT_AN_EFFICIENCY}",
-                    rows.len() + 2,
+                    k + 2,
                     number(e)
                 ),
             });
         }
-        rows.push(r);
     }
     if rows.is_empty() {
         return Err(PlotError::Data {
-            path,
+            path: path.to_path_buf(),
             what: "no data rows".into(),
         });
     }
-    let meta: MapMeta = read_json(&dir.join("map.json"))?;
+    Ok(())
+}
+
+/// The checked `rows` on their (speed × torque) grid.
+fn grid(rows: Vec<MapRow>, meta: MapMeta, path: &Path) -> Result<MapGrid, PlotError> {
     let speeds = unique_sorted(rows.iter().map(|r| r.speed_rpm).collect());
     let torques = unique_sorted(rows.iter().map(|r| r.torque_nm).collect());
     if speeds.is_empty() || torques.is_empty() {
         return Err(PlotError::Data {
-            path,
+            path: path.to_path_buf(),
             what: "no finite speed/torque values".into(),
         });
     }
-    check_grid(&path, &speeds, &torques)?;
+    check_grid(path, &speeds, &torques)?;
     let mut cells = vec![None; speeds.len() * torques.len()];
     for r in rows {
         if !(r.speed_rpm.is_finite() && r.torque_nm.is_finite()) {
@@ -483,19 +452,25 @@ pub fn read_map(dir: &Path) -> Result<MapGrid, PlotError> {
     })
 }
 
-/// `bench.json`: what the work-precision study was run on.
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(default)]
-pub struct BenchMeta {
-    /// Model name.
-    pub model: Option<String>,
-    /// Cycle name.
-    pub cycle: Option<String>,
+/// Read `map.csv` ([`MapRow`]) and `map.json` ([`MapMeta`]) of the map output directory `dir`
+/// with the writer's types, onto their grid.
+pub fn read_map(dir: &Path) -> Result<MapGrid, PlotError> {
+    let path = dir.join("map.csv");
+    let mut rdr = open_csv(&path)?;
+    let rows: Vec<MapRow> = rdr
+        .deserialize::<MapRow>()
+        .collect::<Result<_, _>>()
+        .map_err(|e| csv_err(&path, e))?;
+    check_rows(&rows, &path)?;
+    let meta: MapMeta = read_json(&dir.join("map.json"))?;
+    grid(rows, meta, &path)
 }
 
-/// Read `bench.csv` (into the writer's [`BenchRow`]: an empty number is NaN, a failed row's
-/// reason is not in the file) and `bench.json` of the bench output directory `dir`.
-pub fn read_bench(dir: &Path) -> Result<(Vec<BenchRow>, BenchMeta), PlotError> {
+/// Read a bench output directory `dir` with the writer's types: `bench.json` into
+/// [`BenchResult`] (a key an earlier version did not write reads as its default) and its rows
+/// from `bench.csv` into [`BenchRow`] (an empty number is NaN, a failed row's reason is not in
+/// the file).
+pub fn read_bench(dir: &Path) -> Result<BenchResult, PlotError> {
     let path = dir.join("bench.csv");
     let mut rdr = open_csv(&path)?;
     let headers = rdr.headers().map_err(|e| csv_err(&path, e))?.clone();
@@ -549,8 +524,8 @@ pub fn read_bench(dir: &Path) -> Result<(Vec<BenchRow>, BenchMeta), PlotError> {
             what: "no data rows".into(),
         });
     }
-    let meta: BenchMeta = read_json(&dir.join("bench.json"))?;
-    Ok((rows, meta))
+    let meta: BenchResult = read_json(&dir.join("bench.json"))?;
+    Ok(BenchResult { rows, ..meta })
 }
 
 /// Split the rows in `order` into runs of consecutive finite (x, y) points, so that missing

@@ -64,7 +64,7 @@ impl Quantity {
     fn value(self, r: &MapRow) -> f64 {
         let v = match self {
             Quantity::Efficiency => r.efficiency.map(|e| 100.0 * e),
-            Quantity::TotalLoss => r.total_loss_w,
+            Quantity::TotalLoss => r.loss_total_w,
             Quantity::OilTemp => r.oil_temp_c,
         };
         v.filter(|x| x.is_finite()).unwrap_or(f64::NAN)

@@ -54,7 +54,7 @@ pub fn markdown(grid: &MapGrid) -> String {
     let _ = writeln!(
         s,
         "| Total loss | {} |",
-        range_text(range(cells.iter().filter_map(|c| c.total_loss_w)), 1.0, "W", 1)
+        range_text(range(cells.iter().filter_map(|c| c.loss_total_w)), 1.0, "W", 1)
     );
     let _ = writeln!(
         s,

@@ -5,8 +5,12 @@
 //!   [`render_run_dir`] reads them from a run directory (`summary.json`, `timeseries.csv`) with
 //!   the same types.
 //! - [`render_map`]: `map_efficiency.png`, `map_total_loss.png`, `map_oil_temp.png` and
-//!   `report.md` from a map directory (`map.csv`, `map.json`).
-//! - [`render_bench`]: `work_precision.png` from a bench directory (`bench.csv`, `bench.json`).
+//!   `report.md` from a map's results in memory (its [`MapRow`]s and [`MapMeta`]);
+//!   [`render_map_dir`] reads them from a map directory (`map.csv`, `map.json`) with the same
+//!   types.
+//! - [`render_bench`]: `work_precision.png` from a work-precision study's [`BenchResult`] in
+//!   memory; [`render_bench_dir`] reads it from a bench directory (`bench.json`, `bench.csv`)
+//!   with the same types.
 //! - [`rating::render`]: `rating.png`, the thermal rating curve of a `rating` sweep.
 //!
 //! Every PNG is 1600×1000 px. Each output is rendered to a temporary file in the target
@@ -20,6 +24,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use tempfile::NamedTempFile;
 
+use crate::report::bench::BenchResult;
+use crate::report::map::{MapMeta, MapRow};
 use crate::report::run::Summary;
 use crate::report::timeseries::Timeseries;
 
@@ -172,12 +178,25 @@ pub fn render_run_dir(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
     render_run(dir, &summary, &table)
 }
 
-/// Render the three heat maps into `dir` (which holds `map.csv` and `map.json`).
-pub fn render_map(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+/// Render the three heat maps and `report.md` of a map's results (`rows` of `map.csv`, `meta`
+/// of `map.json`) into `dir`. Returns the paths written.
+pub fn render_map(dir: &Path, rows: &[MapRow], meta: &MapMeta) -> Result<Vec<PathBuf>, PlotError> {
     check_dir(dir)?;
-    style::ensure_fonts()?;
+    let grid = data::MapGrid::new(rows.to_vec(), meta.clone(), &dir.join("map.csv"))?;
+    render_grid(dir, &grid)
+}
+
+/// Read the map directory `dir` (`map.csv`, `map.json`, with the writer's types) and render its
+/// report into it ([`render_map`]).
+pub fn render_map_dir(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+    check_dir(dir)?;
     let grid = data::read_map(dir)?;
-    let grid = &grid;
+    render_grid(dir, &grid)
+}
+
+/// The heat maps and `report.md` of `grid` into `dir`.
+fn render_grid(dir: &Path, grid: &data::MapGrid) -> Result<Vec<PathBuf>, PlotError> {
+    style::ensure_fonts()?;
     let mut jobs: Vec<Box<dyn FnOnce() -> Result<Staged, PlotError> + Send + '_>> = heatmap::Quantity::ALL
         .into_iter()
         .map(|q| {
@@ -255,17 +274,25 @@ pub fn render_validation(
     commit(stage_parallel(jobs)?)
 }
 
-/// Render `work_precision.png` into `dir` (which holds `bench.csv` and `bench.json`).
-pub fn render_bench(dir: &Path) -> Result<PathBuf, PlotError> {
+/// Render `work_precision.png` of a work-precision study's results into `dir`. Returns the
+/// path written.
+pub fn render_bench(dir: &Path, result: &BenchResult) -> Result<PathBuf, PlotError> {
     check_dir(dir)?;
     style::ensure_fonts()?;
-    let (rows, meta) = data::read_bench(dir)?;
     let staged = stage_png(dir, "work_precision.png", |root| {
-        work_precision::draw(root, &rows, &meta)
+        work_precision::draw(root, &result.rows, &result.model, &result.cycle)
     })?;
     let mut paths = commit(vec![staged])?;
     paths.pop().ok_or_else(|| PlotError::Data {
         path: dir.to_path_buf(),
         what: "nothing written".into(),
     })
+}
+
+/// Read the bench directory `dir` (`bench.json`, `bench.csv`, with the writer's types) and
+/// render `work_precision.png` into it ([`render_bench`]).
+pub fn render_bench_dir(dir: &Path) -> Result<PathBuf, PlotError> {
+    check_dir(dir)?;
+    let result = data::read_bench(dir)?;
+    render_bench(dir, &result)
 }

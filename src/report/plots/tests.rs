@@ -400,7 +400,7 @@ fn maps_render() {
     for (nx, ny, shuffle) in [(30, 25, true), (6, 5, false), (1, 1, false), (1, 4, false)] {
         let dir = tempfile::tempdir().unwrap();
         write_map(dir.path(), nx, ny, shuffle);
-        let paths = render_map(dir.path()).unwrap_or_else(|e| panic!("{nx}x{ny}: {e}"));
+        let paths = render_map_dir(dir.path()).unwrap_or_else(|e| panic!("{nx}x{ny}: {e}"));
         assert_eq!(paths.len(), 4, "three heat maps and report.md");
         let md = fs::read_to_string(dir.path().join("report.md")).unwrap();
         assert!(
@@ -422,7 +422,7 @@ fn malformed_map_names_the_file() {
     let mut t = fs::read_to_string(&p).unwrap();
     t.push_str("100,5,0.9,1,1,1,1,40,3,maybe\n");
     fs::write(&p, t).unwrap();
-    let err = render_map(dir.path()).unwrap_err();
+    let err = render_map_dir(dir.path()).unwrap_err();
     assert!(err.to_string().contains("map.csv"), "{err}");
     assert_no_temp_files(dir.path());
 }
@@ -488,7 +488,7 @@ fn write_bench(dir: &Path) {
 fn bench_renders() {
     let dir = tempfile::tempdir().unwrap();
     write_bench(dir.path());
-    let p = render_bench(dir.path()).unwrap_or_else(|e| panic!("{e}"));
+    let p = render_bench_dir(dir.path()).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(p, dir.path().join("work_precision.png"));
     assert_png_ok(&p);
     assert_no_temp_files(dir.path());
@@ -583,12 +583,12 @@ fn write_samples() {
         let d = out.join(name);
         fs::create_dir_all(&d).unwrap();
         write_map(&d, nx, ny, true);
-        render_map(&d).unwrap();
+        render_map_dir(&d).unwrap();
     }
     let d = out.join("bench");
     fs::create_dir_all(&d).unwrap();
     write_bench(&d);
-    render_bench(&d).unwrap();
+    render_bench_dir(&d).unwrap();
 }
 
 #[test]

@@ -6,7 +6,7 @@ use plotters::coord::combinators::{LogCoord, WithKeyPoints};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
 
-use super::data::{BenchMeta, BenchRow};
+use super::data::{name_or, BenchRow};
 use super::panel::Axes;
 use super::style::{self, LegendEntry, Marker, Swatch};
 use super::{Canvas, DrawResult};
@@ -112,11 +112,11 @@ struct Placement {
 }
 
 /// Draw `work_precision.png`: wall time vs maximum temperature error per solver.
-pub fn draw(root: &Canvas, rows: &[BenchRow], meta: &BenchMeta) -> DrawResult {
+pub fn draw(root: &Canvas, rows: &[BenchRow], model: &str, cycle: &str) -> DrawResult {
     let title = format!(
         "Work–precision — {} / {}",
-        meta.model.as_deref().unwrap_or("model"),
-        meta.cycle.as_deref().unwrap_or("cycle")
+        name_or(model, "model"),
+        name_or(cycle, "cycle")
     );
     let root = style::titled(root, &title)?;
     let (w, _) = root.dim_in_pixel();

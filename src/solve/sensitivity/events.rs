@@ -67,13 +67,13 @@ impl EventScratch {
     pub(super) fn new(scene: &Scene) -> Self {
         let all = scene.switching_count();
         EventScratch {
-            count: scene.thermal.controls.len() * EVENTS_PER_CONTROL,
+            count: scene.thermal().controls.len() * EVENTS_PER_CONTROL,
             g: vec![0.0; all],
             gp: vec![0.0; all],
             gm: vec![0.0; all],
             due: false,
             switches: 0,
-            dtau: vec![Vec::new(); scene.thermal.controls.len()],
+            dtau: vec![Vec::new(); scene.thermal().controls.len()],
         }
     }
 }
@@ -242,7 +242,7 @@ impl Tangent<'_> {
         (0..self.delta.len())
             .map(|j| {
                 let start = self.ev.dtau[k].get(j).copied().unwrap_or(0.0);
-                let end = |e: &super::Eval<'_>| e.scene.thermal.controls[k].dwell_end(mode, last);
+                let end = |e: &super::Eval<'_>| e.scene.thermal().controls[k].dwell_end(mode, last);
                 let dd = match (end(&self.plus[j]), end(&self.minus[j])) {
                     (Some(a), Some(b)) => (a - b) / (2.0 * self.delta[j]),
                     _ => 0.0,

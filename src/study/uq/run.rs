@@ -390,7 +390,7 @@ fn grid_of(base: &job::Model, job: &UqJob, points: usize) -> Result<Grid, JobErr
             let p = job::run::prepare(base, r)?;
             let t0 = p.segs.first().map_or(0.0, |s| s.t0);
             let t1 = p.segs.last().map_or(0.0, |s| s.t1);
-            let nodes = p.scene.thermal.names.clone();
+            let nodes = p.scene.thermal().names.clone();
             Ok((
                 job::series::names(&p.scene),
                 job::series::grid(t0, t1, points),
@@ -400,7 +400,7 @@ fn grid_of(base: &job::Model, job: &UqJob, points: usize) -> Result<Grid, JobErr
         UqJob::Steady(s) => {
             base.state(&s.gear)?;
             let scene = base.compile(&crate::scene::Needs::default())?;
-            Ok((Vec::new(), Vec::new(), scene.thermal.names.clone()))
+            Ok((Vec::new(), Vec::new(), scene.thermal().names.clone()))
         }
     }
 }

@@ -43,7 +43,7 @@ use super::coolers::Cooler;
 use super::links::Link;
 use crate::model::choice::{choice, Choice};
 use crate::model::problems::Problems;
-use crate::physics::oil::KELVIN_OFFSET;
+use crate::physics::units::c_to_k;
 
 /// The kinds of controller.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -248,7 +248,7 @@ fn set_point(problems: &mut Problems, path: &str, v: Option<f64>) -> Option<f64>
     };
     let (lo, hi) = SET_POINT_RANGE_C;
     let ok = temp_ok(problems, path, v) && problems.in_range(path, v, lo, hi, " °C (the oil's range)");
-    ok.then_some(v + KELVIN_OFFSET)
+    ok.then_some(c_to_k(v))
 }
 
 /// A share in [0, 1] (default `default`).

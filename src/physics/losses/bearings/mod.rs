@@ -13,6 +13,8 @@ pub mod skf;
 pub use palmgren::Palmgren;
 pub use skf::{DragForm, Skf, SkfConstants, SkfKind};
 
+use crate::physics::units::MM2_S_PER_M2_S;
+
 /// A bearing's boundary dimensions, m.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BearingSize {
@@ -59,7 +61,7 @@ pub struct BearingOil {
 impl BearingOil {
     /// Oil of kinematic viscosity `nu` (m²/s).
     pub fn new(nu: f64) -> BearingOil {
-        let v = nu * 1e6;
+        let v = nu * MM2_S_PER_M2_S;
         let ln = v.ln();
         BearingOil {
             nu: v,

@@ -12,6 +12,7 @@
 //! bearing gives its own (docs/physics.md §Bearings).
 
 use super::{BearingError, BearingLoad, BearingMoment, BearingOil, BearingSize, LoadTerms};
+use crate::physics::units::{MM_PER_M, N_M_PER_N_MM};
 
 /// Palmgren model of one bearing.
 #[derive(Debug, Clone, PartialEq)]
@@ -28,7 +29,7 @@ pub struct Palmgren {
 impl Palmgren {
     /// Build from the size, f0, f1 and the load factors of P1.
     pub fn new(size: BearingSize, f0: f64, f1: f64, k_a: f64, k_r: f64) -> Result<Palmgren, BearingError> {
-        let dm = size.mean() * 1e3;
+        let dm = size.mean() * MM_PER_M;
         if !(dm > 0.0 && f0 >= 0.0 && f1 >= 0.0 && k_a.is_finite() && k_r.is_finite()) {
             return Err(BearingError(format!(
                 "d_m = {dm} mm, f0 = {f0}, f1 = {f1}: need d_m > 0 and f0, f1 ≥ 0"
@@ -66,8 +67,8 @@ impl Palmgren {
         // the published law except for 2000 ≤ ν n < 2024 (docs/physics.md §Bearings).
         let m0 = 1e-7 * self.f0_dm3 * (t.speed[0] * oil.p0667).max(160.0);
         BearingMoment {
-            rolling: 1e-3 * m0,
-            sliding: 1e-3 * t.g_sl,
+            rolling: N_M_PER_N_MM * m0,
+            sliding: N_M_PER_N_MM * t.g_sl,
             seal: 0.0,
             drag: 0.0,
         }

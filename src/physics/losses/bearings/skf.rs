@@ -41,6 +41,7 @@
 //! [`super::Palmgren`].
 
 use super::{BearingError, BearingLoad, BearingMoment, BearingOil, BearingSize, LoadTerms};
+use crate::physics::units::{MM_PER_M, N_M_PER_N_MM};
 
 /// Exponents of the speed n in [`LoadTerms::speed`]: (n d_m)^1.28, n^0.6, n^1.4 and the drag's
 /// n²·n^−1.379 (the SKF model's, module docs).
@@ -200,7 +201,7 @@ pub struct SkfInput {
 impl Skf {
     /// Build the model; errors name the input that is out of range.
     pub fn new(i: &SkfInput) -> Result<Skf, BearingError> {
-        let (d, big_d) = (i.size.bore * 1e3, i.size.outside * 1e3);
+        let (d, big_d) = (i.size.bore * MM_PER_M, i.size.outside * MM_PER_M);
         if !(d > 0.0 && big_d > d) {
             return Err(BearingError(format!(
                 "bore {d} mm and outside diameter {big_d} mm: need 0 < d < D"
@@ -226,10 +227,10 @@ impl Skf {
         let dm = 0.5 * (d + big_d);
         let m_seal = i
             .seal
-            .map_or(0.0, |(k1, k2, beta, ds)| k1 * (ds * 1e3).powf(beta) + k2);
+            .map_or(0.0, |(k1, k2, beta, ds)| k1 * (ds * MM_PER_M).powf(beta) + k2);
         // Drag: SKF with t from the oil level H over d_m (H clamped to 1.2 d_m, where
         // the bearing is fully immersed).
-        let h = (i.oil_level * 1e3).clamp(0.0, 1.2 * dm);
+        let h = (i.oil_level * MM_PER_M).clamp(0.0, 1.2 * dm);
         let (drag1, drag2, dm2_ft) = if h > 0.0 {
             let t = 2.0 * ((0.6 * dm - h) / (0.6 * dm)).clamp(-1.0, 1.0).acos();
             let f_t = if t <= std::f64::consts::PI {
@@ -240,7 +241,7 @@ impl Skf {
             let f_a = 0.05 * c.k_z * (big_d + d) / (big_d - d);
             let r_s = 0.36 * dm * dm * (t - t.sin()) * f_a;
             let first = if i.kind.is_roller() {
-                let b = i.width * 1e3;
+                let b = i.width * MM_PER_M;
                 if !(b > 0.0 && c.k_l > 0.0) {
                     return Err(BearingError(format!(
                         "roller drag needs the width B ({b} mm) and K_L ({}) > 0",
@@ -379,10 +380,10 @@ impl Skf {
         let mu_sl = phi_bl * self.mu_bl + (1.0 - phi_bl) * self.mu_ehl;
         let m_drag = n * n * self.drag1 + self.drag2 * drag_n * oil.p1379;
         BearingMoment {
-            rolling: 1e-3 * m_rr,
-            sliding: 1e-3 * t.g_sl * mu_sl,
-            seal: 1e-3 * self.m_seal,
-            drag: 1e-3 * m_drag,
+            rolling: N_M_PER_N_MM * m_rr,
+            sliding: N_M_PER_N_MM * t.g_sl * mu_sl,
+            seal: N_M_PER_N_MM * self.m_seal,
+            drag: N_M_PER_N_MM * m_drag,
         }
     }
 }

@@ -4,7 +4,7 @@
 use super::skf::{Lubrication, SkfInput};
 use super::*;
 
-const RPM: f64 = std::f64::consts::PI / 30.0;
+use crate::physics::units::RAD_S_PER_RPM;
 
 fn input(kind: SkfKind, c: SkfConstants, d: f64, big_d: f64, c0: f64, mu: (f64, f64)) -> SkfInput {
     SkfInput {
@@ -44,7 +44,7 @@ fn dgbb(r1: f64, s1: f64, s2: f64) -> SkfConstants {
 fn moment(i: &SkfInput, n: f64, fr: f64, fa: f64, nu_cst: f64) -> BearingMoment {
     let m = BearingFriction::Skf(Skf::new(i).unwrap());
     let t = m.load_terms(
-        n * RPM,
+        n * RAD_S_PER_RPM,
         BearingLoad {
             radial: fr,
             axial: fa,
@@ -162,7 +162,7 @@ fn skf_units_and_scaling() {
         axial: 0.0,
     };
     let oil = BearingOil::new(30e-6);
-    let w = 1500.0 * RPM;
+    let w = 1500.0 * RAD_S_PER_RPM;
     close(
         m.power(w, load, oil),
         m.moment(&m.load_terms(w, load), oil).total() * w,
@@ -183,7 +183,7 @@ fn palmgren_units_match_thermca_si_form() {
     };
     let m = Palmgren::new(size, 3.0, 0.0, 0.0, 1.0).unwrap();
     let (nu, rpm) = (13.5e-6, 2175.0);
-    let w = rpm * RPM;
+    let w = rpm * RAD_S_PER_RPM;
     let t = m.load_terms(rpm, BearingLoad::default());
     let got = m.moment(&t, BearingOil::new(nu)).rolling;
     let r = size.mean() / 2.0;

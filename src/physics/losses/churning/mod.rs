@@ -451,7 +451,7 @@ pub(crate) mod test_support {
     }
 
     pub fn rpm(n: f64) -> f64 {
-        n * PI / 30.0
+        crate::physics::units::rpm_to_rad_s(n)
     }
 
     /// Log-log slope of `f` between `a` and `b`.

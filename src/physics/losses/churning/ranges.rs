@@ -18,6 +18,7 @@
 //!   plate law there is derived (White), not part of seed 000's fitted or tested range.
 
 use super::{ChangenetJoin, ChurningGear, GearChurning, OilState};
+use crate::physics::units::MM_PER_M;
 
 /// One kind of out-of-range use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -125,11 +126,11 @@ pub const STAVYTSKYI_TESTED: &str =
 /// listed when h/r_a differs from 0.55 by more than 0.005 (its printed precision).
 pub fn stavytskyi_geometry(g: &ChurningGear) -> Vec<String> {
     let mut v = Vec::new();
-    let m = g.normal_module * 1e3;
+    let m = g.normal_module * MM_PER_M;
     if !(1.5..=5.0).contains(&m) {
         v.push(format!("module {m:.2} mm"));
     }
-    let b = g.face_width * 1e3;
+    let b = g.face_width * MM_PER_M;
     if !(14.0..=24.0).contains(&b) {
         v.push(format!("face width {b:.1} mm"));
     }

@@ -325,6 +325,7 @@ impl StavytskyiGear {
 mod tests {
     use super::super::test_support::*;
     use super::*;
+    use crate::physics::units::rad_s_to_rpm;
 
     fn model(g: &ChurningGear, p: StavytskyiParams) -> StavytskyiGear {
         StavytskyiGear::new(g, &p).unwrap()
@@ -417,11 +418,11 @@ mod tests {
         assert!(n_max > 4000.0 && n_max < 10000.0, "maximum at {n_max} rpm");
         assert!(p(n_max * 1.15) < 0.9 * p_max, "fall after the maximum");
         // the maximum sits just below the filling limit speed
-        let n0 = m.filling_limit_speed(&o).unwrap() * 30.0 / PI;
+        let n0 = rad_s_to_rpm(m.filling_limit_speed(&o).unwrap());
         assert!(n_max < n0 && n_max > 0.7 * n0, "n_max {n_max}, n0 {n0}");
         // and the limit is where ½ρω²(r_a² − r_f²) ≈ p_0 (R3), within the small gravity/viscous terms
         let w0 = (2.0 * 101_325.0 / (o.density * (g.tip_radius.powi(2) - g.root_radius.powi(2)))).sqrt();
-        assert!((n0 / (w0 * 30.0 / PI) - 1.0).abs() < 0.05);
+        assert!((n0 / rad_s_to_rpm(w0) - 1.0).abs() < 0.05);
     }
 
     #[test]

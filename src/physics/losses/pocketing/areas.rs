@@ -878,7 +878,7 @@ mod tests {
         let fzg = cases::fzg_c();
         let pm = super::super::PocketingMesh::new(&fzg, 0.65).unwrap();
         for rpm in [1000.0, 3000.0, 6000.0] {
-            let w = rpm * std::f64::consts::PI / 30.0;
+            let w = crate::physics::units::rpm_to_rad_s(rpm);
             let [a, b] = pm.family_power(w, 870.0);
             eprintln!("fzg_c {rpm} rpm: {:.2} W ({a:.2} + {b:.2})", a + b);
         }
@@ -896,7 +896,7 @@ mod tests {
                     t.k_helical(0.65, s, 64)
                 };
             }
-            let w = 3000.0 * std::f64::consts::PI / 30.0;
+            let w = crate::physics::units::rpm_to_rad_s(3000.0);
             let p = 16.0 * 870.0 * w.powi(3) * kh / (4.0 * std::f64::consts::PI);
             eprintln!(
                 "fzg_c helical β {beta}°: K_hel/K_spur (n = 64) {:.3}, P 3000 rpm {p:.1} W",

@@ -134,13 +134,14 @@ impl PocketingMesh {
 mod tests {
     use super::super::cases;
     use super::*;
+    use crate::physics::units::rpm_to_rad_s;
     use std::f64::consts::PI;
 
     #[test]
     fn power_formula_equals_passage_frequency_times_energy() {
         let inp = cases::fzg_c();
         let m = PocketingMesh::new(&inp, 0.65).unwrap();
-        let (w, rho) = (3000.0 * PI / 30.0, 870.0);
+        let (w, rho) = (rpm_to_rad_s(3000.0), 870.0);
         let e = 0.5 * rho * w * w * (m.k()[0] + m.k()[1]);
         let p = inp.z1 as f64 * w / (2.0 * PI) * e;
         assert!((m.power(w, rho) - p).abs() < 1e-12 * p);
@@ -180,7 +181,7 @@ mod tests {
             face_width: 14.0 / 1000.0,
             ..m_si
         };
-        let w = 6000.0 * PI / 30.0;
+        let w = rpm_to_rad_s(6000.0);
         let p_si = PocketingMesh::new(&m_si, 0.65).unwrap().power(w, 870.0);
         let p_mm = PocketingMesh::new(&mm, 0.65).unwrap().power(w, 870.0);
         assert!(((p_si - p_mm) / p_si).abs() < 1e-9, "{p_si} vs {p_mm}");

@@ -8,6 +8,7 @@
 //! no readable source of the full formula was found (see DOCS.md). It is listed as missing.
 
 use super::SlidingError;
+use crate::physics::units::{MM_PER_M, MPA_S_PER_PA_S, M_PER_MM, UM_PER_M};
 
 /// Newtons per pound-force (exact by definition of the lbf).
 pub const NEWTON_PER_LBF: f64 = 4.448_221_615_260_5;
@@ -82,7 +83,7 @@ impl BenedictKelley {
     /// μ for one contact, with the roughness factor precomputed by [`Self::roughness_factor`].
     pub fn mu(&self, c: &ContactState, roughness_factor: f64) -> f64 {
         let w_lbf_in = c.line_load * METRE_PER_INCH / NEWTON_PER_LBF;
-        let eta_cp = c.viscosity * 1e3;
+        let eta_cp = c.viscosity * MPA_S_PER_PA_S;
         let vg = c.sliding_speed / METRE_PER_INCH;
         let vs = c.sum_speed / METRE_PER_INCH;
         let raw = self.constant * w_lbf_in / (eta_cp * vg * vs * vs);
@@ -120,10 +121,10 @@ impl Default for IsoTc60 {
 impl IsoTc60 {
     /// μ for one contact. Precondition: η, R, v_Σ > 0 (guaranteed inside the mesh path).
     pub fn mu(&self, c: &ContactState) -> f64 {
-        let w_n_mm = c.line_load * 1e-3;
-        let ra_um = c.roughness * 1e6;
-        let eta_mpas = c.viscosity * 1e3;
-        let r_mm = c.reduced_radius * 1e3;
+        let w_n_mm = c.line_load * M_PER_MM; // N/m × m/mm = N/mm
+        let ra_um = c.roughness * UM_PER_M;
+        let eta_mpas = c.viscosity * MPA_S_PER_PA_S;
+        let r_mm = c.reduced_radius * MM_PER_M;
         let x = (w_n_mm * ra_um / (eta_mpas * r_mm * c.sum_speed)).max(0.0);
         // x^0.25 as two square roots (same value to rounding, several times faster than powf)
         let xe = if self.exponent == 0.25 {
@@ -189,10 +190,10 @@ impl Schlenk {
         viscosity: f64,
         roughness: f64,
     ) -> f64 {
-        let f_n_mm = load_per_width * 1e-3;
-        let rho_mm = reduced_radius_c * 1e3;
-        let eta_mpas = viscosity * 1e3;
-        let ra_um = roughness * 1e6;
+        let f_n_mm = load_per_width * M_PER_MM; // N/m × m/mm = N/mm
+        let rho_mm = reduced_radius_c * MM_PER_M;
+        let eta_mpas = viscosity * MPA_S_PER_PA_S;
+        let ra_um = roughness * UM_PER_M;
         let x = (f_n_mm / (sum_speed_c * rho_mm)).max(0.0);
         self.coefficient
             * x.powf(0.2)

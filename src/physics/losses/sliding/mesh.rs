@@ -395,6 +395,7 @@ mod tests {
     use super::super::friction::{BenedictKelley, IsoTc60};
     use super::super::load_sharing::LoadSharing;
     use super::*;
+    use crate::physics::units::rpm_to_rad_s;
     use std::f64::consts::PI;
 
     const OIL: OilState = OilState {
@@ -469,7 +470,7 @@ mod tests {
 
     #[test]
     fn spur_uniform_constant_mu_equals_ohlendorf() {
-        let w1 = 2000.0 * PI / 30.0;
+        let w1 = rpm_to_rad_s(2000.0);
         for inp in [seed_input(0.0), fzg_c(1e-3)] {
             let mesh = SlidingMesh::new(&inp, &opts(FrictionLaw::Constant(0.05))).unwrap();
             let w2 = w1 * inp.z1 as f64 / inp.z2 as f64;
@@ -607,7 +608,7 @@ mod tests {
     fn seed003_weighted_ratio_per_sample() {
         // spur, 33:67, constant μ, moment balance: P(sample)/P_in = Σ_k LS_k φ(n_k) with seed 003's
         // ratio on the approach side (n < 0) and its mirrored branch on the recess side
-        let (w, t, mu) = (2000.0 * PI / 30.0, 201.0, 0.06);
+        let (w, t, mu) = (rpm_to_rad_s(2000.0), 201.0, 0.06);
         let inp = seed_input(0.0);
         let o = SlidingOptions {
             load_sharing: LoadSharing::Share33_67,
