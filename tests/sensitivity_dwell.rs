@@ -7,10 +7,13 @@
 //! sensitivity of that parameter over the trace).
 
 use geartherm::scene::Scene;
-use geartherm::solve::sensitivity::{integrate_sensitivities, Direction, SensitivityOptions};
+use geartherm::solve::sensitivity::{integrate_sensitivities, Direction};
 use geartherm::solve::transient::{integrate, Method, Segment, TransientOptions};
 
 mod common;
+use common::controls::{
+    casing_air, heater, oil_casing, sensitivity_options as opts, uniform, C1, G2, START_C,
+};
 use common::{fzg_frozen, steady_inputs};
 
 /// on_c, off_c, heater_w, min_on_s.
@@ -18,37 +21,8 @@ const NOMINAL: [f64; 4] = [40.0, 45.0, 1500.0, 30.0];
 const NAMES: [&str; 4] = ["on_c", "off_c", "heater_w", "min_on_s"];
 
 fn network(p: &[f64; 4]) -> String {
-    format!(
-        r#"
-[thermal]
-oil_node = "oil"
-initial_temp_c = 30.0
-[[thermal.nodes]]
-name = "oil"
-capacity_j_per_k = 2000.0
-[[thermal.nodes]]
-name = "casing"
-capacity_j_per_k = 5000.0
-[[thermal.boundaries]]
-name = "ambient"
-temp_c = 20.0
-[[thermal.links]]
-between = ["oil", "casing"]
-conductance_w_per_k = 20.0
-[[thermal.links]]
-between = ["casing", "ambient"]
-conductance_w_per_k = 10.0
-[[thermal.controls]]
-name = "heater"
-kind = "two_point"
-sensor = "oil"
-on_c = {:e}
-off_c = {:e}
-heater_w = {:e}
-min_on_s = {:e}
-"#,
-        p[0], p[1], p[2], p[3]
-    )
+    let dwell = format!("min_on_s = {:e}\n", p[3]);
+    oil_casing(START_C, C1) + &casing_air(G2, None) + &heater(p[0], p[1], p[2], &dwell)
 }
 
 fn scene(p: &[f64; 4]) -> Scene {
@@ -56,23 +30,7 @@ fn scene(p: &[f64; 4]) -> Scene {
 }
 
 fn segments(n: usize, dt: f64) -> Vec<Segment> {
-    let inputs = steady_inputs(0.0, 0.0);
-    (0..n)
-        .map(|k| Segment {
-            t0: k as f64 * dt,
-            t1: (k + 1) as f64 * dt,
-            inputs,
-        })
-        .collect()
-}
-
-fn opts(rtol: f64) -> SensitivityOptions {
-    SensitivityOptions {
-        rtol,
-        atol: rtol,
-        max_steps: 10_000_000,
-        initial: None,
-    }
+    uniform(steady_inputs(0.0, 0.0), n, dt)
 }
 
 /// A parameter's step: 1e-3 K on a temperature, 1e-3 relative otherwise.
