@@ -10,7 +10,8 @@ use geartherm::solve::transient::{energy_balance, Method};
 
 mod common;
 use common::controls::{
-    casing_air, frozen_with_source, heater, oil_casing, run, uniform, Linear, C1, G2, POWER, START_C,
+    casing_air, frozen_with_source, heater, oil_casing, run, switching_report, uniform, Linear, C1, G2,
+    POWER, START_C,
 };
 use common::{fzg_frozen, steady_inputs};
 
@@ -97,20 +98,7 @@ fn switching_instants_and_temperatures_match_the_analytic_solution() {
                 println!("switch {a} {b} {:e}", a - b);
             }
         }
-        let eb = energy_balance(&scene, &traj);
-        println!(
-            "{method:?}: {} switches, worst switching time {dt_worst:.3e} s, worst temperature \
-             {t_worst:.3e} K, energy balance {:.2e}, steps {}",
-            times.len(),
-            eb.relative,
-            traj.stats.steps
-        );
-        if !(dt_worst < 1e-6 && t_worst < 1e-6) {
-            bad.push(format!(
-                "{method:?}: switching time off by {dt_worst:e} s, temperature by {t_worst:e} K"
-            ));
-        }
-        assert!(eb.relative < 1e-9, "{method:?}: energy balance {:e}", eb.relative);
+        switching_report(&scene, &traj, method, times.len(), (dt_worst, t_worst), &mut bad);
         assert_eq!(traj.switches, vec![switches.len()]);
     }
     assert!(bad.is_empty(), "{bad:?}");

@@ -7,10 +7,13 @@
 
 use geartherm::physics::oil::KELVIN_OFFSET;
 use geartherm::scene::{Inputs, Scene};
-use geartherm::solve::transient::{energy_balance, integrate, Method, Segment, Trajectory, TransientOptions};
+use geartherm::solve::transient::Method;
 
 mod common;
-use common::controls::{casing_air, frozen_with_source, heater, oil_casing, Linear, C1, G2, POWER, START_C};
+use common::controls::{
+    casing_air, frozen_with_source, heater, oil_casing, run, switching_report, uniform, Linear, C1, G2,
+    POWER, START_C,
+};
 
 /// The analytic solution's scan for a crossing, s.
 const SCAN: f64 = 0.25;
@@ -94,26 +97,6 @@ fn analytic(l: Law, src: [f64; 2], t_end: f64, dt: f64) -> Exact {
     out
 }
 
-fn run(scene: &Scene, segs: &[Segment], method: Method, rtol: f64) -> Trajectory {
-    let o = TransientOptions {
-        method,
-        rtol,
-        atol: rtol,
-        ..TransientOptions::default()
-    };
-    integrate(scene, segs, &o, &mut |_, _| {}).unwrap()
-}
-
-fn uniform(inputs: Inputs, n: usize, dt: f64) -> Vec<Segment> {
-    (0..n)
-        .map(|k| Segment {
-            t0: k as f64 * dt,
-            t1: (k + 1) as f64 * dt,
-            inputs,
-        })
-        .collect()
-}
-
 /// Every method's switching instants and rows against the analytic ones.
 fn check(l: Law, t_end: f64, dt: f64) {
     let (scene, inputs, src) = scene(l);
@@ -156,20 +139,7 @@ fn check(l: Law, t_end: f64, dt: f64) {
             .zip(&exact.rows)
             .map(|(y, e)| (y[0] - e[0]).abs().max((y[1] - e[1]).abs()))
             .fold(0.0, f64::max);
-        let eb = energy_balance(&scene, &traj);
-        println!(
-            "{method:?}: {} switches, worst switching time {dt_worst:.3e} s, worst temperature \
-             {t_worst:.3e} K, energy balance {:.2e}, steps {}",
-            times.len(),
-            eb.relative,
-            traj.stats.steps
-        );
-        if !(dt_worst < 1e-6 && t_worst < 1e-6) {
-            bad.push(format!(
-                "{method:?}: switching time off by {dt_worst:e} s, temperature by {t_worst:e} K"
-            ));
-        }
-        assert!(eb.relative < 1e-9, "{method:?}: energy balance {:e}", eb.relative);
+        switching_report(&scene, &traj, method, times.len(), (dt_worst, t_worst), &mut bad);
         assert_eq!(traj.switches, vec![exact.switches.len()]);
     }
     assert!(bad.is_empty(), "{bad:?}");

@@ -5,8 +5,8 @@
 
 use geartherm::physics::oil::KELVIN_OFFSET;
 use geartherm::scene::{Inputs, Scene};
-use geartherm::solve::sensitivity::SensitivityOptions;
-use geartherm::solve::transient::{integrate, Method, Segment, Trajectory, TransientOptions};
+use geartherm::solve::sensitivity::{SensitivityOptions, SensitivityTrajectory};
+use geartherm::solve::transient::{energy_balance, integrate, Method, Segment, Trajectory, TransientOptions};
 
 use super::{fzg_frozen, steady_inputs};
 
@@ -189,4 +189,55 @@ pub fn sensitivity_options(rtol: f64) -> SensitivityOptions {
         max_steps: 10_000_000,
         initial: None,
     }
+}
+
+/// Print a trajectory's switching comparison (switches, worst switching time and temperature
+/// against the analytic ones, energy balance, steps), note a miss over 1e-6 s or 1e-6 K in
+/// `bad`, and assert the energy balance within 1e-9.
+pub fn switching_report(
+    scene: &Scene,
+    traj: &Trajectory,
+    method: Method,
+    switches: usize,
+    (dt_worst, t_worst): (f64, f64),
+    bad: &mut Vec<String>,
+) {
+    let eb = energy_balance(scene, traj);
+    println!(
+        "{method:?}: {} switches, worst switching time {dt_worst:.3e} s, worst temperature \
+         {t_worst:.3e} K, energy balance {:.2e}, steps {}",
+        switches, eb.relative, traj.stats.steps
+    );
+    if !(dt_worst < 1e-6 && t_worst < 1e-6) {
+        bad.push(format!(
+            "{method:?}: switching time off by {dt_worst:e} s, temperature by {t_worst:e} K"
+        ));
+    }
+    assert!(eb.relative < 1e-9, "{method:?}: energy balance {:e}", eb.relative);
+}
+
+/// The sensitivities of parameter `k` (of `np`) in `tangent` against the central differences
+/// of the integrations `a` (parameter + `h`) and `b` (− `h`) over both nodes and every row:
+/// the largest |S| and the largest difference relative to it, printed with `name`; asserts
+/// that there is a sensitivity.
+pub fn against_central_differences(
+    tangent: &SensitivityTrajectory,
+    (a, b): (&SensitivityTrajectory, &SensitivityTrajectory),
+    h: f64,
+    (k, np): (usize, usize),
+    name: &str,
+) -> f64 {
+    let (mut err, mut scale) = (0.0_f64, 0.0_f64);
+    for r in 0..tangent.times.len() {
+        for i in 0..2 {
+            let cd = (a.temps[r][i] - b.temps[r][i]) / (2.0 * h);
+            let s = tangent.sens_at(r, i, k, np);
+            err = err.max((s - cd).abs());
+            scale = scale.max(s.abs());
+        }
+    }
+    let rel = err / scale;
+    println!("{name}: max |S| {scale:.4e} K per unit, relative error {rel:.2e}");
+    assert!(scale > 0.0, "{name}: no sensitivity");
+    rel
 }
