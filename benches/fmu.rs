@@ -11,9 +11,11 @@
 //! The importer's side (the inputs, boundary values and derivatives at every communication
 //! point, from the run's segments: inputs held over each 1 s sample, ambient and coolant as
 //! lines) is computed before the clock starts. Each iteration instantiates, initialises,
-//! steps through the cycle and frees an instance. Outputs are read once per 1 s sample
-//! (`fmu/cosim_*`), or at every communication point (`fmu/cosim_0.01s_read_every_step`, what
-//! FMPy's `simulate_fmu` does: each read computes the outputs from the state).
+//! steps through the cycle and frees an instance. Outputs (node temperatures and total loss) are
+//! read once per 1 s sample (`fmu/cosim_*`), and at every communication point as well in the
+//! `_read_` benches: the node temperatures and total loss (`read_every_step`), the temperatures
+//! and loss energies, which need no loss evaluation (`read_temperatures_energies`), every output
+//! variable (`read_all_outputs`, what FMPy's `simulate_fmu` records).
 //!
 //! `cargo build --release && cargo bench --bench fmu -- --warm-up-time 1 --measurement-time 4`
 
@@ -22,7 +24,7 @@ use std::path::{Path, PathBuf};
 
 use criterion::{criterion_group, criterion_main, Criterion};
 
-use geartherm::job::fmu::{slot, FmuModel, Payload, Role};
+use geartherm::job::fmu::{slot, Causality, FmuModel, Payload, Role};
 use geartherm::job::{run, Model, RunOptions};
 use geartherm::scene::Inputs;
 
@@ -144,7 +146,12 @@ struct Refs {
     held: [u32; 3],
     gear: u32,
     boundaries: Vec<u32>,
+    /// The node temperatures and the total loss.
     outputs: Vec<u32>,
+    /// The node temperatures and the loss energy per source and total (no loss power).
+    state_outputs: Vec<u32>,
+    /// Every output variable (what FMPy's `simulate_fmu` records).
+    all_outputs: Vec<u32>,
 }
 
 fn refs(fm: &FmuModel) -> Refs {
@@ -163,15 +170,33 @@ fn refs(fm: &FmuModel) -> Refs {
             .map(|n| vr(Role::NodeTemp(n)))
             .chain([vr(Role::TotalLoss)])
             .collect(),
+        state_outputs: fm
+            .vars
+            .iter()
+            .filter(|v| {
+                matches!(
+                    v.role,
+                    Role::NodeTemp(_) | Role::SourceEnergy(_) | Role::TotalEnergy
+                )
+            })
+            .map(|v| v.vr)
+            .collect(),
+        all_outputs: fm
+            .vars
+            .iter()
+            .filter(|v| v.causality == Causality::Output)
+            .map(|v| v.vr)
+            .collect(),
     }
 }
 
-/// One WLTC co-simulation through the C API; outputs read at every point when `every`, else
-/// once per sample. Returns the sum of the last outputs (kept from the optimiser).
-fn cosim(api: &Api, r: &Refs, plan: &[(Inputs, Vec<Point>)], every: bool) -> f64 {
+/// One WLTC co-simulation through the C API; the outputs `every` read at every point, when
+/// given, and `r.outputs` once per sample. Returns the sum of the last outputs (kept from the
+/// optimiser).
+fn cosim(api: &Api, r: &Refs, plan: &[(Inputs, Vec<Point>)], every: Option<&[u32]>) -> f64 {
     let name = c"bench";
     let callbacks = [std::ptr::null_mut::<c_void>(); 5];
-    let mut out = vec![0.0; r.outputs.len()];
+    let mut out = vec![0.0; r.all_outputs.len()];
     let orders: Vec<c_int> = vec![1; r.boundaries.len()];
     // SAFETY: the FMI 2.0 calling sequence on an instance of this library, with arrays of the
     // lengths passed.
@@ -200,8 +225,8 @@ fn cosim(api: &Api, r: &Refs, plan: &[(Inputs, Vec<Point>)], every: bool) -> f64
                 let s = (api.set_derivatives)(c, r.boundaries.as_ptr(), nb, orders.as_ptr(), d.as_ptr());
                 assert_eq!(s, 0);
                 assert_eq!((api.do_step)(c, *a, b - a, 1), 0);
-                if every {
-                    (api.get_real)(c, r.outputs.as_ptr(), r.outputs.len(), out.as_mut_ptr());
+                if let Some(vrs) = every {
+                    (api.get_real)(c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr());
                 }
             }
             (api.get_real)(c, r.outputs.as_ptr(), r.outputs.len(), out.as_mut_ptr());
@@ -231,10 +256,16 @@ fn benches(c: &mut Criterion) {
     });
     let coarse = plan(&p, 1.0);
     let fine = plan(&p, 0.01);
-    g.bench_function("cosim_1s", |b| b.iter(|| cosim(&api, &r, &coarse, false)));
-    g.bench_function("cosim_0.01s", |b| b.iter(|| cosim(&api, &r, &fine, false)));
+    g.bench_function("cosim_1s", |b| b.iter(|| cosim(&api, &r, &coarse, None)));
+    g.bench_function("cosim_0.01s", |b| b.iter(|| cosim(&api, &r, &fine, None)));
     g.bench_function("cosim_0.01s_read_every_step", |b| {
-        b.iter(|| cosim(&api, &r, &fine, true))
+        b.iter(|| cosim(&api, &r, &fine, Some(&r.outputs)))
+    });
+    g.bench_function("cosim_0.01s_read_temperatures_energies", |b| {
+        b.iter(|| cosim(&api, &r, &fine, Some(&r.state_outputs)))
+    });
+    g.bench_function("cosim_0.01s_read_all_outputs", |b| {
+        b.iter(|| cosim(&api, &r, &fine, Some(&r.all_outputs)))
     });
     g.finish();
     let steps = |pl: &[(Inputs, Vec<Point>)]| pl.iter().map(|(_, p)| p.len()).sum::<usize>();

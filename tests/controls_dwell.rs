@@ -7,18 +7,16 @@
 
 use geartherm::physics::oil::KELVIN_OFFSET;
 use geartherm::scene::{Inputs, Scene};
-use geartherm::solve::transient::{energy_balance, integrate, Method, Segment, Trajectory, TransientOptions};
+use geartherm::solve::transient::Method;
 
 mod common;
-use common::{fzg_frozen, steady_inputs};
+use common::controls::{
+    casing_air, frozen_with_source, heater, oil_casing, run, switching_report, uniform, Linear, C1, G2,
+    POWER, START_C,
+};
 
-const C1: f64 = 2000.0;
-const C2: f64 = 5000.0;
-const G1: f64 = 20.0;
-const G2: f64 = 10.0;
-const POWER: f64 = 1500.0;
-const AMBIENT_C: f64 = 20.0;
-const START_C: f64 = 30.0;
+/// The analytic solution's scan for a crossing, s.
+const SCAN: f64 = 0.25;
 
 /// The heater's law: set points (°C) and minimum times (s).
 #[derive(Clone, Copy)]
@@ -31,119 +29,14 @@ struct Law {
 
 /// Oil (C1) – casing (C2) – ambient, a heater of POWER W on the oil.
 fn network(l: Law) -> String {
-    format!(
-        r#"
-[thermal]
-oil_node = "oil"
-initial_temp_c = {START_C:e}
-[[thermal.nodes]]
-name = "oil"
-capacity_j_per_k = {C1:e}
-[[thermal.nodes]]
-name = "casing"
-capacity_j_per_k = {C2:e}
-[[thermal.boundaries]]
-name = "ambient"
-temp_c = {AMBIENT_C:e}
-[[thermal.links]]
-between = ["oil", "casing"]
-conductance_w_per_k = {G1:e}
-[[thermal.links]]
-between = ["casing", "ambient"]
-conductance_w_per_k = {G2:e}
-[[thermal.controls]]
-name = "heater"
-kind = "two_point"
-sensor = "oil"
-on_c = {:e}
-off_c = {:e}
-min_on_s = {:e}
-min_off_s = {:e}
-heater_w = {POWER:e}
-"#,
-        l.on_c, l.off_c, l.min_on, l.min_off
-    )
+    let times = format!("min_on_s = {:e}\nmin_off_s = {:e}\n", l.min_on, l.min_off);
+    oil_casing(START_C, C1) + &casing_air(G2, None) + &heater(l.on_c, l.off_c, POWER, &times)
 }
 
 /// The scene at standstill with the oil properties frozen (the losses a constant source) and
 /// that source per node.
 fn scene(l: Law) -> (Scene, Inputs, [f64; 2]) {
-    let scene = fzg_frozen(&network(l), 40.0);
-    let inputs = steady_inputs(0.0, 0.0);
-    let mut w = scene.work(inputs);
-    let y = scene.initial_state(None);
-    scene.evaluate_losses(&y, &mut w);
-    let mut src = [0.0; 2];
-    for (q, dest) in w.q.iter().zip(&scene.thermal().heat) {
-        for &(node, f) in dest {
-            src[node] += f * q;
-        }
-    }
-    (scene, inputs, src)
-}
-
-/// The exact solution of y' = A y + b (A 2×2 with real distinct eigenvalues).
-struct Linear {
-    a: [[f64; 2]; 2],
-    b: [f64; 2],
-}
-
-impl Linear {
-    fn new(src: [f64; 2], heater: f64) -> Linear {
-        let ta = AMBIENT_C + KELVIN_OFFSET;
-        Linear {
-            a: [[-G1 / C1, G1 / C1], [G1 / C2, -(G1 + G2) / C2]],
-            b: [(src[0] + heater) / C1, (src[1] + G2 * ta) / C2],
-        }
-    }
-
-    fn at(&self, y0: [f64; 2], t: f64) -> [f64; 2] {
-        let [[a, b], [c, d]] = self.a;
-        let det = a * d - b * c;
-        let ys = [
-            -(d * self.b[0] - b * self.b[1]) / det,
-            -(-c * self.b[0] + a * self.b[1]) / det,
-        ];
-        let tr = a + d;
-        let disc = (tr * tr / 4.0 - det).sqrt();
-        let (l1, l2) = (tr / 2.0 + disc, tr / 2.0 - disc);
-        let (e1, e2) = ((l1 * t).exp(), (l2 * t).exp());
-        let m = |i: usize, j: usize| {
-            let id = if i == j { 1.0 } else { 0.0 };
-            (e1 * (self.a[i][j] - l2 * id) - e2 * (self.a[i][j] - l1 * id)) / (l1 - l2)
-        };
-        let z = [y0[0] - ys[0], y0[1] - ys[1]];
-        [
-            ys[0] + m(0, 0) * z[0] + m(0, 1) * z[1],
-            ys[1] + m(1, 0) * z[0] + m(1, 1) * z[1],
-        ]
-    }
-
-    /// First time in (0, horizon] at which the oil reaches `target` from the side it starts
-    /// on (bisection on a bracket found by scanning), if any.
-    fn crossing(&self, y0: [f64; 2], target: f64, horizon: f64) -> Option<f64> {
-        let f = |t: f64| self.at(y0, t)[0] - target;
-        let s0 = f(0.0).signum();
-        let dt = 0.25;
-        let mut lo = 0.0;
-        while lo < horizon {
-            let hi = lo + dt;
-            if f(hi).signum() != s0 {
-                let (mut a, mut b) = (lo, hi);
-                for _ in 0..200 {
-                    let m = 0.5 * (a + b);
-                    if f(m).signum() == s0 {
-                        a = m;
-                    } else {
-                        b = m;
-                    }
-                }
-                return Some(0.5 * (a + b));
-            }
-            lo = hi;
-        }
-        None
-    }
+    frozen_with_source(&network(l))
 }
 
 /// The analytic switching instants (and which ended a minimum time with a switch already due),
@@ -178,11 +71,11 @@ fn analytic(l: Law, src: [f64; 2], t_end: f64, dt: f64) -> Exact {
             if due {
                 (Some(dwell_end), true)
             } else {
-                let c = s.crossing(ye, target, t_end - dwell_end + dt);
+                let c = s.crossing(ye, target, t_end - dwell_end + dt, SCAN);
                 (c.map(|c| dwell_end + c), false)
             }
         } else {
-            (s.crossing(y, target, t_end - t + dt).map(|c| t + c), false)
+            (s.crossing(y, target, t_end - t + dt, SCAN).map(|c| t + c), false)
         };
         while next_row <= t_end + 1e-9 && ts.map_or(true, |ts| next_row <= ts) {
             out.rows.push(s.at(y, next_row - t));
@@ -202,26 +95,6 @@ fn analytic(l: Law, src: [f64; 2], t_end: f64, dt: f64) -> Exact {
         heating = !heating;
     }
     out
-}
-
-fn run(scene: &Scene, segs: &[Segment], method: Method, rtol: f64) -> Trajectory {
-    let o = TransientOptions {
-        method,
-        rtol,
-        atol: rtol,
-        ..TransientOptions::default()
-    };
-    integrate(scene, segs, &o, &mut |_, _| {}).unwrap()
-}
-
-fn uniform(inputs: Inputs, n: usize, dt: f64) -> Vec<Segment> {
-    (0..n)
-        .map(|k| Segment {
-            t0: k as f64 * dt,
-            t1: (k + 1) as f64 * dt,
-            inputs,
-        })
-        .collect()
 }
 
 /// Every method's switching instants and rows against the analytic ones.
@@ -266,20 +139,7 @@ fn check(l: Law, t_end: f64, dt: f64) {
             .zip(&exact.rows)
             .map(|(y, e)| (y[0] - e[0]).abs().max((y[1] - e[1]).abs()))
             .fold(0.0, f64::max);
-        let eb = energy_balance(&scene, &traj);
-        println!(
-            "{method:?}: {} switches, worst switching time {dt_worst:.3e} s, worst temperature \
-             {t_worst:.3e} K, energy balance {:.2e}, steps {}",
-            times.len(),
-            eb.relative,
-            traj.stats.steps
-        );
-        if !(dt_worst < 1e-6 && t_worst < 1e-6) {
-            bad.push(format!(
-                "{method:?}: switching time off by {dt_worst:e} s, temperature by {t_worst:e} K"
-            ));
-        }
-        assert!(eb.relative < 1e-9, "{method:?}: energy balance {:e}", eb.relative);
+        switching_report(&scene, &traj, method, times.len(), (dt_worst, t_worst), &mut bad);
         assert_eq!(traj.switches, vec![exact.switches.len()]);
     }
     assert!(bad.is_empty(), "{bad:?}");

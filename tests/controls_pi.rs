@@ -11,47 +11,29 @@ use geartherm::physics::oil::KELVIN_OFFSET;
 use geartherm::scene::{Inputs, Scene};
 use geartherm::solve::equilibrium::equilibrium;
 use geartherm::solve::steady::SteadyOptions;
-use geartherm::solve::transient::{energy_balance, integrate, Method, Segment, Trajectory, TransientOptions};
+use geartherm::solve::transient::{energy_balance, Method, Segment};
 
 mod common;
+use common::controls::{casing_air, oil_casing, run, uniform, AMBIENT_C, C1, G1, G2};
 use common::{fzg_frozen, steady_inputs};
 
-const C1: f64 = 2000.0;
-const C2: f64 = 5000.0;
-const G1: f64 = 20.0;
-const G2: f64 = 10.0;
 /// The cooler's ε·C_min, W/K, and its coolant, °C.
 const COOLANT_C: f64 = 30.0;
-const AMBIENT_C: f64 = 20.0;
 const SET_C: f64 = 60.0;
 const GAIN: f64 = 0.05;
 const TI: f64 = 200.0;
 
 fn network(gc: f64, min: f64, max: f64) -> String {
-    format!(
-        r#"
-[thermal]
-oil_node = "oil"
-initial_temp_c = {AMBIENT_C:e}
-[[thermal.nodes]]
-name = "oil"
-capacity_j_per_k = {C1:e}
-[[thermal.nodes]]
-name = "casing"
-capacity_j_per_k = {C2:e}
-[[thermal.boundaries]]
-name = "ambient"
-temp_c = {AMBIENT_C:e}
-[[thermal.boundaries]]
+    oil_casing(AMBIENT_C, C1)
+        + &format!(
+            r#"[[thermal.boundaries]]
 name = "coolant"
 temp_c = {COOLANT_C:e}
-[[thermal.links]]
-between = ["oil", "casing"]
-conductance_w_per_k = {G1:e}
-[[thermal.links]]
-between = ["casing", "ambient"]
-conductance_w_per_k = {G2:e}
-[[thermal.coolers]]
+"#
+        )
+        + &casing_air(G2, None)
+        + &format!(
+            r#"[[thermal.coolers]]
 name = "cooler"
 hot = "oil"
 cold = "coolant"
@@ -68,7 +50,7 @@ integral_time_s = {TI:e}
 min_share = {min:e}
 max_share = {max:e}
 "#
-    )
+        )
 }
 
 /// Input torque of the nominal load and of the lighter one, N·m (at 3000 rpm).
@@ -126,26 +108,6 @@ fn oil_at_share(q: f64, gc: f64, u: f64) -> f64 {
     // Oil: q = G1 (T1 − T2) + u gc (T1 − Tk); casing: G1 (T1 − T2) = G2 (T2 − Ta).
     let g12 = G1 * G2 / (G1 + G2);
     (q + g12 * ta + u * gc * tk) / (g12 + u * gc)
-}
-
-fn run(scene: &Scene, segs: &[Segment], method: Method, rtol: f64) -> Trajectory {
-    let o = TransientOptions {
-        method,
-        rtol,
-        atol: rtol,
-        ..TransientOptions::default()
-    };
-    integrate(scene, segs, &o, &mut |_, _| {}).unwrap()
-}
-
-fn uniform(inputs: Inputs, n: usize, dt: f64) -> Vec<Segment> {
-    (0..n)
-        .map(|k| Segment {
-            t0: k as f64 * dt,
-            t1: (k + 1) as f64 * dt,
-            inputs,
-        })
-        .collect()
 }
 
 #[test]

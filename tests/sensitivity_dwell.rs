@@ -7,10 +7,14 @@
 //! sensitivity of that parameter over the trace).
 
 use geartherm::scene::Scene;
-use geartherm::solve::sensitivity::{integrate_sensitivities, Direction, SensitivityOptions};
+use geartherm::solve::sensitivity::{integrate_sensitivities, Direction};
 use geartherm::solve::transient::{integrate, Method, Segment, TransientOptions};
 
 mod common;
+use common::controls::{
+    against_central_differences, casing_air, heater, oil_casing, sensitivity_options as opts, uniform, C1,
+    G2, START_C,
+};
 use common::{fzg_frozen, steady_inputs};
 
 /// on_c, off_c, heater_w, min_on_s.
@@ -18,37 +22,8 @@ const NOMINAL: [f64; 4] = [40.0, 45.0, 1500.0, 30.0];
 const NAMES: [&str; 4] = ["on_c", "off_c", "heater_w", "min_on_s"];
 
 fn network(p: &[f64; 4]) -> String {
-    format!(
-        r#"
-[thermal]
-oil_node = "oil"
-initial_temp_c = 30.0
-[[thermal.nodes]]
-name = "oil"
-capacity_j_per_k = 2000.0
-[[thermal.nodes]]
-name = "casing"
-capacity_j_per_k = 5000.0
-[[thermal.boundaries]]
-name = "ambient"
-temp_c = 20.0
-[[thermal.links]]
-between = ["oil", "casing"]
-conductance_w_per_k = 20.0
-[[thermal.links]]
-between = ["casing", "ambient"]
-conductance_w_per_k = 10.0
-[[thermal.controls]]
-name = "heater"
-kind = "two_point"
-sensor = "oil"
-on_c = {:e}
-off_c = {:e}
-heater_w = {:e}
-min_on_s = {:e}
-"#,
-        p[0], p[1], p[2], p[3]
-    )
+    let dwell = format!("min_on_s = {:e}\n", p[3]);
+    oil_casing(START_C, C1) + &casing_air(G2, None) + &heater(p[0], p[1], p[2], &dwell)
 }
 
 fn scene(p: &[f64; 4]) -> Scene {
@@ -56,23 +31,7 @@ fn scene(p: &[f64; 4]) -> Scene {
 }
 
 fn segments(n: usize, dt: f64) -> Vec<Segment> {
-    let inputs = steady_inputs(0.0, 0.0);
-    (0..n)
-        .map(|k| Segment {
-            t0: k as f64 * dt,
-            t1: (k + 1) as f64 * dt,
-            inputs,
-        })
-        .collect()
-}
-
-fn opts(rtol: f64) -> SensitivityOptions {
-    SensitivityOptions {
-        rtol,
-        atol: rtol,
-        max_steps: 10_000_000,
-        initial: None,
-    }
+    uniform(steady_inputs(0.0, 0.0), n, dt)
 }
 
 /// A parameter's step: 1e-3 K on a temperature, 1e-3 relative otherwise.
@@ -147,21 +106,7 @@ fn sensitivities_across_dwell_ends_match_central_differences() {
             integrate_sensitivities(&scene(&p), &[], &segs, &opts(1e-12)).unwrap()
         };
         let (a, b) = (run(1.0), run(-1.0));
-        let (mut err, mut scale) = (0.0_f64, 0.0_f64);
-        for r in 0..tangent.times.len() {
-            for i in 0..2 {
-                let cd = (a.temps[r][i] - b.temps[r][i]) / (2.0 * h);
-                let s = tangent.sens_at(r, i, k, np);
-                err = err.max((s - cd).abs());
-                scale = scale.max(s.abs());
-            }
-        }
-        let rel = err / scale;
-        println!(
-            "{}: max |S| {scale:.4e} K per unit, relative error {rel:.2e}",
-            NAMES[k]
-        );
-        assert!(scale > 0.0, "{}: no sensitivity", NAMES[k]);
+        let rel = against_central_differences(&tangent, (&a, &b), h, (k, np), NAMES[k]);
         if std::env::var("CD_H").is_err() {
             assert!(rel <= 1e-5, "{}: relative error {rel:.3e} > 1e-5", NAMES[k]);
         }

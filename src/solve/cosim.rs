@@ -176,8 +176,10 @@ impl Stepper {
     /// `t_max`, and the state at `t1` comes from the cubic Hermite interpolant of the step
     /// containing it, from the states and derivatives f at both ends (the Hermite basis and its
     /// mapping to a step [ta, tb], slopes scaled by h, as read in the notes "Cubic Hermite
-    /// Splines" of github.com/uw-ipd/tmol; Hairer, Nørsett & Wanner, Solving ODEs I, §II.6,
-    /// and Shampine 1985, "Interpolation for Runge–Kutta methods", could not be read here);
+    /// Splines" of github.com/uw-ipd/tmol; the same cubic as SUNDIALS ARKODE's Hermite dense
+    /// output, `arkInterpEvaluate_Hermite` in `arkode_interp.c`, docs/fmu.md; Hairer, Nørsett &
+    /// Wanner, Solving ODEs I, §II.6, and Shampine 1985, "Interpolation for Runge–Kutta
+    /// methods", could not be read here);
     /// `hermite_is_exact_on_cubics` checks the formula. No continuous extension of ROS3's
     /// own is used (none was read with its coefficients, [`super::rosenbrock`]; a continuous
     /// extension would need its stages). The interpolant's error is O(h⁴), below the step's
@@ -291,9 +293,16 @@ impl Stepper {
 
     /// The losses (W per item) at the current state with the inputs in force.
     pub fn losses(&self, scene: &Scene) -> Vec<f64> {
+        let mut q = vec![0.0; scene.items()];
+        self.losses_into(scene, &mut q);
+        q
+    }
+
+    /// [`Stepper::losses`] into `q` (one per item).
+    pub fn losses_into(&self, scene: &Scene, q: &mut [f64]) {
         let mut w = self.work.borrow_mut();
         scene.evaluate_losses(&self.y_out, &mut w);
-        w.q.clone()
+        q.copy_from_slice(&w.q);
     }
 
     /// Counters so far.

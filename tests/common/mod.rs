@@ -2,6 +2,8 @@
 //! input segments.
 #![allow(dead_code)]
 
+pub mod controls;
+
 use geartherm::model;
 use geartherm::physics::units::c_to_k;
 use geartherm::scene::{Inputs, Needs, Scene};

@@ -26,7 +26,7 @@ use crate::job::limits::{self, Limit};
 use crate::job::run::DEFAULT_MAX_STEPS;
 use crate::job::{JobError, Model};
 use crate::physics::efficiency::efficiency;
-use crate::scene::{sum_by_source, Inputs, Scene};
+use crate::scene::{Inputs, LossItem, Scene, N_SOURCES};
 use crate::solve::cosim::Stepper;
 use crate::solve::transient::{Method, TransientOptions};
 
@@ -58,7 +58,65 @@ pub struct Instance {
     rtol_set: bool,
     start_time: f64,
     run: Option<Run>,
-    outputs_fresh: bool,
+    /// Where the inputs are in `values`.
+    slots: Slots,
+    /// The boundary inputs of the coming step (a buffer of [`Instance::do_step`]).
+    lines: Vec<(f64, f64)>,
+    /// Whether the outputs of each [`Part`] are those of the current state and inputs.
+    fresh: [bool; 3],
+}
+
+/// Positions in `values` of the inputs read at every step, found once per instance.
+#[derive(Debug, Clone, Default)]
+struct Slots {
+    input_speed: Option<usize>,
+    input_torque: Option<usize>,
+    vehicle_speed: Option<usize>,
+    gear: Option<usize>,
+    /// Every boundary input, in the order of the variables.
+    boundaries: Vec<usize>,
+}
+
+impl Slots {
+    fn of(vars: &[Variable]) -> Slots {
+        let at = |role: Role| vars.iter().position(|v| v.role == role);
+        Slots {
+            input_speed: at(Role::InputSpeed),
+            input_torque: at(Role::InputTorque),
+            vehicle_speed: at(Role::VehicleSpeed),
+            gear: at(Role::Gear),
+            boundaries: (vars.iter().enumerate())
+                .filter(|(_, v)| matches!(v.role, Role::Boundary(_)))
+                .map(|(k, _)| k)
+                .collect(),
+        }
+    }
+}
+
+/// The outputs in three parts computed apart, each when one of its variables is read: what the
+/// state and the inputs give directly (temperatures, energies, speeds), the oil's viscosity, and
+/// what needs the loss items evaluated (loss powers, efficiency, input torque with losses).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Part {
+    State = 0,
+    Oil = 1,
+    Losses = 2,
+}
+
+/// The part of the outputs a variable of role `role` belongs to (None: not an output).
+fn part_of(role: Role) -> Option<Part> {
+    match role {
+        Role::NodeTemp(_)
+        | Role::SourceEnergy(_)
+        | Role::TotalEnergy
+        | Role::OutputSpeed
+        | Role::OutputTorque => Some(Part::State),
+        Role::OilViscosity => Some(Part::Oil),
+        Role::SourceLoss(_) | Role::TotalLoss | Role::Efficiency | Role::InputTorqueWithLosses => {
+            Some(Part::Losses)
+        }
+        _ => None,
+    }
 }
 
 /// A started instance: the model with its parameters, its scene, the stepper, the envelope its
@@ -73,6 +131,16 @@ struct Run {
     applied: Vec<(f64, f64)>,
     /// The scene's boundary lines start at `.0` and end at `.1`, s.
     line_span: (f64, f64),
+    /// The loss items of each source, in item order (for the sums per source, in the order
+    /// `sum_by_source` and `Scene::loss_energy_by_source` add them).
+    source_items: [Vec<usize>; N_SOURCES],
+    /// Whether each loss item is paid ahead of the input shaft (`LossItem::engine_side`).
+    item_engine_side: Vec<bool>,
+    /// Loss per item at the current state (W), a buffer of the outputs.
+    q: Vec<f64>,
+    /// The inputs the stepper integrates with since its last restart (the outputs may have
+    /// switched its work area to inputs set after the last step).
+    step_inputs: Inputs,
 }
 
 /// A boundary line is applied to the scene over this span beyond its communication point (or
@@ -86,6 +154,14 @@ const LINE_SPAN: f64 = 10.0;
 const LINE_TOL: f64 = 1e-10;
 
 impl Run {
+    /// The loss items' sources and sides, packed from the scene, and the loss buffer.
+    fn pack_items(&mut self) {
+        let items = &self.scene.losses().items;
+        self.source_items = source_items(items);
+        self.item_engine_side = items.iter().map(|it| it.engine_side).collect();
+        self.q = vec![0.0; items.len()];
+    }
+
     /// Whether the inputs `lines` at `now` continue the boundary lines applied, up to `t1`.
     fn lines_continue(&self, now: f64, t1: f64, lines: &[(f64, f64)]) -> bool {
         let (t0, t_end) = self.line_span;
@@ -146,7 +222,6 @@ impl Instance {
         let values = fm.vars.iter().map(|v| v.start.unwrap_or(0.0)).collect();
         let n = fm.vars.len();
         Instance {
-            fm,
             phase: Phase::Instantiated,
             values,
             deriv: vec![0.0; n],
@@ -154,7 +229,10 @@ impl Instance {
             rtol_set: false,
             start_time: 0.0,
             run: None,
-            outputs_fresh: false,
+            slots: Slots::of(&fm.vars),
+            lines: Vec::new(),
+            fresh: [false; 3],
+            fm,
         }
     }
 
@@ -213,7 +291,7 @@ impl Instance {
         match self.start() {
             Ok(run) => {
                 self.run = Some(run);
-                self.outputs_fresh = false;
+                self.fresh = [false; 3];
                 self.phase = Phase::Step;
                 Ok(())
             }
@@ -230,11 +308,13 @@ impl Instance {
     }
 
     fn inputs(&self) -> Inputs {
+        let at = |k: Option<usize>| k.map_or(f64::NAN, |k| self.values[k]);
+        let s = &self.slots;
         Inputs {
-            state: self.value_of(Role::Gear) as usize,
-            input_speed: self.value_of(Role::InputSpeed),
-            input_torque: self.value_of(Role::InputTorque),
-            vehicle_speed: self.value_of(Role::VehicleSpeed),
+            state: at(s.gear) as usize,
+            input_speed: at(s.input_speed),
+            input_torque: at(s.input_torque),
+            vehicle_speed: at(s.vehicle_speed),
         }
     }
 
@@ -281,7 +361,12 @@ impl Instance {
             ..TransientOptions::default()
         };
         let stepper = Stepper::new(&scene, y0, self.inputs(), opts.clone(), self.start_time)?;
+        let items = &scene.losses().items;
         Ok(Run {
+            source_items: source_items(items),
+            item_engine_side: items.iter().map(|it| it.engine_side).collect(),
+            q: vec![0.0; items.len()],
+            step_inputs: self.inputs(),
             opts,
             envelope: Envelope::of(&scene),
             applied: self.boundary_inputs(),
@@ -294,13 +379,16 @@ impl Instance {
 
     /// (value, derivative) of every boundary input.
     fn boundary_inputs(&self) -> Vec<(f64, f64)> {
-        self.fm
-            .vars
-            .iter()
-            .enumerate()
-            .filter(|(_, v)| matches!(v.role, Role::Boundary(_)))
-            .map(|(k, _)| (self.values[k], self.deriv[k]))
-            .collect()
+        let mut lines = Vec::new();
+        self.boundary_inputs_into(&mut lines);
+        lines
+    }
+
+    /// [`Instance::boundary_inputs`] into `lines`.
+    fn boundary_inputs_into(&self, lines: &mut Vec<(f64, f64)>) {
+        lines.clear();
+        let at = |&k: &usize| (self.values[k], self.deriv[k]);
+        lines.extend(self.slots.boundaries.iter().map(at));
     }
 
     /// Check a value set for `v`.
@@ -333,8 +421,8 @@ impl Instance {
     /// `fmi2SetReal` / `fmi2SetInteger` of one variable. A bad value is an error (the
     /// instance then needs a reset).
     pub fn set(&mut self, vr: u32, x: f64) -> Result<(), Message> {
-        let fm = Arc::clone(&self.fm);
-        let v = var_of(&fm, vr)?;
+        let v = var_of(&self.fm, vr)?;
+        let role = v.role;
         let settable = match v.causality {
             Causality::Input => self.phase != Phase::Terminated && self.phase != Phase::Error,
             Causality::Parameter => {
@@ -346,16 +434,16 @@ impl Instance {
         if !settable {
             return Err(format!("{} cannot be set now ({:?})", v.name, self.phase));
         }
-        let time = self.run.as_ref().map_or(self.start_time, |r| r.stepper.time());
         if let Err(m) = self.check_value(v, x) {
-            return self.fail(format!("t = {time} s: {m}"));
+            return self.fail(format!("t = {} s: {m}", self.time()));
         }
-        if v.role == Role::Rtol {
+        if role == Role::Rtol {
             self.rtol_set = true;
         }
         let old = std::mem::replace(&mut self.values[vr as usize - 1], x);
-        self.outputs_fresh = false;
-        if self.phase == Phase::Step && matches!(v.role, Role::Param(_)) && old != x {
+        self.fresh = [false; 3];
+        if self.phase == Phase::Step && matches!(role, Role::Param(_)) && old != x {
+            let time = self.time();
             if let Err(m) = self.retune() {
                 return self.fail(format!("t = {time} s: {m}"));
             }
@@ -378,19 +466,19 @@ impl Instance {
         apply_lines(&self.fm, &run.applied, &mut scene, t0, t_end - t0);
         let now = run.stepper.time();
         let y = run.stepper.state().to_vec();
-        let inputs = run.stepper.inputs();
+        let inputs = run.step_inputs;
         run.stepper = Stepper::new(&scene, y, inputs, run.opts.clone(), now)?;
         run.envelope = Envelope::of(&scene);
         run.model = model;
         run.scene = scene;
+        run.pack_items();
         Ok(())
     }
 
     /// `fmi2SetRealInputDerivatives` of one variable (order 1; boundaries follow it, the other
     /// inputs are held and ignore it).
     pub fn set_derivative(&mut self, vr: u32, order: i32, d: f64) -> Result<(), Message> {
-        let fm = Arc::clone(&self.fm);
-        let v = var_of(&fm, vr)?;
+        let v = var_of(&self.fm, vr)?;
         if v.causality != Causality::Input || v.integer {
             return Err(format!("{}: derivatives only of real inputs", v.name));
         }
@@ -410,7 +498,8 @@ impl Instance {
             return Err(format!("doStep is allowed only in step mode ({:?})", self.phase));
         }
         let inputs = self.inputs();
-        let lines = self.boundary_inputs();
+        let mut lines = std::mem::take(&mut self.lines);
+        self.boundary_inputs_into(&mut lines);
         let Some(run) = self.run.as_mut() else {
             return Err("no run".into());
         };
@@ -423,7 +512,7 @@ impl Instance {
         let t1 = now + h;
         // Unchanged inputs: the stepper may go on with a step it took past `now`; else it restarts
         // from its state at `now` with the new inputs.
-        if run.stepper.inputs() != inputs || !run.lines_continue(now, t1, &lines) {
+        if run.step_inputs != inputs || !run.lines_continue(now, t1, &lines) {
             run.stepper.restart();
             // Boundaries held at their last values need no new line (nor a fresh work area).
             let span = h.max(LINE_SPAN);
@@ -431,14 +520,16 @@ impl Instance {
                 apply_lines(&self.fm, &lines, &mut run.scene, now, span);
                 run.stepper.refresh(&run.scene);
             }
-            run.applied = lines;
+            run.applied.clone_from(&lines);
             run.line_span = (now, now + span);
-            run.stepper.set_inputs(&run.scene, inputs);
+            run.step_inputs = inputs;
         }
+        run.stepper.set_inputs(&run.scene, inputs);
+        self.lines = lines;
         let r = run.stepper.step_ahead(&run.scene, t1, run.line_span.1);
         let breach = run.envelope.check(&run.stepper.state()[..run.scene.nodes()]);
         self.deriv.iter_mut().for_each(|d| *d = 0.0);
-        self.outputs_fresh = false;
+        self.fresh = [false; 3];
         match (r, breach) {
             (Err(e), _) => self.fail(e.to_string()),
             (Ok(()), Err(b)) => self.fail(format!(
@@ -450,10 +541,9 @@ impl Instance {
 
     /// `fmi2GetReal` / `fmi2GetInteger` of one variable.
     pub fn get(&mut self, vr: u32) -> Result<f64, Message> {
-        let fm = Arc::clone(&self.fm);
-        let v = var_of(&fm, vr)?;
-        if v.causality == Causality::Output && !self.outputs_fresh {
-            self.compute_outputs()?;
+        let v = var_of(&self.fm, vr)?;
+        if let Some(part) = part_of(v.role).filter(|&p| !self.fresh[p as usize]) {
+            self.compute_outputs(part)?;
         }
         Ok(self.values[vr as usize - 1])
     }
@@ -463,8 +553,8 @@ impl Instance {
         self.run.as_ref().map_or(self.start_time, |r| r.stepper.time())
     }
 
-    /// Every output from the state at the current time with the inputs in force.
-    fn compute_outputs(&mut self) -> Result<(), Message> {
+    /// The outputs of `part` from the state at the current time with the inputs in force.
+    fn compute_outputs(&mut self, part: Part) -> Result<(), Message> {
         if self.run.is_none() {
             if self.phase != Phase::Initialization {
                 return Err("outputs are available from initialization mode on".into());
@@ -472,57 +562,22 @@ impl Instance {
             self.run = Some(self.start()?);
         }
         let inputs = self.inputs();
-        let Some(Run {
-            model,
-            scene,
-            stepper,
-            ..
-        }) = self.run.as_mut()
-        else {
+        let Some(run) = self.run.as_mut() else {
             return Err("no run".into());
         };
-        stepper.set_inputs(scene, inputs);
-        let q = stepper.losses(scene);
-        let y = stepper.state();
-        let by = sum_by_source(&scene.losses().items, &q);
-        let total: f64 = q.iter().sum();
-        // The losses supplied through the input shaft: not the converter's slip or an
-        // engine-driven pump, paid ahead of it (as `timeseries.csv`'s input torque).
-        let shaft: f64 = scene
-            .losses()
-            .items
-            .iter()
-            .zip(&q)
-            .filter(|(it, _)| !it.engine_side)
-            .map(|(_, p)| p)
-            .sum();
-        let energy = scene.loss_energy_by_source(y);
-        let (w, torque) = (inputs.input_speed, inputs.input_torque);
-        let ratio = model.gearbox.gear_states[inputs.state].ratio();
-        let nu = model.gearbox.oil.nu(scene.oil_temp(y));
-        let nodes = y[..scene.nodes()].to_vec();
-        for (k, v) in self.fm.vars.iter().enumerate() {
-            let x = match v.role {
-                Role::NodeTemp(i) => nodes[i],
-                Role::SourceLoss(s) => by[s.index()],
-                Role::TotalLoss => total,
-                Role::SourceEnergy(s) => energy[s.index()],
-                Role::TotalEnergy => energy.iter().sum(),
-                Role::Efficiency => efficiency(torque * w, total).unwrap_or(0.0),
-                Role::OutputSpeed => w / ratio,
-                Role::OutputTorque => torque * ratio,
-                Role::InputTorqueWithLosses => torque + if w > 0.0 { shaft / w } else { 0.0 },
-                Role::OilViscosity => nu,
-                _ => continue,
-            };
-            if !x.is_finite() {
-                let t = stepper.time();
-                self.phase = Phase::Error;
-                return Err(format!("t = {t} s: output {} is not finite", v.name));
-            }
-            self.values[k] = x;
+        let fm = &self.fm;
+        let values = &mut self.values;
+        let bad = match part {
+            Part::State => state_outputs(fm, run, inputs, values),
+            Part::Oil => oil_outputs(fm, run, values),
+            Part::Losses => loss_outputs(fm, run, inputs, values),
+        };
+        if let Some(k) = bad {
+            let t = run.stepper.time();
+            self.phase = Phase::Error;
+            return Err(format!("t = {t} s: output {} is not finite", fm.vars[k].name));
         }
-        self.outputs_fresh = true;
+        self.fresh[part as usize] = true;
         Ok(())
     }
 
@@ -530,6 +585,99 @@ impl Instance {
     pub fn terminate(&mut self) {
         self.phase = Phase::Terminated;
     }
+}
+
+/// The outputs of [`Part::State`] into `values` from the stepper's state; the position of the
+/// first that is not finite, if any.
+fn state_outputs(fm: &FmuModel, run: &Run, inputs: Inputs, values: &mut [f64]) -> Option<usize> {
+    let (scene, y) = (&run.scene, run.stepper.state());
+    // Loss energy per source, J: the sums of `Scene::loss_energy_by_source` in the same order.
+    let n = scene.nodes();
+    let mut energy = [0.0; N_SOURCES];
+    if scene.has_item_energies() {
+        for (e, items) in energy.iter_mut().zip(&run.source_items) {
+            *e = items.iter().fold(0.0, |sum, &k| sum + y[n + k]);
+        }
+    } else {
+        energy.copy_from_slice(&y[n..n + N_SOURCES]);
+    }
+    let w = inputs.input_speed;
+    let torque = inputs.input_torque;
+    let ratio = run.model.gearbox.gear_states[inputs.state].ratio();
+    for (k, v) in fm.vars.iter().enumerate() {
+        let x = match v.role {
+            Role::NodeTemp(i) => y[i],
+            Role::SourceEnergy(s) => energy[s.index()],
+            Role::TotalEnergy => energy.iter().sum(),
+            Role::OutputSpeed => w / ratio,
+            Role::OutputTorque => torque * ratio,
+            _ => continue,
+        };
+        if !x.is_finite() {
+            return Some(k);
+        }
+        values[k] = x;
+    }
+    None
+}
+
+/// The output of [`Part::Oil`] (the viscosity at the oil temperature of the stepper's state)
+/// into `values`; its position if it is not finite.
+fn oil_outputs(fm: &FmuModel, run: &Run, values: &mut [f64]) -> Option<usize> {
+    let nu = run.model.gearbox.oil.nu(run.scene.oil_temp(run.stepper.state()));
+    for (k, v) in fm.vars.iter().enumerate() {
+        if v.role == Role::OilViscosity {
+            if !nu.is_finite() {
+                return Some(k);
+            }
+            values[k] = nu;
+        }
+    }
+    None
+}
+
+/// The loss items of each source, in item order.
+fn source_items(items: &[LossItem]) -> [Vec<usize>; N_SOURCES] {
+    let mut by: [Vec<usize>; N_SOURCES] = Default::default();
+    for (k, it) in items.iter().enumerate() {
+        by[it.source.index()].push(k);
+    }
+    by
+}
+
+/// The outputs of [`Part::Losses`] into `values`: the loss items evaluated at the stepper's
+/// state with the inputs in force; the position of the first that is not finite, if any.
+fn loss_outputs(fm: &FmuModel, run: &mut Run, inputs: Inputs, values: &mut [f64]) -> Option<usize> {
+    run.stepper.set_inputs(&run.scene, inputs);
+    run.stepper.losses_into(&run.scene, &mut run.q);
+    let q = &run.q;
+    // Per source and total as `sum_by_source` and `geartherm run` sum them (item order).
+    let mut by = [0.0; N_SOURCES];
+    for (b, items) in by.iter_mut().zip(&run.source_items) {
+        *b = items.iter().fold(0.0, |sum, &k| sum + q[k]);
+    }
+    let total: f64 = q.iter().sum();
+    // The losses supplied through the input shaft: not the converter's slip or an
+    // engine-driven pump, paid ahead of it (as `timeseries.csv`'s input torque).
+    let shaft: f64 = (run.item_engine_side.iter().zip(q))
+        .filter(|(&engine_side, _)| !engine_side)
+        .map(|(_, p)| p)
+        .sum();
+    let (w, torque) = (inputs.input_speed, inputs.input_torque);
+    for (k, v) in fm.vars.iter().enumerate() {
+        let x = match v.role {
+            Role::SourceLoss(s) => by[s.index()],
+            Role::TotalLoss => total,
+            Role::Efficiency => efficiency(torque * w, total).unwrap_or(0.0),
+            Role::InputTorqueWithLosses => torque + if w > 0.0 { shaft / w } else { 0.0 },
+            _ => continue,
+        };
+        if !x.is_finite() {
+            return Some(k);
+        }
+        values[k] = x;
+    }
+    None
 }
 
 /// A limit in rpm as one in rad/s.
