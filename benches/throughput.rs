@@ -2,7 +2,10 @@
 //! solved per second by the study runner that `geartherm study` and Python's local backend call
 //! (`study::runner::run`, nothing written), on every rayon thread, and one case on one thread
 //! split into its parts: the model with the sample's overrides (parse + checks), the scene
-//! compile, and the summary-only integration.
+//! compile, and the summary-only integration with and without the range checks over its output
+//! rows (a study's table row keeps no warnings). Last, one whole sample of the AT6 WLTC
+//! uncertainty study (`models/studies/at6_wltc_uq.toml`: overrides, checks, compile, run, band
+//! series), as `geartherm uq` solves it.
 //!
 //! Run: `cargo bench --bench throughput`. Figures are recorded in docs/performance.md.
 
@@ -12,6 +15,7 @@ use std::sync::atomic::AtomicBool;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use geartherm::job::{self, RunOptions};
+use geartherm::study::uq::run::{Uq, UqOptions};
 use geartherm::study::{runner, Selection, Study};
 
 fn benches(c: &mut Criterion) {
@@ -45,6 +49,24 @@ fn benches(c: &mut Criterion) {
     });
     c.bench_function("study/case/run_summary_only", |b| {
         b.iter(|| job::run::run(black_box(&m), &o, &mut |_, _| {}).expect("run"))
+    });
+    let mut p = job::run::prepare(&m, &o).expect("prepare");
+    for warnings in [true, false] {
+        p.range_warnings = warnings;
+        let name = if warnings { "with" } else { "without" };
+        c.bench_function(&format!("study/case/solve_{name}_range_warnings"), |b| {
+            b.iter(|| job::run::solve(black_box(&m), &p, &mut |_, _| {}).expect("run"))
+        });
+    }
+
+    let uq = Uq::from_file(
+        &root.join("models/studies/at6_wltc_uq.toml"),
+        UqOptions::default(),
+    )
+    .expect("bundled uq study");
+    let case = uq.study.cases()[0];
+    c.bench_function("uq/case/at6_wltc_with_bands", |b| {
+        b.iter(|| uq.study.run_case(black_box(&case), false))
     });
 }
 

@@ -1,6 +1,8 @@
 //! Bundled drive cycles (`models/cycles/*.csv`, compiled into the binary; provenance in
 //! `models/cycles/SOURCES.md`) and name resolution.
 
+use std::sync::OnceLock;
+
 use super::error::{CycleError, CycleErrorKind};
 use super::parse::DriveCycle;
 
@@ -63,30 +65,38 @@ pub fn bundled_names() -> &'static [&'static str] {
 }
 
 /// Map a name (canonical, alias, or file stem such as `wltc_class3b`; case-insensitive; a
-/// trailing `.csv` is ignored) to the bundled entry.
-fn lookup(name: &str) -> Option<&'static (&'static str, &'static str, &'static str)> {
+/// trailing `.csv` is ignored) to the bundled entry's index in [`BUNDLED`].
+fn lookup(name: &str) -> Option<usize> {
     let n = name.trim().to_ascii_lowercase();
     let n = n.strip_suffix(".csv").unwrap_or(&n);
     let n = ALIASES.iter().find(|(a, _)| *a == n).map_or(n, |(_, c)| *c);
     BUNDLED
         .iter()
-        .find(|(canon, file, _)| *canon == n || file.strip_suffix(".csv") == Some(n))
+        .position(|(canon, file, _)| *canon == n || file.strip_suffix(".csv") == Some(n))
 }
 
 impl DriveCycle {
     /// A bundled cycle by name. Accepted: [`bundled_names`], the alias `artemis_motorway`
     /// (= `artemis_motorway130`), and the file stems (`wltc_class3b`, `ftp75_no_soak`).
     pub fn bundled(name: &str) -> Result<DriveCycle, CycleError> {
-        let (canon, file, text) = lookup(name).ok_or_else(|| {
+        let k = lookup(name).ok_or_else(|| {
             CycleError::new(
                 CycleErrorKind::UnknownName,
                 name,
                 format!("not a bundled cycle; bundled: {}", NAMES.join(", ")),
             )
         })?;
-        let mut c = DriveCycle::parse(text, &format!("bundled:{canon} (models/cycles/{file})"))?;
-        c.name = canon.to_string();
-        Ok(c)
+        // Each bundled cycle is parsed once per process (a study runs one cycle many times).
+        static PARSED: [OnceLock<Result<DriveCycle, CycleError>>; BUNDLED.len()] =
+            [const { OnceLock::new() }; BUNDLED.len()];
+        PARSED[k]
+            .get_or_init(|| {
+                let (canon, file, text) = BUNDLED[k];
+                let mut c = DriveCycle::parse(text, &format!("bundled:{canon} (models/cycles/{file})"))?;
+                c.name = canon.to_string();
+                Ok(c)
+            })
+            .clone()
     }
 
     /// A bundled cycle if `arg` names one, else the file at path `arg`.

@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::cycle::{DriveCycle, Schedule};
 use crate::physics::units::c_to_k;
-use crate::report::run::{check_finite, summary, timeseries_csv, Summary};
+use crate::report::run::{check_finite, run_warnings, summary, timeseries_csv, Summary};
 use crate::scene::{Needs, Scene, SpreadScene};
 use crate::solve::drive::{row_inputs, segments};
 use crate::solve::transient::{
@@ -134,6 +134,10 @@ pub struct Prepared {
     pub opts: TransientOptions,
     /// The model-form alternatives (with `spread`).
     pub spread: Option<SpreadScene>,
+    /// Check the loss models' ranges at every output row into the summary's `warnings` (true
+    /// from [`prepare`]; a caller that keeps no warnings, such as a study's table row, sets it
+    /// false and saves those evaluations).
+    pub range_warnings: bool,
 }
 
 /// Check the options, read and schedule the cycle, compile the scene for it: everything that
@@ -179,6 +183,7 @@ pub fn prepare(m: &Model, o: &RunOptions) -> Result<Prepared, JobError> {
         segs,
         opts,
         spread,
+        range_warnings: true,
     })
 }
 
@@ -243,6 +248,9 @@ fn finish(m: &Model, p: &Prepared, traj: &Trajectory) -> Result<RunResult, JobEr
         p.opts.rtol,
         p.opts.atol,
     );
+    if p.range_warnings {
+        sum.warnings = run_warnings(&p.scene, traj, &rows);
+    }
     let numerical = |what: String| JobError::numerical(format!("{}: {what}", m.label()));
     check_finite(&p.scene, traj, &rows, &sum).map_err(numerical)?;
     if let Some(s) = &p.spread {

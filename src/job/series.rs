@@ -8,7 +8,7 @@ use crate::physics::units::k_to_c;
 use crate::scene::{Scene, Source};
 use crate::solve::transient::Trajectory;
 
-use super::run::{prepare, solve_keeping, RunOptions, RunResult};
+use super::run::{prepare, solve_keeping, Prepared, RunOptions, RunResult};
 use super::{JobError, Model};
 
 /// Fewest and most grid points of a series.
@@ -52,21 +52,32 @@ pub fn sample(scene: &Scene, traj: &Trajectory, times: &[f64]) -> Vec<Vec<f64>> 
     let nodes = scene.nodes();
     let width = nodes + Source::ALL.len();
     let mut out = vec![Vec::with_capacity(times.len()); width];
-    let row = |k: usize| {
+    // The values of output row k (temperatures °C, energies J), kept while the grid stays there.
+    let fill = |k: usize, v: &mut Vec<f64>| {
         let y = &traj.states[k];
         let e = scene.loss_energy_by_source(y);
-        let mut v: Vec<f64> = y[..nodes].iter().map(|&t| k_to_c(t)).collect();
+        v.clear();
+        v.extend(y[..nodes].iter().map(|&t| k_to_c(t)));
         v.extend(Source::ALL.iter().map(|s| e[s.index()]));
-        v
     };
+    let (mut a, mut b) = (Vec::with_capacity(width), Vec::with_capacity(width));
+    let (mut ka, mut kb) = (usize::MAX, usize::MAX);
     let last = traj.times.len().saturating_sub(1);
     let mut k = 0;
     for &t in times {
         while k + 1 < last && traj.times[k + 1] < t {
             k += 1;
         }
-        let (a, b) = (row(k), row((k + 1).min(last)));
-        let (ta, tb) = (traj.times[k], traj.times[(k + 1).min(last)]);
+        let k1 = (k + 1).min(last);
+        if ka != k {
+            fill(k, &mut a);
+            ka = k;
+        }
+        if kb != k1 {
+            fill(k1, &mut b);
+            kb = k1;
+        }
+        let (ta, tb) = (traj.times[k], traj.times[k1]);
         let w = if tb > ta {
             ((t - ta) / (tb - ta)).clamp(0.0, 1.0)
         } else {
@@ -92,8 +103,13 @@ pub fn run_with_series(m: &Model, o: &RunOptions, points: usize) -> Result<(RunR
             ),
         ));
     }
-    let p = prepare(m, o)?;
-    let (r, traj) = solve_keeping(m, &p, &mut |_, _| {})?;
+    solve_with_series(m, &prepare(m, o)?, points)
+}
+
+/// Integrate a prepared run ([`super::run::solve`]) and sample its series on `points` grid times
+/// (checked by the caller: [`run_with_series`], or an uncertainty study's options).
+pub fn solve_with_series(m: &Model, p: &Prepared, points: usize) -> Result<(RunResult, RunSeries), JobError> {
+    let (r, traj) = solve_keeping(m, p, &mut |_, _| {})?;
     let t0 = p.segs.first().map_or(0.0, |s| s.t0);
     let t1 = p.segs.last().map_or(0.0, |s| s.t1);
     let times_s = grid(t0, t1, points);

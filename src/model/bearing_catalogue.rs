@@ -124,12 +124,17 @@ struct CatalogueFile {
     bearing: Vec<CatalogueBearing>,
 }
 
-/// All catalogue series and bearings (a parse failure is a build defect caught by a unit test;
-/// reported as an empty catalogue).
-pub fn catalogue() -> (Vec<SeriesEntry>, Vec<CatalogueBearing>) {
-    toml::from_str::<CatalogueFile>(BEARINGS_TOML)
-        .map(|c| (c.series, c.bearing))
-        .unwrap_or_default()
+/// All catalogue series and bearings, parsed once per process (a parse failure is a build defect
+/// caught by a unit test; reported as an empty catalogue).
+pub fn catalogue() -> (&'static [SeriesEntry], &'static [CatalogueBearing]) {
+    static PARSED: std::sync::OnceLock<(Vec<SeriesEntry>, Vec<CatalogueBearing>)> =
+        std::sync::OnceLock::new();
+    let (s, b) = PARSED.get_or_init(|| {
+        toml::from_str::<CatalogueFile>(BEARINGS_TOML)
+            .map(|c| (c.series, c.bearing))
+            .unwrap_or_default()
+    });
+    (s, b)
 }
 
 #[cfg(test)]

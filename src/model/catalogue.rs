@@ -58,27 +58,38 @@ struct CatalogueFile {
     oil: Vec<CatalogueOil>,
 }
 
-/// All catalogue oils. The embedded file is checked by a unit test, so a parse failure here is a
-/// build defect, reported as an empty catalogue rather than a panic.
+/// All catalogue oils.
 pub fn oils() -> Vec<CatalogueOil> {
-    toml::from_str::<CatalogueFile>(OILS_TOML)
-        .map(|c| c.oil)
-        .unwrap_or_default()
+    parsed().to_vec()
+}
+
+/// The catalogue, parsed once per process. The embedded file is checked by a unit test, so a
+/// parse failure here is a build defect, reported as an empty catalogue rather than a panic.
+fn parsed() -> &'static [CatalogueOil] {
+    static OILS: std::sync::OnceLock<Vec<CatalogueOil>> = std::sync::OnceLock::new();
+    OILS.get_or_init(|| {
+        toml::from_str::<CatalogueFile>(OILS_TOML)
+            .map(|c| c.oil)
+            .unwrap_or_default()
+    })
 }
 
 /// Find an oil by key, alias or name (case-insensitive; a name prefix up to its first parenthesis,
 /// e.g. "FVA 3A reference oil", also matches).
 pub fn find(name: &str) -> Option<CatalogueOil> {
     let want = name.trim().to_lowercase();
-    oils().into_iter().find(|o| {
-        o.key.to_lowercase() == want
-            || o.aliases.iter().any(|a| a.to_lowercase() == want)
-            || o.name.to_lowercase() == want
-            || o.name
-                .split('(')
-                .next()
-                .is_some_and(|short| short.trim().to_lowercase() == want)
-    })
+    parsed()
+        .iter()
+        .find(|o| {
+            o.key.to_lowercase() == want
+                || o.aliases.iter().any(|a| a.to_lowercase() == want)
+                || o.name.to_lowercase() == want
+                || o.name
+                    .split('(')
+                    .next()
+                    .is_some_and(|short| short.trim().to_lowercase() == want)
+        })
+        .cloned()
 }
 
 #[cfg(test)]

@@ -247,7 +247,8 @@ pub fn run_warnings(scene: &Scene, traj: &Trajectory, rows: &[RowInputs]) -> Vec
     log.warnings(scene.losses())
 }
 
-/// Build the summary of a run.
+/// Build the summary of a run, its `warnings` empty (the caller adds [`run_warnings`] when it
+/// keeps them).
 #[allow(clippy::too_many_arguments)]
 pub fn summary(
     scene: &Scene,
@@ -354,7 +355,7 @@ pub fn summary(
         oil_node: scene.thermal().names[scene.thermal().oil].clone(),
         skipped: scene.skipped().to_vec(),
         frozen_viscosity: scene.frozen_oil_temp().is_some(),
-        warnings: run_warnings(scene, traj, rows),
+        warnings: Vec::new(),
         launch: launch_summary(&traj.times, rows),
         controls: control_summaries(scene, traj),
         spread: None,

@@ -74,6 +74,8 @@ pub struct Study {
     pub model_file: PathBuf,
     base: toml::Table,
     paths: Vec<KeyPath>,
+    /// The base model's value at each parameter's path (None: not in the model).
+    base_values: Vec<Option<Value>>,
     /// One value per parameter per sample.
     pub samples: Vec<Vec<ParamValue>>,
     /// The jobs every sample is solved on.
@@ -218,6 +220,7 @@ impl Study {
         checks::check_distinct_cycles(&jobs).map_err(invalid)?;
         let outputs = columns::output_columns(&jobs, &base_model)?;
         checks::check_outputs(&spec.outputs, &outputs)?;
+        let base_values = paths.iter().map(|p| overrides::get(&base, p).ok()).collect();
         let spec_json = serde_json::to_string(&spec).map_err(|e| invalid(e.to_string()))?;
         let fingerprint = format!("{:016x}", fnv1a(&[spec_json.as_bytes(), model_text.as_bytes()]));
         Ok(Study {
@@ -226,6 +229,7 @@ impl Study {
             model_file,
             base,
             paths,
+            base_values,
             samples,
             jobs,
             fingerprint,
@@ -280,7 +284,7 @@ impl Study {
         let mut used = Vec::new();
         for (j, v) in self.samples[sample].iter().enumerate() {
             let p = &self.spec.parameters[j];
-            let base = overrides::get(&self.base, &self.paths[j]).ok();
+            let base = self.base_values[j].clone();
             let (value, shown) = match v {
                 ParamValue::Text(s) => (Value::String(s.clone()), v.clone()),
                 ParamValue::Number(f) if p.scale.is_some() || p.factors => {
@@ -365,19 +369,31 @@ impl Study {
         }
     }
 
+    /// Whether a sample's row keeps the band series (with [`Study::series_points`]): every
+    /// sample but the mixed rows of Saltelli's design, which serve the Sobol indices only.
+    fn keeps_series(&self, sample: usize) -> bool {
+        match &self.uq_plan {
+            Some((_, d)) => d.is_draw(sample),
+            None => true,
+        }
+    }
+
     fn solve(&self, c: &Case, per_case: bool, row: &mut CaseRow) -> Result<CaseFiles, JobError> {
         let (ovs, used) = self.overrides(c.sample).map_err(JobError::invalid)?;
         row.params = used;
         let m = job::Model::from_document(self.base.clone(), &self.model_file, &ovs)?;
         match self.case_job(c, per_case) {
             Job::Run(o) => {
-                let r = match self.series_points {
+                let mut p = job::run::prepare(&m, &o)?;
+                // A table row keeps no range warnings: only a case's own summary.json shows them.
+                p.range_warnings = per_case;
+                let r = match self.series_points.filter(|_| self.keeps_series(c.sample)) {
                     Some(points) => {
-                        let (r, s) = job::series::run_with_series(&m, &o, points)?;
+                        let (r, s) = job::series::solve_with_series(&m, &p, points)?;
                         row.series = Some(uq::run::rounded(&s));
                         r
                     }
-                    None => job::run::run(&m, &o, &mut |_, _| {})?,
+                    None => job::run::solve(&m, &p, &mut |_, _| {})?,
                 };
                 row.outputs = run_outputs(&r.summary);
                 let files = if per_case { r.files()? } else { Vec::new() };

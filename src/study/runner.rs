@@ -1,7 +1,8 @@
 //! The study runner `geartherm study` and the Python package share: the cases still to do
 //! (resume from the journals of the output directory), each finished case journaled (its files
-//! first), a cancellation flag checked before every case, and the compaction of the journals into
-//! `study.csv`, `study.parquet` and the figures.
+//! first; the journal synced to disk every half second and at the end), a cancellation flag
+//! checked before every case, and the compaction of the journals into `study.csv`,
+//! `study.parquet` and the figures.
 //!
 //! Cancellation is cooperative: once the flag is set no new case starts, the cases already
 //! running finish and are journaled, and [`run`] returns with [`Tally::cancelled`] set. A rerun
@@ -135,7 +136,17 @@ impl Session {
         Ok(true)
     }
 
-    /// The tally and the rows recorded by this session (in the order recorded).
+    /// Sync the journal's rows to disk (they are written as each case finishes and synced at
+    /// most [`crate::report::study::SYNC_INTERVAL_S`] later; closing the session syncs too).
+    pub fn sync(&self) -> Result<(), JobError> {
+        match &self.journal {
+            Some(j) => j.journal.sync().map_err(io_error(j.journal.path())),
+            None => Ok(()),
+        }
+    }
+
+    /// The tally and the rows recorded by this session (in the order recorded); the journal is
+    /// synced and closed.
     pub fn finish(self) -> (Tally, Vec<CaseRow>) {
         let rows = self.rows.into_inner().unwrap_or_else(|e| e.into_inner());
         let already_done = self.cases - self.todo.len();
@@ -188,6 +199,7 @@ pub fn run(
     if let Some(e) = write_error.into_inner().unwrap_or_else(|e| e.into_inner()) {
         return Err(e);
     }
+    session.sync()?;
     Ok(session.finish())
 }
 

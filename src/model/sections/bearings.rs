@@ -237,7 +237,7 @@ pub(crate) fn validate_bearings(
             problems.push(format!("{p}.name"), q(&b.name), "duplicate bearing name");
         }
         let mount = mount(b, &p, parts, problems);
-        let Some(entry) = catalogue_entry(&b.designation, &catalogue, &p, problems) else {
+        let Some(entry) = catalogue_entry(&b.designation, catalogue, &p, problems) else {
             continue;
         };
         if !b.position_mm.is_finite() {
@@ -256,11 +256,11 @@ pub(crate) fn validate_bearings(
         );
         problems.in_range(&format!("{p}.axial_preload_n"), b.axial_preload_n, 0.0, 1e7, " N");
         let axis = mount.and_then(|m| axis_height(m, parts, gears));
-        let Some((friction, mu)) = friction(b, entry, &series, axis, oil, &p, problems) else {
+        let Some((friction, mu)) = friction(b, entry, series, axis, oil, &p, problems) else {
             continue;
         };
         let ineffective = ineffective_keys(b, mu.is_some(), axis, oil, entry, &p);
-        let alternatives = friction_alternatives(b, entry, &series, axis, oil, &p);
+        let alternatives = friction_alternatives(b, entry, series, axis, oil, &p);
         let heat = heat_to(&b.heat_to, nodes, &format!("{p}.heat_to"), problems);
         let Some(mount) = mount else { continue };
         let key = match mount {

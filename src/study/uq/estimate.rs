@@ -131,14 +131,6 @@ fn output(row: &CaseRow, name: &str) -> Option<f64> {
         .filter(|v| v.is_finite())
 }
 
-/// Whether a sample of the design is an independent draw of the inputs.
-fn is_draw(design: Design, sample: usize) -> bool {
-    match design {
-        Design::Qmc { .. } => true,
-        Design::Saltelli { d, .. } => sample % (d + 2) < 2,
-    }
-}
-
 fn mean_sd(v: &[f64]) -> (f64, f64) {
     let n = v.len() as f64;
     let m = v.iter().sum::<f64>() / n;
@@ -214,7 +206,7 @@ pub fn estimate(uq: &Uq, rows: &[CaseRow]) -> Result<Estimates, String> {
     let used: Vec<&CaseRow> = ok
         .iter()
         .copied()
-        .filter(|r| is_draw(uq.design, r.sample))
+        .filter(|r| uq.design.is_draw(r.sample))
         .collect();
     if used.is_empty() {
         return Err(format!(

@@ -50,6 +50,17 @@ pub enum Design {
     },
 }
 
+impl Design {
+    /// Whether a sample is an independent draw of the inputs (every Qmc sample; the rows A and B
+    /// of Saltelli's design, not its mixed rows): the bands and probabilities use these only.
+    pub fn is_draw(self, sample: usize) -> bool {
+        match self {
+            Design::Qmc { .. } => true,
+            Design::Saltelli { d, .. } => sample % (d + 2) < 2,
+        }
+    }
+}
+
 /// One sampled quantity as the summary shows it.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct InputInfo {
