@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize};
 
 mod study;
 mod uq;
+mod uq_dask;
 
 /// The Python exception of a failure, built by `geartherm.errors._from_native` (the classes are
 /// plain Python classes there, so they import from `geartherm` and pickle with their fields).

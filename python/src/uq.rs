@@ -53,6 +53,11 @@ fn run_uq(
     let o = result
         .map_err(|e| py_error("io", e, Vec::new(), None))?
         .map_err(job_error)?;
+    texts(&o)
+}
+
+/// The texts `Model.uq` reads: (`uq.json`, `bands.csv` or "", `study.csv`).
+pub(crate) fn texts(o: &geartherm::study::uq::output::UqOutcome) -> PyResult<(String, String, String)> {
     let summary = o
         .summary
         .to_json()
@@ -66,8 +71,8 @@ fn run_uq(
     Ok((summary, bands, String::from_utf8_lossy(&csv).into_owned()))
 }
 
-/// Add the uq function to the module.
+/// Add the uq functions to the module.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_uq, m)?)?;
-    Ok(())
+    crate::uq_dask::register(m)
 }

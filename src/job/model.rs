@@ -50,6 +50,23 @@ impl Model {
         })
     }
 
+    /// What `check` runs: [`Model::load`], then the file's `[uncertainty]` (with the
+    /// overrides applied) checked against the model: every key path exists, every distribution
+    /// reaches only values the model accepts (the checks `uq` makes before any case runs).
+    pub fn check_file(path: &Path, overrides: &[Override]) -> Result<Model, JobError> {
+        let m = Model::load(path, overrides)?;
+        let text = super::read_text(path)?;
+        let mut problems = model::Problems::default();
+        let Some(mut doc) = model::parse::parse_document(&text, &mut problems) else {
+            return Ok(m);
+        };
+        for ov in overrides {
+            model::overrides::apply(&mut doc, ov).map_err(JobError::invalid)?;
+        }
+        model::check_uncertainty(&doc, path)?;
+        Ok(m)
+    }
+
     /// Check model text (`file` names it in messages) with `overrides`.
     pub fn from_text(text: &str, file: &Path, overrides: &[Override]) -> Result<Model, JobError> {
         let gearbox = model::from_str_with(text, file, overrides)?;
