@@ -467,6 +467,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fmu::export_fmu, m)?)?;
     study::register(m)?;
     uq::register(m)?;
+    uq_dask::register(m)?;
     m.add_function(wrap_pyfunction!(oils, m)?)?;
     m.add_function(wrap_pyfunction!(cycles, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;

@@ -71,8 +71,8 @@ pub(crate) fn texts(o: &geartherm::study::uq::output::UqOutcome) -> PyResult<(St
     Ok((summary, bands, String::from_utf8_lossy(&csv).into_owned()))
 }
 
-/// Add the uq functions to the module.
+/// Add the uq function to the module.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_uq, m)?)?;
-    crate::uq_dask::register(m)
+    Ok(())
 }
