@@ -243,6 +243,35 @@ fn refused(uncertainty: &str, extra: &[&str], what: &str) {
 }
 
 #[test]
+fn check_reports_every_problem_of_the_section_at_once() {
+    let amb = "thermal.boundaries[\"ambient\"].temp_c";
+    let cap = "thermal.nodes[\"oil\"].capacity_j_per_k";
+    let (_d, m, _) = setup(&format!(
+        "[uncertainty]\nsamples = 0\n{}{}{}",
+        input(amb, "dist = \"lognormal\"\nmedian = 20.0\nsigma_ln = 0.1"),
+        input(cap, "dist = \"normal\"\nmean = 2000.0\nsd = 2000.0"),
+        input(
+            "thermal.links[\"oil-air\"].conductance_w_per_k",
+            "dist = \"uniform\"\nlo = 4.0\nhi = 2.0"
+        ),
+    ));
+    let o = Command::new(BIN).arg("check").arg(&m).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    for what in [
+        "uncertainty.samples = 0: must lie in [1, 1000000]",
+        "uncertainty.inputs[0].dist = \"lognormal\": a log-normal on a value that may be negative",
+        "uncertainty.inputs[1] = ",
+        "the model refuses this value of thermal.nodes[\"oil\"].capacity_j_per_k",
+        "uncertainty.inputs[2].hi = 2: must be > lo = 4 (bounds reversed)",
+        "4 problem(s)",
+    ] {
+        assert!(err.contains(what), "`{what}` not in: {err}");
+    }
+    assert!(o.stdout.is_empty());
+}
+
+#[test]
 fn check_accepts_good_uncertain_inputs_and_uq_takes_their_sample_count() {
     let g = "thermal.links[\"oil-air\"].conductance_w_per_k";
     let (d, m, cycle) = setup(&format!(
