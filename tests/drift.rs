@@ -356,3 +356,160 @@ fn a_file_that_is_not_utf8_is_bad_input_for_every_reader() {
     }
     assert!(!tmp.path().join("out").exists(), "nothing written");
 }
+
+/// The model of tests/uq_cli.rs: the PT6 spur pair's gears with one capacity node between an
+/// ambient and a coolant boundary, with `uncertainty` appended.
+fn uq_model(uncertainty: &str) -> String {
+    let pt6 = std::fs::read_to_string(root().join("models/pt6_spur_pair.toml")).unwrap();
+    let head = &pt6[..pt6.find("\n[thermal]").unwrap()];
+    format!(
+        "{head}\n[thermal]\noil_node = \"oil\"\ninitial_temp_c = 10.0\n\n[[thermal.nodes]]\nname = \"oil\"\ncapacity_j_per_k = 2000.0\n\n\
+         [[thermal.boundaries]]\nname = \"ambient\"\ntemp_c = 20.0\n\n[[thermal.boundaries]]\nname = \"coolant\"\ntemp_c = 60.0\n\n\
+         [[thermal.links]]\nname = \"oil-air\"\nbetween = [\"oil\", \"ambient\"]\nconductance_w_per_k = 3.0\n\n\
+         [[thermal.links]]\nname = \"oil-coolant\"\nbetween = [\"oil\", \"coolant\"]\nconductance_w_per_k = 1.0\n\n{uncertainty}"
+    )
+}
+
+/// `[uncertainty]` sections and `uq` options, valid and not (python/tests/test_drift.py sends
+/// the same through `Model.uq`): (inputs, options as `--flag=value`).
+const UQ_ROWS: &[(&str, &[&str])] = &[
+    ("amb normal 20 2", &[]),
+    ("amb normal 20 -1", &[]),
+    ("link uniform 4 2", &[]),
+    ("link uniform 2 4", &[]),
+    ("link normal 3 2", &[]),
+    ("amb lognormal 20 0.1", &[]),
+    ("nope uniform 2 4", &[]),
+    ("amb normal 20 2", &["--samples=0"]),
+    ("amb normal 20 2", &["--samples=1000001"]),
+    ("amb normal 20 2", &["--samples=1000000", "--sobol"]),
+    ("amb normal 20 2", &["--limit=nope=100"]),
+    ("amb normal 20 2", &["--limit=oil=25"]),
+    ("amb normal 20 2", &["--percentiles=95,5"]),
+    ("amb normal 20 2", &["--confidence=1"]),
+    ("amb normal 20 2", &["--bootstrap=10001"]),
+    ("amb normal 20 2", &["--series-points=1"]),
+    ("amb normal 20 2", &["--sobol"]),
+    ("samples 0", &[]),
+];
+
+/// The `[[uncertainty.inputs]]` text of a row's inputs (`what dist a b`; `samples N`: the
+/// section's sample count with the ambient input).
+fn uq_inputs(row: &str) -> String {
+    let w: Vec<&str> = row.split(' ').collect();
+    if w[0] == "samples" {
+        return format!(
+            "[uncertainty]\nsamples = {}\n{}",
+            w[1],
+            uq_inputs("amb normal 20 2")
+        );
+    }
+    let path = match w[0] {
+        "amb" => "thermal.boundaries[\"ambient\"].temp_c",
+        "link" => "thermal.links[\"oil-air\"].conductance_w_per_k",
+        _ => "thermal.links[\"nope\"].conductance_w_per_k",
+    };
+    let keys = match w[1] {
+        "normal" => ["mean", "sd"],
+        "lognormal" => ["median", "sigma_ln"],
+        _ => ["lo", "hi"],
+    };
+    format!(
+        "[[uncertainty.inputs]]\npath = '{path}'\ndist = \"{}\"\n{} = {}\n{} = {}\n",
+        w[1], keys[0], w[2], keys[1], w[3]
+    )
+}
+
+/// The use case's options of `flags` (as the CLI converts them).
+fn uq_options(flags: &[&str], cycle: &Path) -> geartherm::study::uq::run::UqOptions {
+    use geartherm::study::uq::run::{Limit, UqJob, UqOptions};
+    let mut o = UqOptions {
+        job: Some(UqJob::Run(RunOptions {
+            cycle: cycle.display().to_string(),
+            rtol: job::run::DEFAULT_RTOL,
+            summary_only: true,
+            ..RunOptions::default()
+        })),
+        samples: Some(8),
+        ..UqOptions::default()
+    };
+    for f in flags {
+        let (k, v) = f.split_once('=').unwrap_or((f, ""));
+        match k {
+            "--samples" => o.samples = v.parse().ok(),
+            "--sobol" => o.sobol = true,
+            "--limit" => {
+                let (node, t) = v.split_once('=').unwrap();
+                o.limits.push(Limit {
+                    node: node.into(),
+                    temp_c: t.parse().unwrap(),
+                });
+            }
+            "--percentiles" => o.percentiles = v.split(',').map(|x| x.parse().unwrap()).collect(),
+            "--confidence" => o.confidence = v.parse().unwrap(),
+            "--bootstrap" => o.bootstrap = v.parse().unwrap(),
+            "--series-points" => o.series_points = v.parse().unwrap(),
+            other => panic!("{other}"),
+        }
+    }
+    o
+}
+
+#[test]
+fn uq_accepts_and_refuses_alike_from_the_cli_and_the_use_case() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cycle = tmp.path().join("standstill.csv");
+    let mut s = String::from("time_s,input_speed_rpm,input_torque_nm,gear\n");
+    for k in 0..=20 {
+        s.push_str(&format!("{},0,0,1\n", k * 50));
+    }
+    std::fs::write(&cycle, s).unwrap();
+    let (mut refused, mut accepted) = (0, 0);
+    for (k, (inputs, flags)) in UQ_ROWS.iter().enumerate() {
+        let model = tmp.path().join(format!("m{k}.toml"));
+        let text = uq_model(&uq_inputs(inputs));
+        std::fs::write(&model, &text).unwrap();
+        let out = tmp.path().join(format!("o{k}"));
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_geartherm"));
+        cmd.arg("uq")
+            .arg(&model)
+            .arg("--cycle")
+            .arg(&cycle)
+            .arg("--quiet");
+        cmd.arg("--out").arg(&out);
+        if !flags.iter().any(|f| f.starts_with("--samples")) {
+            cmd.arg("--samples=8");
+        }
+        let o = cmd.args(flags.iter()).output().unwrap();
+        let names = [
+            "samples",
+            "limit",
+            "percentiles",
+            "confidence",
+            "bootstrap",
+            "series_points",
+        ];
+        let c = match o.status.code() {
+            Some(0) => Outcome::Ok,
+            Some(1) => Outcome::Refused(unspelled_names(String::from_utf8_lossy(&o.stderr).trim(), &names)),
+            c => panic!("row {k}: exit {c:?}: {}", String::from_utf8_lossy(&o.stderr)),
+        };
+        let l = match geartherm::study::uq::run::Uq::new(text, model.clone(), uq_options(flags, &cycle)) {
+            Ok(_) => Outcome::Ok,
+            Err(e) if e.is_invalid() => Outcome::Refused(e.message),
+            Err(e) => Outcome::Failed(e.message),
+        };
+        assert_eq!(c, l, "row {k}: {inputs} {flags:?}: CLI vs use case");
+        if matches!(c, Outcome::Refused(_)) {
+            assert!(!out.exists(), "row {k}: refused but wrote {}", out.display());
+            refused += 1;
+        } else {
+            accepted += 1;
+        }
+    }
+    eprintln!("uq: {accepted} rows accepted, {refused} refused alike by the CLI and the use case");
+    assert!(
+        refused >= 12 && accepted >= 4,
+        "{accepted} accepted, {refused} refused"
+    );
+}

@@ -3,7 +3,7 @@
 //! (`launch.lockup.slip_rpm`, `thermal.links[2].h_law.h1`, `gears[3]`, `vehicle.road_load`), with
 //! the value found. The walk covers the AT6 model, to which the keys no bundled model uses are
 //! added ([[meshes]], inline oil data, every [losses] key, a bearing with every key,
-//! [[thermal.heat]], [thermal.wall_mesh]).
+//! [[thermal.heat]], [thermal.wall_mesh], an [uncertainty] with every key).
 
 use geartherm::model::file::SECTIONS;
 use geartherm::model::parse::parse_table;
@@ -125,6 +125,33 @@ length_m = 0.5
 thickness_mm = 15.0
 conductivity_w_per_mk = 100.0
 oil_wetted_fraction = 0.3
+
+[uncertainty]
+samples = 64
+
+[[uncertainty.inputs]]
+path = "lubrication.oil_level_mm"
+dist = "triangular"
+mean = 1.0
+sd = 1.0
+median = 1.0
+sigma_ln = 0.1
+lo = 1.0
+mode = 2.0
+hi = 3.0
+truncate = [1.0, 3.0]
+relative = false
+note = "test"
+
+[[uncertainty.correlations]]
+between = ["lubrication.oil_level_mm", "oil.nu40_cst"]
+rank = 0.5
+
+[uncertainty.calibration]
+parameters = ["oil.nu40_cst"]
+scale = ["log"]
+value = [35.0]
+covariance = [[0.01]]
 "#
     .parse()
     .unwrap();
@@ -252,12 +279,10 @@ fn every_wrongly_typed_value_is_reported_at_its_full_key_path() {
         "vehicle.shift",
         "launch.lockup",
         "pump.line_pressure",
+        "uncertainty.inputs",
+        "uncertainty.correlations",
+        "uncertainty.calibration",
     ]) {
-        // `[uncertainty]` is parsed by `geartherm uq` (the study layer), not by the model's
-        // own parse, which only checks that it is a table: tests/uq_cli.rs holds its cases.
-        if *section == "uncertainty" {
-            continue;
-        }
         assert!(
             paths.iter().any(|p| p.starts_with(section)),
             "no value of {section} walked"

@@ -233,6 +233,61 @@ fn refused(uncertainty: &str, extra: &[&str], what: &str) {
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains(what), "`{what}` not in: {err}");
     assert!(!out.exists(), "{err}");
+    // A problem of the model file's own `[uncertainty]`: `check` reports it the same way.
+    if extra.is_empty() {
+        let o = Command::new(BIN).arg("check").arg(&m).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "check: {err}");
+        assert!(err.contains(what), "check: `{what}` not in: {err}");
+    }
+}
+
+#[test]
+fn check_reports_every_problem_of_the_section_at_once() {
+    let amb = "thermal.boundaries[\"ambient\"].temp_c";
+    let cap = "thermal.nodes[\"oil\"].capacity_j_per_k";
+    let (_d, m, _) = setup(&format!(
+        "[uncertainty]\nsamples = 0\n{}{}{}",
+        input(amb, "dist = \"lognormal\"\nmedian = 20.0\nsigma_ln = 0.1"),
+        input(cap, "dist = \"normal\"\nmean = 2000.0\nsd = 2000.0"),
+        input(
+            "thermal.links[\"oil-air\"].conductance_w_per_k",
+            "dist = \"uniform\"\nlo = 4.0\nhi = 2.0"
+        ),
+    ));
+    let o = Command::new(BIN).arg("check").arg(&m).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    for what in [
+        "uncertainty.samples = 0: must lie in [1, 1000000]",
+        "uncertainty.inputs[0].dist = \"lognormal\": a log-normal on a value that may be negative",
+        "uncertainty.inputs[1] = ",
+        "the model refuses this value of thermal.nodes[\"oil\"].capacity_j_per_k",
+        "uncertainty.inputs[2].hi = 2: must be > lo = 4 (bounds reversed)",
+        "4 problem(s)",
+    ] {
+        assert!(err.contains(what), "`{what}` not in: {err}");
+    }
+    assert!(o.stdout.is_empty());
+}
+
+#[test]
+fn check_accepts_good_uncertain_inputs_and_uq_takes_their_sample_count() {
+    let g = "thermal.links[\"oil-air\"].conductance_w_per_k";
+    let (d, m, cycle) = setup(&format!(
+        "[uncertainty]\nsamples = 8\n{}",
+        input(g, "dist = \"uniform\"\nlo = 2.0\nhi = 4.0")
+    ));
+    let o = Command::new(BIN).arg("check").arg(&m).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = d.path().join("out");
+    let o = uq(
+        &m,
+        &["--cycle", cycle.to_str().unwrap(), "--out", out.to_str().unwrap()],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s = UqSummary::from_json(&std::fs::read_to_string(out.join("uq.json")).unwrap()).unwrap();
+    assert_eq!(s.samples, 8, "uncertainty.samples is the default of --samples");
 }
 
 fn input(path: &str, body: &str) -> String {
@@ -247,13 +302,13 @@ fn bad_distributions_are_refused_naming_the_key_path_and_nothing_is_written() {
     refused(
         &input(amb, "dist = \"normal\"\nmean = 20.0\nsd = -1.0"),
         &[],
-        &format!("{amb}): sd = -1: must be > 0"),
+        &format!("uncertainty.inputs[0].sd = -1: must be > 0 (normal on {amb})"),
     );
     // Bounds reversed.
     refused(
         &input(g, "dist = \"uniform\"\nlo = 4.0\nhi = 2.0"),
         &[],
-        &format!("{g}): hi = 2: must be > lo = 4 (bounds reversed)"),
+        &format!("uncertainty.inputs[0].hi = 2: must be > lo = 4 (bounds reversed) (uniform on {g})"),
     );
     refused(
         &input(
@@ -261,19 +316,19 @@ fn bad_distributions_are_refused_naming_the_key_path_and_nothing_is_written() {
             "dist = \"normal\"\nmean = 3.0\nsd = 0.5\ntruncate = [4.0, 2.0]",
         ),
         &[],
-        "truncate: hi = 2",
+        "uncertainty.inputs[0].truncate[1] = 2: must be > lo = 4 (bounds reversed)",
     );
     // A log-normal on a value that may be negative (a temperature in °C).
     refused(
         &input(amb, "dist = \"lognormal\"\nmedian = 20.0\nsigma_ln = 0.1"),
         &[],
-        &format!("{amb}): a log-normal on a value that may be negative"),
+        "uncertainty.inputs[0].dist = \"lognormal\": a log-normal on a value that may be negative",
     );
     // A distribution reaching values the model refuses (a negative conductance).
     refused(
         &input(g, "dist = \"normal\"\nmean = 3.0\nsd = 2.0"),
         &[],
-        &format!("{g}): the model refuses the value"),
+        &format!("the model refuses this value of {g}"),
     );
     // Correlations not positive definite.
     let three = format!(
@@ -306,7 +361,7 @@ fn bad_distributions_are_refused_naming_the_key_path_and_nothing_is_written() {
             "dist = \"uniform\"\nlo = 2.0\nhi = 4.0",
         ),
         &[],
-        "thermal.links[\"nope\"].conductance_w_per_k",
+        "uncertainty.inputs[0].path = 'thermal.links[\"nope\"].conductance_w_per_k': not a key path of the model",
     );
     refused(
         &input(
@@ -314,7 +369,7 @@ fn bad_distributions_are_refused_naming_the_key_path_and_nothing_is_written() {
             "dist = \"uniform\"\nlo = 2.0\nhi = 4.0",
         ),
         &[],
-        "thermal.links[\"oil-air\"].conductance)",
+        "uncertainty.inputs[0].path = 'thermal.links[\"oil-air\"].conductance': not a key path of the model",
     );
     // Sample counts of 0 and over the limit.
     let ok = input(g, "dist = \"uniform\"\nlo = 2.0\nhi = 4.0");
@@ -325,6 +380,15 @@ fn bad_distributions_are_refused_naming_the_key_path_and_nothing_is_written() {
     );
     refused(&ok, &["--samples", "1000001"], "samples (--samples) = 1000001");
     refused(&ok, &["--samples", "1000000", "--sobol"], "N(d + 2)");
+    // The model file's own sample count.
+    let zero = format!("[uncertainty]\nsamples = 0\n{ok}");
+    refused(&zero, &[], "uncertainty.samples = 0: must lie in [1, 1000000]");
+    let over = format!("[uncertainty]\nsamples = 1000001\n{ok}");
+    refused(
+        &over,
+        &[],
+        "uncertainty.samples = 1000001: must lie in [1, 1000000]",
+    );
     // Options: a limit on a node the model lacks, percentiles out of order.
     refused(&ok, &["--limit", "sump=100"], "no thermal node `sump`");
     refused(&ok, &["--percentiles", "95,5"], "percentiles");

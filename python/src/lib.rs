@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize};
 
 mod study;
 mod uq;
+mod uq_dask;
 
 /// The Python exception of a failure, built by `geartherm.errors._from_native` (the classes are
 /// plain Python classes there, so they import from `geartherm` and pickle with their fields).
@@ -466,6 +467,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fmu::export_fmu, m)?)?;
     study::register(m)?;
     uq::register(m)?;
+    uq_dask::register(m)?;
     m.add_function(wrap_pyfunction!(oils, m)?)?;
     m.add_function(wrap_pyfunction!(cycles, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;

@@ -63,7 +63,7 @@ fn study_select(
 }
 
 /// `threads` held to [`geartherm::job::limits::THREADS`] before any pool is built.
-fn check_threads(threads: Option<usize>) -> PyResult<()> {
+pub(crate) fn check_threads(threads: Option<usize>) -> PyResult<()> {
     match threads {
         Some(n) => geartherm::job::limits::THREADS
             .check(n as f64)
@@ -73,7 +73,7 @@ fn check_threads(threads: Option<usize>) -> PyResult<()> {
     }
 }
 
-fn in_pool<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> Result<T, String> {
+pub(crate) fn in_pool<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> Result<T, String> {
     match threads {
         Some(n) => Ok(rayon::ThreadPoolBuilder::new()
             .num_threads(n.max(1))

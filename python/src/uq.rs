@@ -53,6 +53,11 @@ fn run_uq(
     let o = result
         .map_err(|e| py_error("io", e, Vec::new(), None))?
         .map_err(job_error)?;
+    texts(&o)
+}
+
+/// The texts `Model.uq` reads: (`uq.json`, `bands.csv` or "", `study.csv`).
+pub(crate) fn texts(o: &geartherm::study::uq::output::UqOutcome) -> PyResult<(String, String, String)> {
     let summary = o
         .summary
         .to_json()

@@ -154,3 +154,86 @@ def test_a_dask_study_into_a_directory_equals_the_local_one_bit_for_bit(tmp_path
     pd.testing.assert_frame_equal(dd, local, check_exact=True)
     assert (tmp_path / "dask" / "study.csv").read_bytes() == (tmp_path / "local" / "study.csv").read_bytes()
     assert (tmp_path / "dask" / "study.parquet").is_file()
+
+
+# `uq`: the model file's own `[uncertainty]` and the options, valid and not, accepted or
+# refused alike with the same message by the CLI and `Model.uq` (tests/drift.rs holds the CLI
+# against the use case with the same rows).
+AMB = 'thermal.boundaries["ambient"].temp_c'
+LINK = 'thermal.links["oil-air"].conductance_w_per_k'
+UQ_ROWS = [
+    ((AMB, "normal", 20.0, 2.0), {}),
+    ((AMB, "normal", 20.0, -1.0), {}),
+    ((LINK, "uniform", 4.0, 2.0), {}),
+    ((LINK, "uniform", 2.0, 4.0), {}),
+    ((LINK, "normal", 3.0, 2.0), {}),
+    ((AMB, "lognormal", 20.0, 0.1), {}),
+    (('thermal.links["nope"].conductance_w_per_k', "uniform", 2.0, 4.0), {}),
+    ((AMB, "normal", 20.0, 2.0), {"samples": 0}),
+    ((AMB, "normal", 20.0, 2.0), {"samples": 1000001}),
+    ((AMB, "normal", 20.0, 2.0), {"samples": 1000000, "sobol": True}),
+    ((AMB, "normal", 20.0, 2.0), {"limits": {"nope": 100.0}}),
+    ((AMB, "normal", 20.0, 2.0), {"limits": {"oil": 25.0}}),
+    ((AMB, "normal", 20.0, 2.0), {"percentiles": [95.0, 5.0]}),
+    ((AMB, "normal", 20.0, 2.0), {"confidence": 1.0}),
+    ((AMB, "normal", 20.0, 2.0), {"bootstrap": 10001}),
+    ((AMB, "normal", 20.0, 2.0), {"series_points": 1}),
+    ((AMB, "normal", 20.0, 2.0), {"sobol": True}),
+]
+KEYS = {"normal": ("mean", "sd"), "lognormal": ("median", "sigma_ln"), "uniform": ("lo", "hi")}
+
+
+def _uq_model_text(path, dist, a, b):
+    pt6 = (ROOT / "models" / "pt6_spur_pair.toml").read_text()
+    head = pt6[: pt6.index("\n[thermal]")]
+    k = KEYS[dist]
+    return (
+        f'{head}\n[thermal]\noil_node = "oil"\ninitial_temp_c = 10.0\n\n[[thermal.nodes]]\nname = "oil"\n'
+        'capacity_j_per_k = 2000.0\n\n[[thermal.boundaries]]\nname = "ambient"\ntemp_c = 20.0\n\n'
+        '[[thermal.boundaries]]\nname = "coolant"\ntemp_c = 60.0\n\n[[thermal.links]]\nname = "oil-air"\n'
+        'between = ["oil", "ambient"]\nconductance_w_per_k = 3.0\n\n[[thermal.links]]\nname = "oil-coolant"\n'
+        'between = ["oil", "coolant"]\nconductance_w_per_k = 1.0\n\n'
+        f"[[uncertainty.inputs]]\npath = '{path}'\ndist = \"{dist}\"\n{k[0]} = {a!r}\n{k[1]} = {b!r}\n"
+    )
+
+
+def _uq_cli(model, cycle, options, out):
+    args = [str(BIN), "uq", str(model), "--cycle", str(cycle), "--quiet", "--out", str(out)]
+    args.append(f"--samples={options.get('samples', 8)}")
+    for k, v in options.items():
+        if k == "sobol":
+            args.append("--sobol")
+        elif k == "limits":
+            args += [f"--limit={n}={t!r}" for n, t in v.items()]
+        elif k == "percentiles":
+            args.append("--percentiles=" + ",".join(repr(x) for x in v))
+        elif k != "samples":
+            args.append(f"--{k.replace('_', '-')}={v!r}")
+    p = subprocess.run(args, cwd=ROOT, capture_output=True, text=True)
+    kind = {0: "ok", 1: "refused"}[p.returncode]
+    names = ["samples", "limit", "percentiles", "confidence", "bootstrap", "series_points"]
+    return kind, "" if kind == "ok" else _unspelled(p.stderr.strip(), names)
+
+
+def _uq_python(model, text, cycle, options):
+    o = dict(options)
+    o.setdefault("samples", 8)
+    try:
+        geartherm.Model.from_text(text, str(model)).uq(str(cycle), threads=1, **o)
+    except (geartherm.InputError, geartherm.ModelError) as e:
+        return "refused", str(e)
+    return "ok", ""
+
+
+def test_uq_is_accepted_and_refused_alike_by_the_cli_and_python(tmp_path):
+    cycle = tmp_path / "standstill.csv"
+    cycle.write_text("time_s,input_speed_rpm,input_torque_nm,gear\n" + "".join(f"{k * 50},0,0,1\n" for k in range(21)))
+    seen = {"ok": 0, "refused": 0}
+    for k, (inputs, options) in enumerate(UQ_ROWS):
+        model = tmp_path / f"m{k}.toml"
+        text = _uq_model_text(*inputs)
+        model.write_text(text)
+        cli = _uq_cli(model, cycle, options, tmp_path / f"o{k}")
+        assert _uq_python(model, text, cycle, options) == cli, f"row {k}: {inputs} {options}"
+        seen[cli[0]] += 1
+    assert seen["ok"] >= 4 and seen["refused"] >= 12, seen

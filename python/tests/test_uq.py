@@ -79,7 +79,33 @@ def test_bands_match_the_normal_distribution_of_a_linear_network(tmp_path: pathl
 
 def test_a_bad_distribution_names_the_key_path(tmp_path: pathlib.Path) -> None:
     bad = [{"path": 'thermal.boundaries["ambient"].temp_c', "dist": "normal", "mean": 20.0, "sd": -1.0}]
-    with pytest.raises(geartherm.GearthermError, match=re.escape('thermal.boundaries["ambient"].temp_c): sd = -1')):
+    with pytest.raises(
+        geartherm.GearthermError,
+        match=re.escape('uncertainty.inputs[0].sd = -1: must be > 0 (normal on thermal.boundaries["ambient"].temp_c)'),
+    ):
         linear_model().uq(standstill(tmp_path), inputs=bad, samples=8)
     with pytest.raises(geartherm.GearthermError, match="samples"):
         linear_model().uq(standstill(tmp_path), inputs=INPUTS, samples=0)
+
+
+def test_a_dask_uq_equals_the_local_one_bit_for_bit(tmp_path: pathlib.Path) -> None:
+    """The samples spread over Dask workers through the runner's session (journal, resume):
+    the bands, the summary and the sample table equal the local ones."""
+    import distributed
+    import pandas as pd
+
+    cycle = standstill(tmp_path)
+    m = linear_model()
+    kw = dict(inputs=INPUTS, samples=64, limits={"oil": 31.0}, series_points=21)
+    local = m.uq(cycle, threads=1, **kw)
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster, distributed.Client(cluster) as client:
+        dask = m.uq(cycle, client=client, batch_size=8, **kw)
+        into = m.uq(cycle, client=client, out=tmp_path / "dask", **kw)
+        again = m.uq(cycle, client=client, out=tmp_path / "dask", **kw)  # resumed: nothing to solve
+    for r in (dask, into, again):
+        assert r.summary == local.summary
+        pd.testing.assert_frame_equal(r.bands, local.bands, check_exact=True)
+        pd.testing.assert_frame_equal(r.samples, local.samples, check_exact=True)
+    assert (tmp_path / "dask" / "uq.json").is_file() and (tmp_path / "dask" / "bands.csv").is_file()

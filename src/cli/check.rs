@@ -59,7 +59,7 @@ impl LossesArgs {
 
 /// Run `check`.
 pub fn check(a: &ModelArgs) -> Result<(), Failure> {
-    let m = a.source.load()?;
+    let m = job::Model::check_file(&a.source.model, &a.source.set)?;
     let r = m.check_report();
     emit(&format!(
         "{}: ok ({} gears, {} meshes, {} gear states)\n",

@@ -50,6 +50,41 @@ impl Model {
         })
     }
 
+    /// What `check` runs: [`Model::load`], then the file's `[uncertainty]` (with the
+    /// overrides applied) checked against the model: every key path exists, every distribution
+    /// reaches only values the model accepts (the checks `uq` makes before any case runs).
+    /// When the model without its `[uncertainty]` is valid, every problem of the section is
+    /// reported at once (those that need no model and those that do).
+    pub fn check_file(path: &Path, overrides: &[Override]) -> Result<Model, JobError> {
+        let loaded = Model::load(path, overrides);
+        if matches!(&loaded, Err(e) if e.kind != super::ErrorKind::Model) {
+            return loaded;
+        }
+        let Ok(text) = super::read_text(path) else {
+            return loaded;
+        };
+        let mut problems = model::Problems::default();
+        let Some(mut doc) = model::parse::parse_document(&text, &mut problems) else {
+            return loaded;
+        };
+        if overrides
+            .iter()
+            .any(|ov| model::overrides::apply(&mut doc, ov).is_err())
+        {
+            return loaded;
+        }
+        let mut without = doc.clone();
+        if without.remove("uncertainty").is_none() {
+            return loaded;
+        }
+        // The probes need the model itself valid.
+        if loaded.is_err() && model::from_document_with(without, path, &[]).is_err() {
+            return loaded;
+        }
+        model::check_uncertainty(&doc, path)?;
+        loaded
+    }
+
     /// Check model text (`file` names it in messages) with `overrides`.
     pub fn from_text(text: &str, file: &Path, overrides: &[Override]) -> Result<Model, JobError> {
         let gearbox = model::from_str_with(text, file, overrides)?;

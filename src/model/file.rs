@@ -5,9 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::sections::*;
 
-/// The top-level keys a model file may have: its sections, in the order of [`ModelFile`], then
-/// `uncertainty` (the uncertain inputs `geartherm uq` samples; no field of the model: the study
-/// layer reads and checks it, every other command only checks that it is a table).
+/// The top-level keys a model file may have: its sections, in the order of [`ModelFile`].
 pub const SECTIONS: &[&str] = &[
     "model",
     "oil",
@@ -87,4 +85,8 @@ pub struct ModelFile {
     /// `[circuit]`: the lubrication circuit (sources and consumers).
     #[serde(default)]
     pub circuit: Option<circuit::CircuitSpec>,
+    /// `[uncertainty]`: the uncertain inputs `geartherm uq` samples (no part of the gearbox;
+    /// checked without the model by every command, against it by `check` and `uq`).
+    #[serde(default)]
+    pub uncertainty: Option<uncertainty::UncertaintySpec>,
 }

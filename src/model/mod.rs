@@ -8,7 +8,8 @@
 //!   `[[gears]]`, `[[meshes]]`, `[[planetary_sets]]`, `[[shift_elements]]`, `[[gear_states]]`,
 //!   `[train]`, `[lubrication]`, `[losses]`, `[thermal]` (a folder, one file per sub-table:
 //!   nodes, boundaries, links, coolers, heat, wall_mesh), `[vehicle]`, `[[clutch_packs]]`,
-//!   `[pump]`, `[launch]`, `[[bearings]]`, `[[seals]]`), each holding the section's serde
+//!   `[pump]`, `[launch]`, `[[bearings]]`, `[[seals]]`, `[uncertainty]` (a folder: the
+//!   uncertain inputs, their distributions and checks)), each holding the section's serde
 //!   struct(s), its checks with their key paths, and the checked type it becomes;
 //! - [`file`]: the whole file, one field per section; [`parse`]: TOML text → [`file::ModelFile`],
 //!   every section's type errors with their full key paths; [`validate`]: the order in which the
@@ -18,8 +19,8 @@
 //!   (the loss sources), [`catalogue`] and [`bearing_catalogue`] (the oils and bearings compiled
 //!   in).
 //!
-//! The paths `model::thermal`, `model::wall_mesh`, `model::bearings`, `model::pump` name the
-//! section modules, and `model::gearbox` every checked part type.
+//! The paths `model::thermal`, `model::wall_mesh`, `model::bearings`, `model::pump`,
+//! `model::uncertainty` name the section modules, and `model::gearbox` every checked part type.
 
 pub mod alternative;
 pub mod bearing_catalogue;
@@ -35,7 +36,7 @@ pub mod source;
 pub mod validate;
 
 pub use sections::thermal::wall_mesh;
-pub use sections::{bearings, pump, thermal};
+pub use sections::{bearings, pump, thermal, uncertainty};
 
 use std::path::{Path, PathBuf};
 
@@ -155,6 +156,24 @@ pub fn schema_takes(mut doc: toml::Table, ov: &Override) -> Result<(), Vec<Probl
         Some(_) if problems.is_empty() => Ok(()),
         _ => Err(problems.into_vec()),
     }
+}
+
+/// The `[uncertainty]` of a model document checked against the model ([`uncertainty::check`]:
+/// key paths, log-normals on positive values, the values each distribution reaches); Ok when
+/// the document has none. Its type errors are the model's own (reported by every parse).
+pub fn check_uncertainty(doc: &toml::Table, file: &Path) -> Result<(), ModelError> {
+    let Some(Ok(spec)) = doc
+        .get("uncertainty")
+        .map(|v| v.clone().try_into::<uncertainty::UncertaintySpec>())
+    else {
+        return Ok(());
+    };
+    uncertainty::check(&spec, doc, file)
+        .map(|_| ())
+        .map_err(|problems| ModelError::Invalid {
+            file: file.to_path_buf(),
+            problems,
+        })
 }
 
 /// Name the override behind each problem it concerns; when none does, list every override.

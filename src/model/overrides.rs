@@ -319,6 +319,22 @@ pub fn get(doc: &Table, path: &KeyPath) -> Result<Value, String> {
     Ok(v.clone())
 }
 
+/// Scale a number or (nested) array of numbers.
+pub fn scaled(v: &Value, f: f64) -> Result<Value, String> {
+    match v {
+        Value::Integer(i) => Ok(Value::Float(*i as f64 * f)),
+        Value::Float(x) => Ok(Value::Float(x * f)),
+        Value::Array(a) => a
+            .iter()
+            .map(|x| scaled(x, f))
+            .collect::<Result<Vec<_>, _>>()
+            .map(Value::Array),
+        other => Err(format!(
+            "a scale parameter needs a number or an array of numbers, found {other}"
+        )),
+    }
+}
+
 /// Whether a problem at `problem_path` concerns the override at canonical path `canon`: the same
 /// key, inside it, or one of its parents.
 pub fn concerns(problem_path: &str, canon: &str) -> bool {

@@ -231,16 +231,6 @@ pub fn parse_table(mut table: Table, problems: &mut Problems) -> Option<ModelFil
     }
     check_names(&Value::Table(table.clone()), "", problems);
     let before = problems.len();
-    // `[uncertainty]` is read by `geartherm uq` (the study layer checks its inputs).
-    if let Some(u) = table.remove("uncertainty") {
-        if !u.is_table() {
-            problems.push(
-                "uncertainty",
-                describe(&u),
-                "must be a table ([[uncertainty.inputs]], read by `geartherm uq`)",
-            );
-        }
-    }
     let model = section::<model::ModelMeta>(&mut table, "model", true, problems);
     let oil = section::<oil::OilSpec>(&mut table, "oil", true, problems);
     let members = array::<members::MemberSpec>(&mut table, "members", false, problems);
@@ -262,6 +252,7 @@ pub fn parse_table(mut table: Table, problems: &mut Problems) -> Option<ModelFil
     let bearings = array::<bearings::BearingSpec>(&mut table, "bearings", false, problems);
     let seals = array::<seals::SealSpec>(&mut table, "seals", false, problems);
     let circuit = section::<circuit::CircuitSpec>(&mut table, "circuit", false, problems);
+    let uncertainty = section::<uncertainty::UncertaintySpec>(&mut table, "uncertainty", false, problems);
     if problems.len() > before || !problems.is_empty() {
         return None;
     }
@@ -285,6 +276,7 @@ pub fn parse_table(mut table: Table, problems: &mut Problems) -> Option<ModelFil
         bearings,
         seals,
         circuit,
+        uncertainty,
     })
 }
 

@@ -120,6 +120,9 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
         .as_ref()
         .filter(|_| !train_failed)
         .and_then(|spec| vehicle::validate_vehicle(spec, &ratios, problems));
+    if let Some(u) = &file.uncertainty {
+        uncertainty::check_spec(u, problems);
+    }
 
     if problems.len() > start {
         return None;

@@ -13,14 +13,14 @@ use crate::scene::{ItemSpread, SourceSpread};
 pub struct SpreadBlock {
     /// Every loss item with every applicable model of its source.
     pub items: Vec<ItemSpread>,
-    /// One line per item whose applicable models disagree by more than a factor 3.
+    /// One line per item the job warns about (its applicable models disagree by more than a
+    /// factor 3 and the choice moves the point's total loss; `job::spread`).
     pub warnings: Vec<String>,
 }
 
 impl SpreadBlock {
-    /// The block of `items`, with their disagreement warnings.
-    pub fn new(items: Vec<ItemSpread>) -> SpreadBlock {
-        let warnings = items.iter().filter_map(ItemSpread::warning).collect();
+    /// The block of `items` with the job's disagreement `warnings`.
+    pub fn new(items: Vec<ItemSpread>, warnings: Vec<String>) -> SpreadBlock {
         SpreadBlock { items, warnings }
     }
 

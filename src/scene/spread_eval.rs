@@ -14,9 +14,6 @@ use super::system::Inputs;
 use super::warning::RangeWarning;
 use crate::physics::oil::OilProperties;
 
-/// Models disagreeing by more than this factor on an item are warned.
-pub const DISAGREEMENT_FACTOR: f64 = 3.0;
-
 /// One model's value of one loss item.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ModelValue {
@@ -51,36 +48,6 @@ pub struct ItemSpread {
     pub factor: Option<f64>,
     /// Every model choice of the item's source.
     pub models: Vec<ModelValue>,
-}
-
-impl ItemSpread {
-    /// The disagreement warning when the applicable models differ by more than
-    /// [`DISAGREEMENT_FACTOR`]: `item churning:wheel1: applicable models disagree by 27.7× (…)`.
-    pub fn warning(&self) -> Option<String> {
-        if self.factor.is_some_and(|f| f <= DISAGREEMENT_FACTOR) || self.max_w <= 0.0 {
-            return None;
-        }
-        let at = |v: f64| {
-            self.models
-                .iter()
-                .find(|m| m.w == Some(v))
-                .map_or("", |m| m.label)
-        };
-        let by = self
-            .factor
-            .map_or("an unbounded factor (one gives 0 W)".into(), |f| {
-                format!("{f:.1}×")
-            });
-        Some(format!(
-            "item {}:{}: applicable models disagree by {by} ({} {:.0} W … {} {:.0} W)",
-            self.source.as_str(),
-            self.name,
-            at(self.max_w),
-            self.max_w,
-            at(self.min_w),
-            self.min_w
-        ))
-    }
 }
 
 /// The ranges of `warnings` about item `it` of source `source`.

@@ -22,6 +22,7 @@ use toml::Value;
 
 use crate::job::command::{command_line, join};
 use crate::job::{self, JobError, RunOptions, SteadyOptions};
+use crate::model::overrides::scaled;
 use crate::model::{self, overrides, KeyPath, Override};
 pub use crate::report::study::{CaseRow, ParamValue};
 pub use columns::{run_outputs, steady_outputs};
@@ -117,22 +118,6 @@ pub(crate) fn key_of(label: &str) -> String {
         })
         .collect();
     s.chars().take(40).collect()
-}
-
-/// Scale a number or (nested) array of numbers.
-fn scaled(v: &Value, f: f64) -> Result<Value, String> {
-    match v {
-        Value::Integer(i) => Ok(Value::Float(*i as f64 * f)),
-        Value::Float(x) => Ok(Value::Float(x * f)),
-        Value::Array(a) => a
-            .iter()
-            .map(|x| scaled(x, f))
-            .collect::<Result<Vec<_>, _>>()
-            .map(Value::Array),
-        other => Err(format!(
-            "a scale parameter needs a number or an array of numbers, found {other}"
-        )),
-    }
 }
 
 /// An uncertainty plan's sampled quantities and design.

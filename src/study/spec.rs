@@ -52,7 +52,7 @@ pub struct StudySpec {
     pub parameters: Vec<ParamSpec>,
     /// Uncertain inputs (distributions on key paths) sampled by the `qmc` and `saltelli` plans.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub uncertainty: Option<super::uq::spec::UncertaintySpec>,
+    pub uncertainty: Option<crate::model::uncertainty::UncertaintySpec>,
     /// Outputs beyond the table.
     #[serde(default)]
     pub outputs: OutputSpec,

@@ -39,6 +39,7 @@ from .results import RunResult, RunSummary, read_run
 from .study import Study, read_study, study, study_commands
 
 if TYPE_CHECKING:
+    import distributed
     import pandas
     import polars
 
@@ -756,6 +757,9 @@ class Model:
         calibration: Optional[Mapping[str, object]] = None,
         out: Optional[Union[str, "os.PathLike[str]"]] = None,
         threads: Optional[int] = None,
+        client: Optional["distributed.Client"] = None,
+        batch_size: Optional[int] = None,
+        threads_per_task: Optional[int] = 1,
     ) -> "UqResult":
         """Uncertainty study: the uncertain inputs sampled quasi-randomly, the cycle (or the
         steady ``point``: ``dict(gear=, speed_rpm=, torque_nm=)``) solved for every sample by the
@@ -765,6 +769,11 @@ class Model:
         ``inputs``: dicts as ``[[uncertainty.inputs]]`` (``path``, ``dist``, its parameters,
         ``truncate``, ``relative``, ``note``); None: the model file's ``[uncertainty]``.
         ``out``: a directory journaled as ``geartherm uq --out`` writes it (resume).
+        ``client``: a ``distributed.Client``; the samples are solved by Dask tasks of
+        ``batch_size`` samples each (default: about four batches per worker thread, each task
+        with ``threads_per_task`` threads) through the runner's session held here (the same
+        journal and resume as ``Study.run(client=...)``); the estimates are made here, and equal
+        the local ones bit for bit.
         The model's overrides are not applied (the model file's text is sampled).
 
         Returns
@@ -783,7 +792,8 @@ class Model:
             self.text, self._m.file, cycle=cycle, point=pt, inputs=inputs, correlations=correlations,
             samples=samples, seed=seed, sobol=sobol, percentiles=percentiles, limits=limits,
             series_points=series_points, confidence=confidence, bootstrap=bootstrap,
-            calibration=calibration, out=out, threads=threads,
+            calibration=calibration, out=out, threads=threads, client=client, batch_size=batch_size,
+            threads_per_task=threads_per_task,
         )
 
     def __reduce__(self) -> Tuple[type, Tuple["_native.Model"]]:

@@ -8,12 +8,16 @@ percentile (``temp_p05_sump_c``), the exceedance table, the Sobol table and the 
 
 import io
 import json
+import math
 import os
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Dict, List, Mapping, Optional, Sequence, Union
 
 import pandas as pd
 
 from . import _native
+
+if TYPE_CHECKING:
+    import distributed
 
 
 class UqResult:
@@ -69,6 +73,9 @@ def run_uq(
     calibration: Optional[Mapping[str, Any]] = None,
     out: Optional[Union[str, "os.PathLike[str]"]] = None,
     threads: Optional[int] = None,
+    client: Optional["distributed.Client"] = None,
+    batch_size: Optional[int] = None,
+    threads_per_task: Optional[int] = 1,
 ) -> UqResult:
     job: Optional[Dict[str, Any]] = None
     if point is not None:
@@ -91,7 +98,40 @@ def run_uq(
     if inputs is not None:
         o["inputs"] = {"inputs": [_input(i) for i in inputs], "correlations": [dict(c) for c in correlations or []]}
     target = None if out is None else os.fspath(out)
+    if client is not None:
+        return UqResult(*_run_dask(client, text, file, json.dumps(o), target, batch_size, threads_per_task))
     return UqResult(*_native.run_uq(text, file, json.dumps(o), target, threads))
+
+
+def _batch(text: str, file: str, options: str, indices: List[int], threads: Optional[int]) -> str:
+    """One Dask task: the samples at ``indices`` solved by the runner (nothing written; rows as
+    JSON)."""
+    return _native.uq_cases(text, file, options, indices, threads)
+
+
+def _run_dask(client, text, file, options, out, batch_size, threads_per_task):
+    """The runner's session here (journal, resume, lock), the samples solved by Dask tasks, the
+    estimates made here from every row (as the local path makes them)."""
+    from distributed import as_completed
+
+    session = _native.UqSession(text, file, options, out)
+    try:
+        todo = session.todo()
+        n = len(todo)
+        if batch_size is None:
+            workers = sum(client.nthreads().values()) or 1
+            batch_size = max(1, math.ceil(n / (4 * workers)))
+        batches = [todo[i : i + batch_size] for i in range(0, n, batch_size)]
+        futures = [client.submit(_batch, text, file, options, b, threads_per_task, pure=False) for b in batches]
+        try:
+            for f in as_completed(futures):
+                session.record(f.result())
+        except BaseException:
+            client.cancel(futures)
+            raise
+        return session.finish()
+    finally:
+        session.close()
 
 
 __all__: List[str] = ["UqResult", "run_uq"]

@@ -25,4 +25,5 @@ pub mod seals;
 pub mod shift_elements;
 pub mod thermal;
 pub mod train;
+pub mod uncertainty;
 pub mod vehicle;

@@ -1,37 +1,24 @@
-//! The sampling plan of an uncertainty study: every uncertain input checked against its
-//! distribution's rules and against the model (the key path exists, the values the distribution
-//! reaches are values the model accepts), then quasi-random points (scrambled Sobol' sequence)
-//! turned into values by each input's inverse CDF: rank correlations by Iman–Conover, a
-//! calibration's covariance as an exact multivariate normal, or Saltelli's design for Sobol
-//! indices.
+//! The sampling plan of an uncertainty study: the uncertain inputs, checked by the model layer
+//! ([`crate::model::uncertainty::check`]: key paths, distributions, correlations, the values
+//! the model accepts), turned into quasi-random points (scrambled Sobol' sequence) by each
+//! input's inverse CDF: rank correlations by Iman–Conover, a calibration's covariance as an
+//! exact multivariate normal, or Saltelli's design for Sobol indices.
 //!
-//! A distribution whose 10⁻⁶ or 1 − 10⁻⁶ quantile (its ends, when bounded) the model refuses is
-//! refused before any case runs: the message names the key path and the value, and asks for a
-//! truncation. A sample beyond those quantiles that the model refuses is a case with status
+//! A sample beyond the probed quantiles that the model refuses is a case with status
 //! `invalid`, counted in the summary.
 
 use std::path::Path;
 
-use toml::Value;
-
-use crate::job::{self, JobError};
-use crate::model::{overrides, KeyPath, Override};
+use crate::job::{ErrorKind, JobError};
+use crate::model::uncertainty::{self, CheckedCalibration, CheckedInput, InputSpec, UncertaintySpec};
+use crate::model::Problem;
 use crate::report::study::ParamValue;
 
-use super::spec::{CalibrationSpec, DistName, InputSpec, UncertaintySpec};
 use super::stats::dist::{normal_quantile, Distribution};
 use super::stats::{correlation, lowdisc, sobol};
 use crate::study::spec::{ParamSpec, Plan, Sampling};
 
-/// Largest number of samples (N) an uncertainty study may ask for.
-pub const MAX_UQ_SAMPLES: usize = 1_000_000;
-
-/// Largest number of model runs an uncertainty study may make (N for a plain plan, N(d + 2) for
-/// Saltelli's design): each keeps its band time series in memory (about 16 kB).
-pub const MAX_UQ_RUNS: usize = 2_000_000;
-
-/// The quantiles probed against the model's own range checks.
-pub const PROBE_QUANTILES: [f64; 2] = [1e-6, 1.0 - 1e-6];
+pub use crate::model::uncertainty::{MAX_UQ_RUNS, MAX_UQ_SAMPLES, PROBE_QUANTILES};
 
 /// How the samples are laid out.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -92,289 +79,6 @@ pub struct Expanded {
     pub design: Design,
     /// What each parameter is.
     pub inputs: Vec<InputInfo>,
-}
-
-/// An input after its checks.
-struct Checked {
-    path: KeyPath,
-    dist: Distribution,
-    relative: bool,
-}
-
-/// The base model with one override, as the model checks it.
-fn probe(base: &toml::Table, file: &Path, path: &KeyPath, value: Value) -> Result<(), JobError> {
-    let ov = Override {
-        path: path.clone(),
-        value,
-    };
-    job::Model::from_document(base.clone(), file, &[ov]).map(|_| ())
-}
-
-fn first_line(e: &JobError) -> String {
-    let problems: Vec<String> = e.problems.iter().map(|p| p.to_string()).collect();
-    if problems.is_empty() {
-        e.message.lines().last().unwrap_or("").trim().to_string()
-    } else {
-        problems.join("; ")
-    }
-}
-
-/// The distribution an input names, with exactly its family's parameters given.
-fn distribution(i: &InputSpec) -> Result<Distribution, String> {
-    let keys = i.dist.keys();
-    let mut vals = Vec::new();
-    for (key, v) in i.given() {
-        match (keys.contains(&key), v) {
-            (true, Some(x)) => vals.push(x),
-            (true, None) => return Err(format!("{} needs `{key}` ({})", i.dist.as_str(), keys.join(", "))),
-            (false, Some(_)) => {
-                return Err(format!(
-                    "`{key}` is not a parameter of {} ({})",
-                    i.dist.as_str(),
-                    keys.join(", ")
-                ))
-            }
-            (false, None) => {}
-        }
-    }
-    let d = match i.dist {
-        DistName::Normal => Distribution::Normal {
-            mean: vals[0],
-            sd: vals[1],
-        },
-        DistName::Lognormal => Distribution::LogNormal {
-            median: vals[0],
-            sigma_ln: vals[1],
-        },
-        DistName::Uniform => Distribution::Uniform {
-            lo: vals[0],
-            hi: vals[1],
-        },
-        DistName::Triangular => Distribution::Triangular {
-            lo: vals[0],
-            mode: vals[1],
-            hi: vals[2],
-        },
-    };
-    d.check().map_err(|e| e.to_string())?;
-    let Some([lo, hi]) = i.truncate else { return Ok(d) };
-    let t = Distribution::Truncated {
-        inner: Box::new(d),
-        lo,
-        hi,
-    };
-    t.check().map_err(|e| format!("truncate: {e}"))?;
-    Ok(t)
-}
-
-/// Every number of a value (a number or a nested array of numbers).
-fn numbers(v: &Value, out: &mut Vec<f64>) -> bool {
-    match v {
-        Value::Integer(i) => out.push(*i as f64),
-        Value::Float(x) => out.push(*x),
-        Value::Array(a) => return a.iter().all(|x| numbers(x, out)),
-        _ => return false,
-    }
-    true
-}
-
-/// The model value an input sets at the sampled number `x`.
-fn value_at(c: &Checked, base_value: Option<&Value>, x: f64) -> Result<Value, String> {
-    match (c.relative, base_value) {
-        (true, Some(b)) => super::super::scaled(b, x),
-        (true, None) => Err("a relative input needs a value in the model to scale".into()),
-        (false, Some(Value::Integer(_))) => Ok(Value::Integer(x.round() as i64)),
-        (false, _) => Ok(Value::Float(x)),
-    }
-}
-
-/// An absolute log-normal on a quantity the model accepts negative, or a relative one on a
-/// model value that is not positive, is refused: a log-normal value is always positive.
-fn check_lognormal(c: &Checked, base: &toml::Table, file: &Path, bv: Option<&Value>) -> Result<(), String> {
-    let mut xs = Vec::new();
-    if c.relative {
-        if bv.is_some_and(|b| numbers(b, &mut xs)) && xs.iter().any(|&x| x <= 0.0) {
-            return Err(
-                "a log-normal factor on a model value that is not positive (the value may be ≤ 0)".into(),
-            );
-        }
-        return Ok(());
-    }
-    if bv.is_some_and(|b| numbers(b, &mut xs)) && xs.iter().any(|&x| x <= 0.0) {
-        return Err(format!("a log-normal on a value the model has ≤ 0 ({})", xs[0]));
-    }
-    if probe(base, file, &c.path, Value::Float(-1.0)).is_ok() {
-        return Err(
-            "a log-normal on a value that may be negative (the model accepts -1 here); \
-                    use a normal, uniform or triangular distribution, or a truncated one"
-                .into(),
-        );
-    }
-    Ok(())
-}
-
-/// One input checked: its key path parses and exists (or the model's schema takes it), its
-/// distribution is well formed, the values it reaches are values the model accepts.
-fn check_input(i: &InputSpec, base: &toml::Table, file: &Path) -> Result<Checked, String> {
-    let path: KeyPath = i.path.parse().map_err(|e| format!("key path: {e}"))?;
-    let dist = distribution(i)?;
-    let bv = overrides::get(base, &path).ok();
-    if bv.is_none() && i.relative {
-        return Err("not in the model (a relative input scales the model's value)".into());
-    }
-    let c = Checked {
-        path,
-        dist,
-        relative: i.relative,
-    };
-    if i.dist == DistName::Lognormal {
-        check_lognormal(&c, base, file, bv.as_ref())?;
-    }
-    for q in PROBE_QUANTILES {
-        let x = c.dist.quantile(q);
-        let v = value_at(&c, bv.as_ref(), x)?;
-        probe(base, file, &c.path, v).map_err(|e| {
-            let what = if bv.is_none() {
-                "the key path is not in the model or "
-            } else {
-                ""
-            };
-            format!(
-                "{what}the model refuses the value {x} (the distribution's {q} quantile): {}; \
-                 narrow the distribution or truncate it to the allowed range (truncate = [lo, hi])",
-                first_line(&e)
-            )
-        })?;
-    }
-    Ok(c)
-}
-
-/// A calibration's block checked: the fitted coordinates' mean and Cholesky factor.
-struct Calibrated {
-    paths: Vec<KeyPath>,
-    log: Vec<bool>,
-    mean: Vec<f64>,
-    chol: Vec<Vec<f64>>,
-}
-
-fn check_calibration(c: &CalibrationSpec) -> Result<Calibrated, String> {
-    let d = c.parameters.len();
-    if d == 0 || c.scale.len() != d || c.value.len() != d || c.covariance.len() != d {
-        return Err(format!(
-            "parameters, scale, value and covariance need one entry per parameter ({d} parameters)"
-        ));
-    }
-    let mut paths = Vec::with_capacity(d);
-    let mut log = Vec::with_capacity(d);
-    let mut mean = Vec::with_capacity(d);
-    for k in 0..d {
-        let p: KeyPath = c.parameters[k]
-            .parse()
-            .map_err(|e| format!("parameters[{k}]: {e}"))?;
-        let is_log = match c.scale[k].as_str() {
-            "log" => true,
-            "linear" => false,
-            s => return Err(format!("scale[{k}] = {s:?}: must be \"log\" or \"linear\"")),
-        };
-        let v = c.value[k];
-        if !v.is_finite() || (is_log && v <= 0.0) {
-            return Err(format!("value[{k}] = {v}: must be finite (> 0 on a log scale)"));
-        }
-        if c.covariance[k].len() != d || c.covariance[k].iter().any(|x| !x.is_finite()) {
-            return Err(format!(
-                "covariance row {k} ({}): {d} finite numbers needed (nan: the fit could not identify the parameter; \
-                 fix it or leave it out)",
-                c.parameters[k]
-            ));
-        }
-        paths.push(p);
-        log.push(is_log);
-        mean.push(if is_log { v.ln() } else { v });
-    }
-    let symmetric = (0..d).all(|i| {
-        (0..d).all(|j| {
-            let (a, b) = (c.covariance[i][j], c.covariance[j][i]);
-            (a - b).abs() <= 1e-9 * (a.abs() + b.abs()).max(f64::MIN_POSITIVE)
-        })
-    });
-    if !symmetric {
-        return Err("covariance: not symmetric".into());
-    }
-    let chol = correlation::cholesky(&c.covariance)
-        .map_err(|e| format!("covariance: not positive definite ({e})"))?;
-    Ok(Calibrated {
-        paths,
-        log,
-        mean,
-        chol,
-    })
-}
-
-impl Calibrated {
-    /// Model values of the parameters at standard-normal scores z.
-    fn values(&self, z: &[f64]) -> Vec<f64> {
-        (0..self.mean.len())
-            .map(|i| {
-                let t = self.mean[i] + (0..=i).map(|k| self.chol[i][k] * z[k]).sum::<f64>();
-                if self.log[i] {
-                    t.exp()
-                } else {
-                    t
-                }
-            })
-            .collect()
-    }
-
-    /// Every parameter at ±4.75 standard deviations (the 10⁻⁶ quantiles) accepted by the model.
-    fn probe(&self, base: &toml::Table, file: &Path) -> Result<(), String> {
-        let z = normal_quantile(PROBE_QUANTILES[1]);
-        for i in 0..self.mean.len() {
-            let sd = self.chol[i][..=i].iter().map(|x| x * x).sum::<f64>().sqrt();
-            for s in [-z, z] {
-                let t = self.mean[i] + s * sd;
-                let x = if self.log[i] { t.exp() } else { t };
-                probe(base, file, &self.paths[i], Value::Float(x)).map_err(|e| {
-                    format!(
-                        "parameters[{i}]: the model refuses the value {x} (mean ± 4.75 sd): {}",
-                        first_line(&e)
-                    )
-                })?;
-            }
-        }
-        Ok(())
-    }
-}
-
-/// The rank-correlation matrix of the inputs from `[[uncertainty.correlations]]`, checked.
-fn correlation_matrix(u: &UncertaintySpec) -> Result<Option<Vec<Vec<f64>>>, String> {
-    if u.correlations.is_empty() {
-        return Ok(None);
-    }
-    let d = u.inputs.len();
-    let mut m: Vec<Vec<f64>> = (0..d)
-        .map(|i| (0..d).map(|j| f64::from(u8::from(i == j))).collect())
-        .collect();
-    let index = |p: &str, k: usize| {
-        u.inputs
-            .iter()
-            .position(|i| i.path == p)
-            .ok_or_else(|| format!("uncertainty.correlations[{k}]: `{p}` is not an uncertain input"))
-    };
-    for (k, c) in u.correlations.iter().enumerate() {
-        let (a, b) = (index(&c.between[0], k)?, index(&c.between[1], k)?);
-        if a == b || !(c.rank > -1.0 && c.rank < 1.0) {
-            return Err(format!(
-                "uncertainty.correlations[{k}] ({} ~ {}): rank = {}: must lie in (-1, 1) between two different inputs",
-                c.between[0], c.between[1], c.rank
-            ));
-        }
-        m[a][b] = c.rank;
-        m[b][a] = c.rank;
-    }
-    correlation::check_correlation(&m).map_err(|e| {
-        format!("uncertainty.correlations: the rank correlation matrix is not a correlation matrix: {e}")
-    })?;
-    Ok(Some(m))
 }
 
 /// Check the sample count and the design against the limits.
@@ -464,6 +168,50 @@ fn param(path: &str, factors: bool) -> ParamSpec {
     }
 }
 
+/// The problems of `[uncertainty]` as one invalid-input error: one line per problem, each
+/// naming its key path, value and what is allowed.
+fn uncertainty_error(problems: Vec<Problem>) -> JobError {
+    let lines: Vec<String> = problems.iter().map(Problem::to_string).collect();
+    JobError {
+        kind: ErrorKind::Model,
+        message: lines.join("\n"),
+        problems,
+        io_kind: None,
+        file: None,
+    }
+}
+
+/// What the summary shows of a calibration's parameters.
+fn calibration_info(names: &[String], k: &CheckedCalibration) -> Vec<InputInfo> {
+    let z = normal_quantile(0.95);
+    names
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let sd = k.sd(i);
+            let coord = if k.log[i] { "ln p" } else { "p" };
+            let at = |t: f64| if k.log[i] { t.exp() } else { t };
+            let mean = if k.log[i] {
+                (k.mean[i] + 0.5 * sd * sd).exp()
+            } else {
+                k.mean[i]
+            };
+            InputInfo {
+                path: p.clone(),
+                column: p.clone(),
+                distribution: format!(
+                    "calibrated: {coord} ~ normal(mean {}, sd {sd:.4}), jointly with the covariance",
+                    k.mean[i]
+                ),
+                note: "calibration covariance".into(),
+                mean,
+                p05: at(k.mean[i] - z * sd),
+                p95: at(k.mean[i] + z * sd),
+            }
+        })
+        .collect()
+}
+
 /// Check `[uncertainty]` against the base model and draw the plan's samples.
 pub fn expand(
     u: &UncertaintySpec,
@@ -471,73 +219,25 @@ pub fn expand(
     base: &toml::Table,
     file: &Path,
 ) -> Result<Expanded, JobError> {
-    let invalid = JobError::invalid;
-    let mut checked = Vec::new();
-    let mut inputs = Vec::new();
-    let mut params = Vec::new();
-    for (k, i) in u.inputs.iter().enumerate() {
-        let c = check_input(i, base, file)
-            .map_err(|e| invalid(format!("uncertainty.inputs[{k}] ({}): {e}", i.path)))?;
-        inputs.push(info(i, &c.dist));
-        params.push(param(&i.path, i.relative));
-        checked.push(c);
+    let checked = uncertainty::check(u, base, file).map_err(uncertainty_error)?;
+    let mut inputs: Vec<InputInfo> = u
+        .inputs
+        .iter()
+        .zip(&checked.inputs)
+        .map(|(i, c)| info(i, &c.dist))
+        .collect();
+    let mut params: Vec<ParamSpec> = u.inputs.iter().map(|i| param(&i.path, i.relative)).collect();
+    if let (Some(spec), Some(k)) = (&u.calibration, &checked.calibration) {
+        inputs.extend(calibration_info(&spec.parameters, k));
+        params.extend(spec.parameters.iter().map(|p| param(p, false)));
     }
-    let cal = match &u.calibration {
-        Some(c) => {
-            let k = check_calibration(c).map_err(|e| invalid(format!("uncertainty.calibration: {e}")))?;
-            k.probe(base, file)
-                .map_err(|e| invalid(format!("uncertainty.calibration: {e}")))?;
-            for (i, p) in c.parameters.iter().enumerate() {
-                let sd = c.covariance[i][i].sqrt();
-                let coord = if k.log[i] { "ln p" } else { "p" };
-                let z = normal_quantile(0.95);
-                let at = |t: f64| if k.log[i] { t.exp() } else { t };
-                let mean = if k.log[i] {
-                    (k.mean[i] + 0.5 * sd * sd).exp()
-                } else {
-                    k.mean[i]
-                };
-                inputs.push(InputInfo {
-                    path: p.clone(),
-                    column: p.clone(),
-                    distribution: format!(
-                        "calibrated: {coord} ~ normal(mean {}, sd {sd:.4}), jointly with the covariance",
-                        k.mean[i]
-                    ),
-                    note: "calibration covariance".into(),
-                    mean,
-                    p05: at(k.mean[i] - z * sd),
-                    p95: at(k.mean[i] + z * sd),
-                });
-                params.push(param(p, false));
-            }
-            Some(k)
-        }
-        None => None,
-    };
     let d = params.len();
-    if d == 0 {
-        return Err(JobError::invalid(
-            "uncertainty: no uncertain inputs ([[uncertainty.inputs]] or a calibration)",
-        ));
-    }
-    if let Some((a, b)) = first_duplicate(&params) {
-        return Err(invalid(format!(
-            "uncertainty: `{}` is sampled twice (inputs and calibration parameters {a} and {b}); each key path once",
-            params[b].path
-        )));
-    }
-    let corr = correlation_matrix(u).map_err(invalid)?;
-    let design = design(
-        s,
-        d,
-        corr.is_some() || cal.as_ref().is_some_and(|c| c.mean.len() > 1),
-    )
-    .map_err(invalid)?;
-    let nu = checked.len();
-    let u_rows = points(design, d, s.seed, corr.as_deref(), nu).map_err(invalid)?;
-    let samples = values(&checked, cal.as_ref(), &u_rows, base);
-    let samples = samples.map_err(invalid)?;
+    let cal = checked.calibration.as_ref();
+    let correlated = checked.correlation.is_some() || cal.is_some_and(|c| c.mean.len() > 1);
+    let design = design(s, d, correlated).map_err(JobError::invalid)?;
+    let nu = checked.inputs.len();
+    let u_rows = points(design, d, s.seed, checked.correlation.as_deref(), nu).map_err(JobError::invalid)?;
+    let samples = values(&checked.inputs, cal, &u_rows).map_err(JobError::invalid)?;
     Ok(Expanded {
         params,
         samples,
@@ -546,21 +246,11 @@ pub fn expand(
     })
 }
 
-fn first_duplicate(params: &[ParamSpec]) -> Option<(usize, usize)> {
-    let paths: Vec<Option<KeyPath>> = params.iter().map(|p| p.path.parse().ok()).collect();
-    (0..paths.len()).find_map(|b| {
-        (0..b)
-            .find(|&a| paths[a].is_some() && paths[a] == paths[b])
-            .map(|a| (a, b))
-    })
-}
-
 /// The sampled numbers (a relative input's factor, every other input's value).
 fn values(
-    checked: &[Checked],
-    cal: Option<&Calibrated>,
+    checked: &[CheckedInput],
+    cal: Option<&CheckedCalibration>,
     u: &[Vec<f64>],
-    _base: &toml::Table,
 ) -> Result<Vec<Vec<ParamValue>>, String> {
     let nu = checked.len();
     u.iter()

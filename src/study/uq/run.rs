@@ -15,7 +15,7 @@ use crate::study::spec::{JobSpec, Meta, OutputSpec, Plan, Sampling, StudySpec};
 use crate::study::{Job, Study};
 
 use super::plan::{Design, InputInfo, MAX_UQ_SAMPLES};
-use super::spec::{calibration_block, CalibrationSpec, UncertaintySpec};
+use crate::model::uncertainty::{calibration_block, CalibrationSpec, UncertaintySpec};
 
 /// Default number of samples (N; Saltelli's design runs N(d + 2)).
 pub const DEFAULT_SAMPLES: usize = 1000;
@@ -57,7 +57,7 @@ pub struct UqOptions {
     /// WLTC).
     pub job: Option<UqJob>,
     /// Samples N (Saltelli's design: base points; None: a study file's `sampling.cases`, else
-    /// [`DEFAULT_SAMPLES`]).
+    /// the inputs' `uncertainty.samples`, else [`DEFAULT_SAMPLES`]).
     pub samples: Option<usize>,
     /// Seed of the scrambled Sobol' points and the bootstrap (None: a study file's, else 1).
     pub seed: Option<u64>,
@@ -298,7 +298,6 @@ impl Uq {
             })
         });
         options.job = Some(job_kind.clone());
-        options.samples = Some(options.samples.unwrap_or(DEFAULT_SAMPLES));
         let seed = options.seed.unwrap_or(1);
         options.seed = Some(seed);
         let base_model = job::Model::from_text(&model_text, &model_file, &[])?;
@@ -315,6 +314,7 @@ impl Uq {
         if options.calibration.is_some() {
             u.calibration = options.calibration.clone();
         }
+        options.samples = Some(options.samples.or(u.samples).unwrap_or(DEFAULT_SAMPLES));
         let spec = spec_of(&options, &job_kind, seed, u, &base_model);
         let label = model_file.display().to_string();
         let mut study = Study::new(spec, model_text, model_file).map_err(|e| match e.kind {

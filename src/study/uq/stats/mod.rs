@@ -1,6 +1,7 @@
 //! The estimators of an uncertainty study: pure numerics, no I/O.
 //!
-//! - [`dist`]: input distributions (check, quantile, CDF, mean, support), Φ and Φ⁻¹;
+//! - [`dist`]: input distributions (check, quantile, CDF, mean, support), Φ and Φ⁻¹ (in the
+//!   model layer, whose `[uncertainty]` checks use them);
 //! - [`lowdisc`]: Sobol' points (Joe–Kuo direction numbers, optional Owen scrambling);
 //! - [`correlation`]: correlation checks, Iman–Conover rank correlation, Gaussian copula;
 //! - [`sobol`]: the Saltelli design and first-order (Saltelli 2010) / total (Jansen 1999)
@@ -8,7 +9,7 @@
 //! - [`quantiles`]: percentiles, exceedance probabilities with Wilson intervals, bands over time.
 
 pub mod correlation;
-pub mod dist;
+pub use crate::model::uncertainty::dist;
 pub mod estimate;
 pub mod lowdisc;
 pub mod quantiles;

@@ -1,9 +1,13 @@
-//! Uncertain inputs as written: a distribution on a model key path, optional rank correlations,
-//! and a calibrated model's covariance. The same `[uncertainty]` table is read from a model file
-//! (`geartherm uq MODEL.toml`) and from a study file (`[sampling] plan = "qmc"` or
-//! `"saltelli"`); the Python binding sends it as JSON.
+//! `[uncertainty]`: uncertain inputs as written — a distribution on a model key path, optional
+//! rank correlations, a calibrated model's covariance, a sample count — and their checks. The
+//! same table is read from a model file (`geartherm check` checks it fully, `geartherm uq`
+//! samples it) and from a study file (`[sampling] plan = "qmc"` or `"saltelli"`); the Python
+//! binding sends it as JSON.
 //!
 //! ```toml
+//! [uncertainty]
+//! samples = 1024               # optional: the default of `geartherm uq --samples`
+//!
 //! [[uncertainty.inputs]]
 //! path = "lubrication.oil_level_mm"
 //! dist = "normal"              # normal | lognormal | uniform | triangular
@@ -23,6 +27,27 @@
 //! between = ["lubrication.oil_level_mm", 'thermal.links["housing-air"].h_table.h_w_per_m2k']
 //! rank = 0.3                   # Spearman rank correlation (Iman–Conover)
 //! ```
+//!
+//! - [`check_spec`] (run by the model's validation, every command): each input's key path
+//!   parses, its distribution has exactly its family's parameters and they are in range, each
+//!   key path once, the rank correlations form a positive definite matrix, the calibration's
+//!   covariance is symmetric positive definite, the sample count is in range;
+//! - [`against::check`] (`geartherm check`, `geartherm uq`): besides, each key path exists in
+//!   the model (or its schema takes it), a log-normal is not put on a value that may be
+//!   negative, and the model accepts the values each distribution reaches;
+//! - [`dist`]: the distributions (check, quantile, CDF); [`matrix`]: correlation checks and
+//!   the Cholesky factor.
+//!
+//! Every problem names its key path in the file (`uncertainty.inputs[0].sd`), the value and
+//! what is allowed, with the input's model key path.
+
+pub mod against;
+pub mod dist;
+pub mod matrix;
+mod spec_checks;
+
+pub use against::{check, CheckedInput, CheckedUncertainty};
+pub use spec_checks::{check_samples, check_spec, CheckedCalibration};
 
 use serde::{Deserialize, Serialize};
 
@@ -39,7 +64,20 @@ pub struct UncertaintySpec {
     /// A calibration's fitted parameters with their covariance (multivariate normal).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub calibration: Option<CalibrationSpec>,
+    /// Samples N (the default of `geartherm uq --samples`; Saltelli's design: base points).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub samples: Option<usize>,
 }
+
+/// Largest number of samples (N) an uncertainty study may ask for.
+pub const MAX_UQ_SAMPLES: usize = 1_000_000;
+
+/// Largest number of model runs an uncertainty study may make (N for a plain plan, N(d + 2) for
+/// Saltelli's design): each keeps its band time series in memory (about 16 kB).
+pub const MAX_UQ_RUNS: usize = 2_000_000;
+
+/// The quantiles probed against the model's own range checks.
+pub const PROBE_QUANTILES: [f64; 2] = [1e-6, 1.0 - 1e-6];
 
 /// The distribution families.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
