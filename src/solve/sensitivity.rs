@@ -339,8 +339,7 @@ impl<'s> Tangent<'s> {
         let mut worst = 0.0f64;
         for (j, d) in dk.iter().enumerate() {
             let mut sum = 0.0;
-            for i in 0..n {
-                let s0 = self.s[(i, j)];
+            for (i, &s0) in self.s.column(j).iter().enumerate() {
                 let s1 = s0 + tab.m[0] * d[0][i] + tab.m[1] * d[1][i] + tab.m[2] * d[2][i];
                 let err = tab.e[0] * d[0][i] + tab.e[1] * d[1][i] + tab.e[2] * d[2][i];
                 let r = err / (atol + rtol * s0.abs().max(s1.abs()));
