@@ -3,78 +3,30 @@
 //! intervals of independent errors on the same traces are printed beside), and the 95 %
 //! prediction band contains 90–98 % of the held-out points.
 
-use std::path::Path;
+#[path = "common/calibrate_rig.rs"]
+mod rig;
 
 use geartherm::job::calibrate::{self, CalibrateOptions, Trace};
 use geartherm::job::Model;
+use rig::{Normal, Rig, H, M};
 
-const MODEL: &str = "models/helical_stage.toml";
-const H: &str = "thermal.links[\"oil-housing\"].h_w_per_m2k";
-const M: &str = "thermal.nodes[\"housing\"].mass_kg";
-const ROWS: usize = 241;
-const STEP_S: usize = 30;
+/// Rig trace: speed and torque steps every 30 min over 2 h, a row every 30 s.
+const RIG: Rig = Rig {
+    rows: 241,
+    step_s: 30,
+    block: 60,
+    loads: [(3000.0, 150.0), (1500.0, 100.0), (3000.0, 120.0), (500.0, 50.0)],
+};
 
-/// splitmix64 → standard normal by Box–Muller.
-struct Normal(u64);
-
-impl Normal {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn sample(&mut self) -> f64 {
-        let (u, v) = (self.uniform().max(1e-300), self.uniform());
-        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
-    }
-}
-
-/// Rig trace: speed and torque steps every 30 min over 2 h, a row every 30 s, the ambient at
-/// 20 °C, oil and housing "measured" with `values` (30 °C when None).
 fn trace_text(values: Option<&[Vec<f64>]>) -> String {
-    let mut s =
-        String::from("time_s,input_speed_rpm,input_torque_nm,gear,boundary:ambient,node:oil,node:housing\n");
-    for k in 0..ROWS {
-        let (w, t) = match k / 60 {
-            0 => (3000.0, 150.0),
-            1 => (1500.0, 100.0),
-            2 => (3000.0, 120.0),
-            _ => (500.0, 50.0),
-        };
-        let (a, b) = values.map_or((30.0, 30.0), |v| (v[k][0], v[k][1]));
-        s.push_str(&format!("{},{w},{t},1,20,{a},{b}\n", k * STEP_S));
-    }
-    s
+    rig::trace_text(&RIG, values)
 }
 
 /// The model text, the model with every node from 30 °C, and the oil and housing temperatures
 /// at the true values `truth` (h, mass).
 fn exact(truth: [f64; 2]) -> (String, Model, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(MODEL).unwrap();
-    let sets: Vec<geartherm::model::Override> = [
-        "thermal.initial_temp_c = 30.0".to_string(),
-        format!("{H} = {}", truth[0]),
-        format!("{M} = {}", truth[1]),
-    ]
-    .iter()
-    .map(|s| s.parse().unwrap())
-    .collect();
-    let mt = Model::from_text(&text, Path::new(MODEL), &sets).unwrap();
-    let m30 = Model::from_text(&text, Path::new(MODEL), &sets[..1]).unwrap();
-    let trace = Trace::parse(&trace_text(None), "truth").unwrap();
-    let o = CalibrateOptions {
-        initial_from_trace: false,
-        ..CalibrateOptions::default()
-    };
-    let exact = calibrate::prepare(&mt, &text, &trace, &o)
-        .unwrap()
-        .problem
-        .simulate(&[], false)
-        .unwrap()
-        .temps_c;
-    (text, m30, exact)
+    let (text, m30) = rig::model(&["thermal.initial_temp_c = 30.0".into()]);
+    (text, m30, rig::exact(&RIG, truth))
 }
 
 #[test]

@@ -4,82 +4,32 @@
 //! boundary column the model does not have is refused by the command, naming the file and the
 //! column, and nothing is written.
 
-use std::path::Path;
+#[path = "common/calibrate_rig.rs"]
+mod rig;
+
 use std::process::Command;
 
 use geartherm::job::calibrate::{self, CalibrateOptions, Trace};
-use geartherm::job::Model;
+use rig::{model, Normal, Rig, H, M, MODEL};
 
-const MODEL: &str = "models/helical_stage.toml";
-const H: &str = "thermal.links[\"oil-housing\"].h_w_per_m2k";
-const M: &str = "thermal.nodes[\"housing\"].mass_kg";
-const ROWS: usize = 121;
 const TRUTH: [f64; 2] = [400.0, 11.0];
 /// Noise of the oil and the housing channel, K.
 const NOISE: [f64; 2] = [0.2, 2.0];
+/// Rig trace: four load steps over 2 h, a row every 60 s.
+const RIG: Rig = Rig {
+    rows: 121,
+    step_s: 60,
+    block: 30,
+    loads: [(3000.0, 150.0), (1500.0, 100.0), (3000.0, 120.0), (500.0, 50.0)],
+};
 
-/// splitmix64 → standard normal by Box–Muller.
-struct Normal(u64);
-
-impl Normal {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn sample(&mut self) -> f64 {
-        let (u, v) = (self.uniform().max(1e-300), self.uniform());
-        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
-    }
-}
-
-/// Rig trace: four load steps over 2 h, a row every 60 s, ambient 20 °C, oil and housing
-/// measured (`values`, 30 °C when None).
 fn trace_text(values: Option<&[Vec<f64>]>) -> String {
-    let mut s =
-        String::from("time_s,input_speed_rpm,input_torque_nm,gear,boundary:ambient,node:oil,node:housing\n");
-    for k in 0..ROWS {
-        let (w, t) = match k / 30 {
-            0 => (3000.0, 150.0),
-            1 => (1500.0, 100.0),
-            2 => (3000.0, 120.0),
-            _ => (500.0, 50.0),
-        };
-        let (a, b) = values.map_or((30.0, 30.0), |v| (v[k][0], v[k][1]));
-        s.push_str(&format!("{},{w},{t},1,20,{a},{b}\n", k * 60));
-    }
-    s
-}
-
-fn model(sets: &[String]) -> (String, Model) {
-    let text = std::fs::read_to_string(MODEL).unwrap();
-    let ovs: Vec<_> = sets.iter().map(|s| s.parse().unwrap()).collect();
-    (
-        text.clone(),
-        Model::from_text(&text, Path::new(MODEL), &ovs).unwrap(),
-    )
+    rig::trace_text(&RIG, values)
 }
 
 /// The two channels at the true values, every node from 30 °C.
 fn exact() -> Vec<Vec<f64>> {
-    let (text, m) = model(&[
-        "thermal.initial_temp_c = 30.0".into(),
-        format!("{H} = {}", TRUTH[0]),
-        format!("{M} = {}", TRUTH[1]),
-    ]);
-    let trace = Trace::parse(&trace_text(None), "truth").unwrap();
-    let o = CalibrateOptions {
-        initial_from_trace: false,
-        ..CalibrateOptions::default()
-    };
-    calibrate::prepare(&m, &text, &trace, &o)
-        .unwrap()
-        .problem
-        .simulate(&[], false)
-        .unwrap()
-        .temps_c
+    rig::exact(&RIG, TRUTH)
 }
 
 /// Fitted (h, mass) and the channels' innovation standard deviations, K.

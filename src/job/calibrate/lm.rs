@@ -6,7 +6,17 @@
 //! Problems, 2004, §3.2): on a gain ratio ρ > 0 the step is taken and μ ← μ·max(1/3, 1 − (2ρ − 1)³),
 //! ν ← 2; else μ ← μ·ν, ν ← 2ν. Stops when the step is below `x_tol`·(‖θ‖ + x_tol), the
 //! actual and the predicted relative decrease of the cost below `f_tol` (Moré's MINPACK test),
-//! the scaled gradient below `g_tol`, or after `max_iterations` evaluations with the Jacobian.
+//! the scaled gradient below `g_tol`, the cost fell by less than `stall_tol` of itself over the
+//! last `stall_window` accepted steps (a cost computed by an adaptive integrator is resolved only to
+//! about its tolerance: below that, steps are accepted and rejected on the integrator's noise),
+//! or after `max_iterations` evaluations with the Jacobian.
+//!
+//! Bounds: a parameter at a bound whose gradient points out of the box (the descent direction
+//! −Jᵀr would leave it) is held there for the step — the active set of a projected method
+//! (Nocedal & Wright §16.7, gradient projection; Kanzow, Yamashita & Fukushima, J. Comput.
+//! Appl. Math. 172 (2004) 375–397, projected Levenberg–Marquardt). Without it the step is solved
+//! as if that parameter could move and then clamped: the other components are those of a step
+//! that was not taken, and the gain ratio of the clamped step collapses.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -21,6 +31,10 @@ pub struct LmOptions {
     pub f_tol: f64,
     /// Gradient tolerance: max |Jᵀr|_k / (‖J_k‖·‖r‖).
     pub g_tol: f64,
+    /// Least relative decrease of the cost over `stall_window` accepted steps.
+    pub stall_tol: f64,
+    /// Accepted steps over which `stall_tol` is measured.
+    pub stall_window: usize,
 }
 
 impl Default for LmOptions {
@@ -30,6 +44,8 @@ impl Default for LmOptions {
             x_tol: 1e-8,
             f_tol: 1e-10,
             g_tol: 1e-8,
+            stall_tol: 1e-4,
+            stall_window: 5,
         }
     }
 }
@@ -54,6 +70,9 @@ pub enum Stop {
     Gradient,
     /// The iteration budget ran out.
     Budget,
+    /// The cost fell by less than `stall_tol` of itself over the last `stall_window` accepted
+    /// steps.
+    Stall,
     /// Nothing to fit.
     NoParameter,
     /// The damped normal equations had no solution: a non-finite residual or Jacobian entry,
@@ -102,8 +121,11 @@ pub fn minimise<E>(
     let cost = |e: &Evaluation| 0.5 * e.r.norm_squared();
     let mut mu: Option<f64> = None;
     let mut nu = 2.0;
+    // The cost at every accepted point.
+    let mut history = vec![cost(&at)];
     loop {
-        let jf = masked(&at.j, free);
+        let moving = held_at_bounds(&at, &theta, bounds, free);
+        let jf = masked(&at.j, &moving);
         let a = jf.transpose() * &jf;
         let g = jf.transpose() * &at.r;
         let m = *mu.get_or_insert(1e-3);
@@ -126,7 +148,7 @@ pub fn minimise<E>(
             });
         }
         let diag: Vec<f64> = (0..p)
-            .map(|k| if free[k] { a[(k, k)].max(1e-300) } else { 1.0 })
+            .map(|k| if moving[k] { a[(k, k)].max(1e-300) } else { 1.0 })
             .collect();
         let mut lhs = a.clone();
         for k in 0..p {
@@ -139,7 +161,7 @@ pub fn minimise<E>(
         };
         let trial: Vec<f64> = (0..p)
             .map(|k| {
-                if free[k] {
+                if moving[k] {
                     (theta[k] + step[k]).clamp(bounds[k].0, bounds[k].1)
                 } else {
                     theta[k]
@@ -182,6 +204,16 @@ pub fn minimise<E>(
             iterations += 1;
             mu = Some(m * (1.0_f64 / 3.0).max(1.0 - (2.0 * rho - 1.0).powi(3)));
             nu = 2.0;
+            history.push(c1);
+            if stalled(&history, o) {
+                return Ok(LmResult {
+                    theta,
+                    at,
+                    evaluations,
+                    iterations,
+                    stop: Stop::Stall,
+                });
+            }
             // Both the actual and the predicted decrease negligible (MINPACK's ftol test): a
             // heavily damped step that gains little is not convergence.
             if (c0 - c1) <= o.f_tol * c0 && predicted <= o.f_tol * c0 && rho <= 2.0 {
@@ -198,6 +230,30 @@ pub fn minimise<E>(
             nu *= 2.0;
         }
     }
+}
+
+/// The free parameters that move in this step: not those at a bound whose gradient component
+/// points out of the box.
+fn held_at_bounds(at: &Evaluation, theta: &[f64], bounds: &[(f64, f64)], free: &[bool]) -> Vec<bool> {
+    let g = masked(&at.j, free).transpose() * &at.r;
+    (0..theta.len())
+        .map(|k| {
+            let (lo, hi) = bounds[k];
+            let out = (theta[k] <= lo && g[k] > 0.0) || (theta[k] >= hi && g[k] < 0.0);
+            free[k] && !out
+        })
+        .collect()
+}
+
+/// The cost fell by less than `stall_tol` of itself over the last `stall_window` accepted
+/// steps.
+fn stalled(history: &[f64], o: &LmOptions) -> bool {
+    let n = history.len();
+    if o.stall_window == 0 || n <= o.stall_window {
+        return false;
+    }
+    let (before, now) = (history[n - 1 - o.stall_window], history[n - 1]);
+    before - now <= o.stall_tol * before
 }
 
 /// J with the fixed parameters' columns zeroed.
@@ -256,6 +312,66 @@ mod tests {
         assert!((res.theta[0] - 2.0).abs() < 1e-12, "{:?}", res.theta);
         let res = fit(&[1.0, 0.7], &[(0.0, 10.0), (0.0, 5.0)], &[true, false]);
         assert!((res.theta[0] - 3.0).abs() < 1e-7 && res.theta[1] == 0.7);
+    }
+
+    /// A parameter at its bound with the gradient pointing out of the box is held there: the
+    /// other, coupled to it, reaches the bounded optimum at once (r = (10(a − b), a − 4), a ≤ 1:
+    /// the optimum a = b = 1), instead of steps solved as if a could move and then clamped.
+    #[test]
+    fn a_parameter_held_at_its_bound_lets_the_others_move() {
+        let eval = |th: &[f64]| -> Result<Evaluation, ()> {
+            let r = DVector::from_vec(vec![10.0 * (th[0] - th[1]), th[0] - 4.0]);
+            let j = DMatrix::from_row_slice(2, 2, &[10.0, -10.0, 1.0, 0.0]);
+            Ok(Evaluation { r, j })
+        };
+        let b = [(-10.0, 1.0), (-10.0, 10.0)];
+        let res = minimise(
+            eval,
+            &[1.0, -3.0],
+            eval(&[1.0, -3.0]).unwrap(),
+            &b,
+            &[true, true],
+            &LmOptions::default(),
+        )
+        .unwrap();
+        println!(
+            "{:?} in {} evaluations, stop {:?}",
+            res.theta, res.evaluations, res.stop
+        );
+        assert!(
+            (res.theta[0] - 1.0).abs() < 1e-12 && (res.theta[1] - 1.0).abs() < 1e-6,
+            "{:?}",
+            res.theta
+        );
+        assert!(res.evaluations <= 8, "{} evaluations", res.evaluations);
+    }
+
+    /// A cost resolved only to about 10⁻³ (noise of an adaptive integrator) stops on the stall
+    /// test, not on the budget.
+    #[test]
+    fn a_noisy_cost_stops_on_the_stall_test() {
+        let eval = |th: &[f64]| -> Result<Evaluation, ()> {
+            let noise = 1e-3 * (1e4 * th[0]).sin();
+            let r = DVector::from_vec(vec![th[0] - 2.0 + noise, 0.5 * (th[0] - 2.0) + 1.0]);
+            let j = DMatrix::from_vec(2, 1, vec![1.0, 0.5]);
+            Ok(Evaluation { r, j })
+        };
+        let o = LmOptions {
+            max_iterations: 200,
+            ..LmOptions::default()
+        };
+        let res = minimise(eval, &[0.0], eval(&[0.0]).unwrap(), &[(-10.0, 10.0)], &[true], &o).unwrap();
+        println!(
+            "{:?} in {} evaluations, stop {:?}",
+            res.theta, res.evaluations, res.stop
+        );
+        assert!(
+            res.stop != Stop::Budget,
+            "{:?} after {}",
+            res.stop,
+            res.evaluations
+        );
+        assert!((res.theta[0] - 1.6).abs() < 0.01, "{:?}", res.theta);
     }
 
     /// A Jacobian with a NaN entry stops the fit as singular instead of raising the damping for

@@ -895,6 +895,13 @@ fn assemble(
             res.evaluations
         ));
     }
+    if res.stop == lm::Stop::Stall {
+        warnings.push(format!(
+            "the fit stopped after {} evaluations: the cost fell by less than 1e-4 of itself over the \
+             last 5 accepted steps, below what the integration's tolerance resolves",
+            res.evaluations
+        ));
+    }
     let sim = pr.simulate(&res.theta, !pr.params.is_empty())?;
     if let Some(b) = &sim.breach {
         return Err(breach_error(p, &res.theta, b));
