@@ -292,6 +292,28 @@ pub struct CalibrationSummary {
     /// What the user should know: pairs the trace cannot tell apart, parameters without
     /// influence or at a bound, a fit that ran out of iterations.
     pub warnings: Vec<String>,
+    /// A fit over several traces (or segments): per trace its segments and its errors per
+    /// channel (empty for a fit of one segment).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub traces: Vec<TraceErrors>,
+}
+
+/// One trace of a fit over several traces: its segments and its errors per channel (the
+/// residual process is that of every trace together, in [`CalibrationSummary::channels`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TraceErrors {
+    /// The trace's name (`KEYPATH@NAME` names its own parameters).
+    pub name: String,
+    /// Its file (or the name given to its text).
+    pub source: String,
+    /// Its index among the traces (`KEYPATH@INDEX`).
+    pub index: usize,
+    /// The segments of its file fitted (0-based, as `geartherm trace` lists them).
+    pub segments: Vec<usize>,
+    /// Rows over those segments.
+    pub rows: usize,
+    /// Errors per measured channel (its `noise` is the common residual process's).
+    pub channels: Vec<ChannelErrors>,
 }
 
 /// `fit.csv`: `time_s,holdout`, then per channel `<node>_measured_c,<node>_simulated_c,
