@@ -344,6 +344,38 @@ pub fn fit_csv(
     s
 }
 
+/// The errors per trace of a fit over several (empty for one segment).
+fn trace_table(s: &CalibrationSummary) -> String {
+    let mut t = String::new();
+    if s.traces.is_empty() {
+        return t;
+    }
+    let e = |x: &Option<Errors>| {
+        x.map_or("—".to_string(), |e| {
+            let band = e
+                .inside_band95
+                .map_or("—".into(), |f| format!("{:.1} %", 100.0 * f));
+            format!("{:.3} / {:.3} / {band}", e.rmse_k, e.max_abs_k)
+        })
+    };
+    t.push_str("trace, channel            segments    rows   fitted rmse / max, K / in band   held-out rmse / max, K / in band\n");
+    for tr in &s.traces {
+        for c in &tr.channels {
+            t.push_str(&format!(
+                "  {} {}: {}, {:>8} {:>6} {:>32} {:>34}\n",
+                tr.index,
+                tr.name,
+                c.node,
+                tr.segments.len(),
+                tr.rows,
+                e(&c.fitted),
+                e(&c.holdout)
+            ));
+        }
+    }
+    t
+}
+
 /// Human-readable summary.
 pub fn to_text(s: &CalibrationSummary) -> String {
     let mut t = format!(
@@ -420,6 +452,7 @@ pub fn to_text(s: &CalibrationSummary) -> String {
             acf.join(", ")
         ));
     }
+    t.push_str(&trace_table(s));
     for d in s.identifiability.iter().filter(|d| d.status != "determined") {
         let along: Vec<String> = d
             .components

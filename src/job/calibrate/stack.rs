@@ -402,7 +402,7 @@ pub fn prepare<'a>(
         for &k in &t.segments {
             let seg = &t.file.segments[k];
             let map: Vec<usize> = (0..params.len())
-                .filter(|&q| owners[q].is_none_or(|w| w == ti))
+                .filter(|&q| owners[q].map_or(true, |w| w == ti))
                 .collect();
             let local = map.iter().map(|&q| params[q].clone()).collect();
             let mut base = m.overrides.clone();
