@@ -31,7 +31,7 @@ def _trace(model, mass, t0_gap=90_000.0):
                 "node:housing": [30.0] * 61,
             }
         )
-        truth = model.override({M: mass, "thermal.initial_temp_c": 30.0}).calibrate(
+        truth = model.override({H: 400.0, M: mass, "thermal.initial_temp_c": 30.0}).calibrate(
             cycle, holdout=["0:1e9"], initial_from_trace=False
         )
         cycle["node:oil"] = truth.fit["oil_simulated_c"].round(4)

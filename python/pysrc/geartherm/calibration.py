@@ -90,7 +90,7 @@ class CalibrationResult:
                 if e is not None:
                     rows.append({"node": ch["node"], "rows_of": part, **e})
         self.errors: "pandas.DataFrame" = pd.DataFrame(rows)
-        self.fit: "pandas.DataFrame" = frame(fit_csv)
+        self.fit: "pandas.DataFrame" = frame(fit_csv, text=("trace",))
         for ch in s["channels"]:
             n = ch["node"]
             if f"{n}_band95_k" in self.fit.columns:
