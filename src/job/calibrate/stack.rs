@@ -374,6 +374,14 @@ fn channel_perm(nodes: &[(String, String)], pr: &Problem<'_>, first: &str) -> Re
     ))
 }
 
+/// The model at a segment's start checks, its boundary columns lie in the model file's range and
+/// its measured values in the physics envelope.
+fn check_segment(m: &Model, problem: &Problem<'_>) -> Result<(), JobError> {
+    problem.gearbox_at(&problem.start())?;
+    checks::boundaries_in_model_range(m, problem)?;
+    checks::measured_in_envelope(m, problem)
+}
+
 /// Check the options and the traces and map every segment onto the model: every invalid input
 /// fails here (exit 1), before any fit.
 pub fn prepare<'a>(
@@ -419,9 +427,7 @@ pub fn prepare<'a>(
                     .collect();
             }
             let perm = channel_perm(&nodes, &problem, &traces[0].file.source)?;
-            problem.gearbox_at(&problem.start())?;
-            checks::boundaries_in_model_range(m, &problem)?;
-            checks::measured_in_envelope(m, &problem)?;
+            check_segment(m, &problem)?;
             let held = seg
                 .trace
                 .times
