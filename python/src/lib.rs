@@ -282,12 +282,7 @@ impl Model {
         let r = py
             .detach(|| in_process_pool(|| job::calibrate::calibrate(&m, &text, trace, &o)))
             .map_err(job_error)?;
-        let files = r
-            .files()
-            .map_err(job_error)?
-            .into_iter()
-            .map(|(n, b)| (n.to_string(), b))
-            .collect();
+        let files = r.files().map_err(job_error)?;
         Ok((
             to_json(&r.summary)?,
             r.fit_csv,
@@ -295,6 +290,59 @@ impl Model {
             r.cycle_csv,
             files,
         ))
+    }
+    /// Calibrate over several traces ((CSV text, name) pairs; a mapping of
+    /// `job::CalibrateOptions`): a [`Calibration`]. With `evaluator` (θ → every segment's
+    /// (residuals, Jacobian) in order) the segments are evaluated by it, on Dask workers.
+    #[pyo3(signature = (traces, options, evaluator=None))]
+    fn calibrate_traces(
+        &self,
+        py: Python<'_>,
+        traces: Vec<(String, String)>,
+        options: &Bound<'_, PyAny>,
+        evaluator: Option<Py<PyAny>>,
+    ) -> PyResult<Calibration> {
+        let o: job::CalibrateOptions = self::options("calibrate", options)?;
+        let files = calibrate::read_traces(&traces, &o)?;
+        let (m, text) = (self.m.clone(), self.state.text.clone());
+        let r = py
+            .detach(|| {
+                in_process_pool(|| calibrate::calibrate_traces(&m, &text, &files, &o, evaluator.as_ref()))
+            })
+            .map_err(job_error)?;
+        let files = r.files().map_err(job_error)?;
+        Ok((
+            to_json(&r.summary)?,
+            r.fit_csv,
+            r.calibrated_model,
+            r.cycle_csv,
+            files,
+        ))
+    }
+
+    /// The residuals and Jacobians of the segments `which` at θ (a Dask worker's share of
+    /// [`Self::calibrate_traces`]): a list of (residuals, Jacobian row-major).
+    fn evaluate_segments(
+        &self,
+        py: Python<'_>,
+        traces: Vec<(String, String)>,
+        options: &Bound<'_, PyAny>,
+        theta: Vec<f64>,
+        which: Vec<usize>,
+    ) -> PyResult<Vec<(Vec<f64>, Vec<f64>)>> {
+        let o: job::CalibrateOptions = self::options("calibrate", options)?;
+        let files = calibrate::read_traces(&traces, &o)?;
+        let (m, text) = (self.m.clone(), self.state.text.clone());
+        py.detach(|| in_process_pool(|| calibrate::evaluate_segments(&m, &text, &files, &o, &theta, &which)))
+            .map_err(job_error)
+    }
+    /// The number of segments a calibration over `traces` fits (the indices of
+    /// [`Self::evaluate_segments`] run over 0 … this).
+    fn segment_count(&self, traces: Vec<(String, String)>, options: &Bound<'_, PyAny>) -> PyResult<usize> {
+        let o: job::CalibrateOptions = self::options("calibrate", options)?;
+        let files = calibrate::read_traces(&traces, &o)?;
+        let inputs = job::calibrate::stack::inputs(&files, &o).map_err(job_error)?;
+        Ok(inputs.iter().map(|t| t.segments.len()).sum())
     }
     // --- end calibrate -------------------------------------------------------------------
 

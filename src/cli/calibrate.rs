@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use crate::job::calibrate::{self, CalibrateOptions, Missing, TraceFile};
+use crate::job::calibrate::{self, CalibrateOptions, CalibrateResult, Missing, TraceFile};
 use crate::report::calibration::to_text;
 use crate::report::files::OutputDir;
 
@@ -17,11 +17,15 @@ pub struct CalibrateArgs {
     pub source: ModelSource,
     /// Trace CSV: a cycle's columns (time_s and speed_kmh[,gear], or input_speed_rpm,
     /// input_torque_nm,gear), boundary:NAME and node:NAME temperature columns in °C.
-    #[arg(long)]
-    pub trace: PathBuf,
+    /// Repeatable: several traces are fitted together, every segment of each (trace N, 0-based,
+    /// named by its file's stem).
+    #[arg(long, required = true)]
+    pub trace: Vec<PathBuf>,
     /// A parameter to fit, by key path, with optional bounds: KEYPATH[=LO:HI] (repeatable;
     /// positive values are fitted on a log scale). Without --fit the model is only compared.
-    #[arg(long, value_name = "KEYPATH[=LO:HI]")]
+    /// With several traces KEYPATH@TRACE[=LO:HI] is trace TRACE's own value (its 0-based index
+    /// or its name; @* one value per trace); without @ the value is shared by every trace.
+    #[arg(long, value_name = "KEYPATH[@TRACE][=LO:HI]")]
     pub fit: Vec<String>,
     /// A time window T0:T1 (s) whose rows are predicted, not fitted (repeatable).
     #[arg(long, value_name = "T0:T1")]
@@ -45,9 +49,10 @@ pub struct CalibrateArgs {
     #[arg(long)]
     pub keep_initial: bool,
     /// The segment of the trace fitted, 0-based (gaps in time cut a trace file into
-    /// segments; `geartherm trace FILE` lists them).
-    #[arg(long, value_name = "K")]
-    pub segment: Option<usize>,
+    /// segments; `geartherm trace FILE` lists them); K1,K2,… or all: several segments of the
+    /// trace fitted together.
+    #[arg(long, value_name = "K|K1,K2,…|all")]
+    pub segment: Option<String>,
     /// Refuse a trace with empty cells (by default their rows are dropped and counted).
     #[arg(long)]
     pub refuse_missing: bool,
@@ -88,8 +93,17 @@ pub struct CalibrateArgs {
 impl CalibrateArgs {
     /// The job's options.
     pub fn options(&self) -> CalibrateOptions {
+        let (segment, segments) = match self.segment.as_deref().map(str::trim) {
+            Some(k) => match k.parse::<usize>() {
+                Ok(k) => (Some(k), None),
+                Err(_) => (None, Some(k.to_string())),
+            },
+            None => (None, None),
+        };
+        let shown: Vec<String> = self.trace.iter().map(|p| p.display().to_string()).collect();
         CalibrateOptions {
-            trace: self.trace.display().to_string(),
+            trace: shown.first().cloned().unwrap_or_default(),
+            traces: shown.iter().skip(1).cloned().collect(),
             fit: self.fit.clone(),
             holdout: self.holdout.clone(),
             rtol: self.rtol,
@@ -97,7 +111,8 @@ impl CalibrateArgs {
             max_steps: self.max_steps,
             max_iterations: self.max_iterations,
             initial_from_trace: !self.keep_initial,
-            segment: self.segment,
+            segment,
+            segments,
             refuse_missing: self.refuse_missing,
             residuals: self.residuals.clone(),
             prior: self.prior.clone(),
@@ -121,24 +136,35 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
         from_file.append(&mut o.prior);
         o.prior = from_file;
     }
-    let file = TraceFile::load(&args.trace, o.missing())?;
+    if args.trace.len() > 1 || o.segments.is_some() {
+        return calibrate_traces(args, &m, &text, &o);
+    }
+    let file = TraceFile::load(&args.trace[0], o.missing())?;
     let trace = file.select(o.segment).map_err(|e| invalid(e.to_string()))?;
     let mut prepared = calibrate::prepare(&m, &text, trace, &o)?;
     if let Some(path) = &args.band_from {
         let json = crate::job::read_text(path)?;
         prepared.band_from(&json, &path.display().to_string())?;
     }
-    let dir = args
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("runs").join(format!("{}_calibration", m.stem())));
-    let out = OutputDir::begin(&dir)?;
+    let out = OutputDir::begin(&out_dir(args, &m))?;
     let result = calibrate::fit(&m, &prepared, &o)?;
+    finish(args, out, &result, true)
+}
+
+/// Write the result's files (and the figure), print, commit.
+fn finish(
+    args: &CalibrateArgs,
+    out: OutputDir,
+    result: &CalibrateResult,
+    figure: bool,
+) -> Result<(), Failure> {
     for (name, bytes) in result.files()? {
-        out.write(name, &bytes)?;
+        out.write(&name, &bytes)?;
     }
-    crate::report::plots::calibration::render_calibration(out.path())
-        .map_err(|e| io_failure(format!("calibration.png: {e}")))?;
+    if figure {
+        crate::report::plots::calibration::render_calibration(out.path())
+            .map_err(|e| io_failure(format!("calibration.png: {e}")))?;
+    }
     for w in &result.summary.warnings {
         warn(w);
     }
@@ -153,6 +179,49 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
     }
     out.commit()?;
     Ok(())
+}
+
+/// The output directory of a calibration.
+fn out_dir(args: &CalibrateArgs, m: &crate::job::Model) -> PathBuf {
+    args.out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("runs").join(format!("{}_calibration", m.stem())))
+}
+
+/// Several traces, or several segments of one, in one fit (docs/calibration.md, "Several
+/// traces"): each file once, named by its stem.
+fn calibrate_traces(
+    args: &CalibrateArgs,
+    m: &crate::job::Model,
+    text: &str,
+    o: &CalibrateOptions,
+) -> Result<(), Failure> {
+    let mut seen: Vec<PathBuf> = Vec::new();
+    let mut files = Vec::with_capacity(args.trace.len());
+    for path in &args.trace {
+        let canon = std::fs::canonicalize(path).unwrap_or_else(|_| path.clone());
+        if seen.contains(&canon) {
+            let shown = path.display().to_string();
+            let msg = format!("trace = {shown}: the same file is given twice: each trace file once");
+            return Err(crate::job::JobError::option("trace", &shown, "each trace file once", msg).into());
+        }
+        seen.push(canon);
+        let name = path.file_stem().map_or_else(
+            || path.display().to_string(),
+            |s| s.to_string_lossy().into_owned(),
+        );
+        files.push((name, TraceFile::load(path, o.missing())?));
+    }
+    if let Some(path) = &args.band_from {
+        let shown = path.display().to_string();
+        let msg = format!("band_from = {shown}: only for a prediction of one trace segment");
+        return Err(crate::job::JobError::option("band_from", &shown, "a run of one segment", msg).into());
+    }
+    let inputs = calibrate::stack::inputs(&files, o)?;
+    let stack = calibrate::stack::prepare(m, text, &inputs, o)?;
+    let out = OutputDir::begin(&out_dir(args, m))?;
+    let result = calibrate::stack_fit::fit(m, &stack, o, &|th| stack.evaluate(th))?;
+    finish(args, out, &result, false)
 }
 
 /// Arguments of `trace`.

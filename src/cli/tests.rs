@@ -191,11 +191,24 @@ fn calibrate_options_round_trip() {
             initial_from_trace: false,
             segment: Some(2),
             refuse_missing: true,
+            traces: Vec::new(),
+            segments: None,
             residuals: "independent".into(),
             prior: vec!["thermal.nodes[\"oil\"].mass_kg=lognormal:2:0.5".into()],
             profile: vec!["thermal.nodes[\"oil\"].mass_kg".into()],
             gearbox_kind: Some("wind-turbine".into()),
             rated: Some("1680:-11600".into()),
+        },
+        CalibrateOptions {
+            trace: "a.csv".into(),
+            traces: vec!["b.csv".into()],
+            fit: vec!["losses.multiplier.churning@*=0.1:10".into()],
+            ..CalibrateOptions::default()
+        },
+        CalibrateOptions {
+            trace: "a.csv".into(),
+            segments: Some("0,2".into()),
+            ..CalibrateOptions::default()
         },
     ];
     for o in all {

@@ -292,6 +292,28 @@ pub struct CalibrationSummary {
     /// What the user should know: pairs the trace cannot tell apart, parameters without
     /// influence or at a bound, a fit that ran out of iterations.
     pub warnings: Vec<String>,
+    /// A fit over several traces (or segments): per trace its segments and its errors per
+    /// channel (empty for a fit of one segment).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub traces: Vec<TraceErrors>,
+}
+
+/// One trace of a fit over several traces: its segments and its errors per channel (the
+/// residual process is that of every trace together, in [`CalibrationSummary::channels`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TraceErrors {
+    /// The trace's name (`KEYPATH@NAME` names its own parameters).
+    pub name: String,
+    /// Its file (or the name given to its text).
+    pub source: String,
+    /// Its index among the traces (`KEYPATH@INDEX`).
+    pub index: usize,
+    /// The segments of its file fitted (0-based, as `geartherm trace` lists them).
+    pub segments: Vec<usize>,
+    /// Rows over those segments.
+    pub rows: usize,
+    /// Errors per measured channel (its `noise` is the common residual process's).
+    pub channels: Vec<ChannelErrors>,
 }
 
 /// `fit.csv`: `time_s,holdout`, then per channel `<node>_measured_c,<node>_simulated_c,
@@ -320,6 +342,38 @@ pub fn fit_csv(
         s.push('\n');
     }
     s
+}
+
+/// The errors per trace of a fit over several (empty for one segment).
+fn trace_table(s: &CalibrationSummary) -> String {
+    let mut t = String::new();
+    if s.traces.is_empty() {
+        return t;
+    }
+    let e = |x: &Option<Errors>| {
+        x.map_or("—".to_string(), |e| {
+            let band = e
+                .inside_band95
+                .map_or("—".into(), |f| format!("{:.1} %", 100.0 * f));
+            format!("{:.3} / {:.3} / {band}", e.rmse_k, e.max_abs_k)
+        })
+    };
+    t.push_str("trace, channel            segments    rows   fitted rmse / max, K / in band   held-out rmse / max, K / in band\n");
+    for tr in &s.traces {
+        for c in &tr.channels {
+            t.push_str(&format!(
+                "  {} {}: {}, {:>8} {:>6} {:>32} {:>34}\n",
+                tr.index,
+                tr.name,
+                c.node,
+                tr.segments.len(),
+                tr.rows,
+                e(&c.fitted),
+                e(&c.holdout)
+            ));
+        }
+    }
+    t
 }
 
 /// Human-readable summary.
@@ -398,6 +452,7 @@ pub fn to_text(s: &CalibrationSummary) -> String {
             acf.join(", ")
         ));
     }
+    t.push_str(&trace_table(s));
     for d in s.identifiability.iter().filter(|d| d.status != "determined") {
         let along: Vec<String> = d
             .components

@@ -646,7 +646,7 @@ class Model:
 
     def calibrate(
         self,
-        trace: Union[PathLike, "pandas.DataFrame"],
+        trace: Union[PathLike, "pandas.DataFrame", None] = None,
         fit: Sequence[str] = (),
         holdout: Optional[Sequence[Union[str, Tuple[float, float]]]] = None,
         *,
@@ -664,6 +664,10 @@ class Model:
         profile: Sequence[str] = (),
         gearbox_kind: Optional[str] = None,
         rated: Optional[Tuple[float, float]] = None,
+        traces: Optional[Sequence[Union[PathLike, "pandas.DataFrame"]]] = None,
+        names: Optional[Sequence[str]] = None,
+        segments: Optional[str] = None,
+        client: Optional[object] = None,
     ) -> CalibrationResult:
         """Fit parameters (``fit``: key paths, ``"KEYPATH=LO:HI"`` with bounds) to a measured
         trace, as ``geartherm calibrate``.
@@ -702,8 +706,24 @@ class Model:
             ``"wind-turbine"``: compare the calibrated losses with the sourced figure.
         rated : (rpm, N·m), optional
             A rated point at which the calibrated losses are reported.
+        traces : sequence of DataFrame or path, optional
+            Several traces in one fit (instead of ``trace``; docs/calibration.md, "Several
+            traces"): every segment of each; ``fit`` keys ``KEYPATH@N`` (N a trace's index or
+            name, ``@*`` one per trace) are a trace's own. :attr:`CalibrationResult.traces`
+            has the errors per trace, :attr:`CalibrationResult.fit` the columns ``trace``,
+            ``segment`` first.
+        names : sequence of str, optional
+            The traces' names (default: a path's stem, ``trace<N>`` for a DataFrame).
+        segments : str, optional
+            ``"all"`` or ``"K1,K2,…"``: several segments of one trace in one fit.
+        client : dask.distributed.Client, optional
+            With ``traces``: the segments are integrated on the client's workers (the fit's
+            steps here).
         """
-        text, label = _trace_text(trace, name)
+        if traces is None and segments is None:
+            if trace is None:
+                raise TypeError("calibrate: give trace (or traces)")
+            text, label = _trace_text(trace, name)
         windows = []
         for h in holdout or ():
             windows.append(h if isinstance(h, str) else f"{float(h[0])!r}:{float(h[1])!r}")
@@ -736,6 +756,18 @@ class Model:
         for k, v in (("rtol", rtol), ("atol", atol), ("max_steps", max_steps), ("max_iterations", max_iterations)):
             if v is not None:
                 o[k] = v
+        if traces is not None or segments is not None:
+            from .calibration import calibrate_traces
+
+            given = list(traces) if traces is not None else [trace]
+            pairs = []
+            for i, t in enumerate(given):
+                default = os.path.splitext(os.path.basename(os.fspath(t)))[0] if isinstance(t, (str, os.PathLike)) else f"trace{i}"
+                text_i, _ = _trace_text(t, None)
+                pairs.append((text_i, names[i] if names is not None else default))
+            if segments is not None:
+                o["segments"] = segments
+            return calibrate_traces(self._m, pairs, o, client)
         return CalibrationResult(*self._m.calibrate(text, label, o))
 
 

@@ -19,7 +19,7 @@ if TYPE_CHECKING:
 
     from . import Model
 
-__all__ = ["CalibrationResult", "TraceFile", "read_trace"]
+__all__ = ["CalibrationResult", "TraceFile", "read_trace", "calibrate_traces"]
 
 
 class CalibrationResult:
@@ -54,6 +54,9 @@ class CalibrationResult:
         The calibrated model's loss per source (``at``: ``highest_power`` or ``rated``;
         ``source``, ``loss_w``, ``power_w``, ``efficiency``, ``oil_temp_c``); empty when not
         evaluated.
+    traces : pandas.DataFrame
+        A fit over several traces: per trace, channel and part (``rows_of``) its errors
+        (``rmse_k``, ``inside_band95``, …); empty for one segment.
     warnings : list of str
     calibrated_text : str
         The model text with the fitted values written in (``calibrated.toml``);
@@ -87,7 +90,7 @@ class CalibrationResult:
                 if e is not None:
                     rows.append({"node": ch["node"], "rows_of": part, **e})
         self.errors: "pandas.DataFrame" = pd.DataFrame(rows)
-        self.fit: "pandas.DataFrame" = frame(fit_csv)
+        self.fit: "pandas.DataFrame" = frame(fit_csv, text=("trace",))
         for ch in s["channels"]:
             n = ch["node"]
             if f"{n}_band95_k" in self.fit.columns:
@@ -121,6 +124,16 @@ class CalibrationResult:
                     )
         self.plausibility: "pandas.DataFrame" = pd.DataFrame(plaus)
         self.warnings: List[str] = list(s["warnings"])
+        self.traces: "pandas.DataFrame" = pd.DataFrame(
+            [
+                {"trace": t["name"], "index": t["index"], "segments": len(t["segments"]), "node": ch["node"],
+                 "rows_of": part, **ch[part]}
+                for t in s.get("traces", [])
+                for ch in t["channels"]
+                for part in ("fitted", "holdout")
+                if ch[part] is not None
+            ]
+        )
         self.calibrated_text = calibrated_text
         self.cycle_csv = cycle_csv
         self._sigma = float(s["fit"]["sigma_k"])
@@ -257,3 +270,31 @@ def _trace_text(trace: Union[PathLike, "pandas.DataFrame"], name: Optional[str])
         with open(label, encoding="utf-8") as fh:
             return fh.read(), name or label
     return trace.to_csv(index=False), name or "trace"
+
+
+def _segments_of(native, pairs, options, theta, which):
+    """A Dask worker's share: the residuals and Jacobians of the segments ``which`` at θ."""
+    return native.evaluate_segments(pairs, options, list(theta), list(which))
+
+
+def calibrate_traces(native, pairs, options, client=None) -> CalibrationResult:
+    """Calibrate over several traces ((CSV text, name) pairs). With a Dask ``client`` every
+    evaluation of the fit spreads the segments over the workers (each integrates its segments'
+    residuals and sensitivities through ``evaluate_segments``); the Levenberg–Marquardt steps,
+    the statistics and the report are computed here, by the same code as the local fit."""
+    if client is None:
+        return CalibrationResult(*native.calibrate_traces(pairs, options))
+    n = native.segment_count(pairs, options)
+    workers = max(1, len(client.scheduler_info().get("workers", {})))
+    chunks = [list(range(k, n, workers)) for k in range(min(workers, n))]
+    shared = client.scatter([native, pairs, options], broadcast=True)
+
+    def evaluator(theta):
+        futures = [client.submit(_segments_of, *shared, list(theta), c, pure=False) for c in chunks]
+        parts = [None] * n
+        for c, out in zip(chunks, client.gather(futures)):
+            for k, e in zip(c, out):
+                parts[k] = e
+        return parts
+
+    return CalibrationResult(*native.calibrate_traces(pairs, options, evaluator))

@@ -21,6 +21,8 @@ pub mod prior;
 pub mod problem;
 pub mod profile;
 pub mod residuals;
+pub mod stack;
+pub mod stack_fit;
 pub mod stats;
 pub mod trace;
 pub mod trace_file;
@@ -93,8 +95,13 @@ pub struct CalibrateOptions {
     /// Start every measured node at its first measured value and the others at their mean
     /// (else at the model's initial temperatures).
     pub initial_from_trace: bool,
+    /// Further traces fitted together with `trace` (files, or names given to trace text):
+    /// docs/calibration.md, "Several traces".
+    pub traces: Vec<String>,
     /// The segment of the trace file fitted (0-based; needed when gaps cut it into several).
     pub segment: Option<usize>,
+    /// Several segments of a one-trace file fitted together: `all` or `K1,K2,…` (0-based).
+    pub segments: Option<String>,
     /// Refuse empty cells (else their rows are dropped and counted).
     pub refuse_missing: bool,
     /// Residual model: `ar1` (least squares; intervals and bands from per channel AR(1)
@@ -133,7 +140,9 @@ impl Default for CalibrateOptions {
             max_steps: super::run::DEFAULT_MAX_STEPS,
             max_iterations: DEFAULT_MAX_ITERATIONS,
             initial_from_trace: true,
+            traces: Vec::new(),
             segment: None,
+            segments: None,
             refuse_missing: false,
             residuals: "ar1".into(),
             prior: Vec::new(),
@@ -232,21 +241,39 @@ pub struct CalibrateResult {
     /// `cycle.csv`: the trace's input columns (`geartherm run calibrated.toml --cycle cycle.csv`
     /// reproduces the fitted trajectory).
     pub cycle_csv: String,
+    /// With several traces and parameters of one trace: per trace its calibrated model
+    /// (`calibrated_<trace>.toml`, text).
+    pub per_trace_models: Vec<(String, String)>,
 }
 
 impl CalibrateResult {
-    /// The files of the output directory.
-    pub fn files(&self) -> Result<Vec<(&'static str, Vec<u8>)>, JobError> {
+    /// The files of the output directory (a fit over several traces with parameters of one
+    /// trace writes one `calibrated_<trace>.toml` per trace instead of `calibrated.toml`, and
+    /// no `cycle.csv`).
+    pub fn files(&self) -> Result<Vec<(String, Vec<u8>)>, JobError> {
         let json = serde_json::to_vec_pretty(&self.summary)
             .map_err(|e| JobError::numerical(format!("cannot serialise the calibration: {e}")))?;
         let mut files = vec![
-            ("calibration.json", json),
-            ("fit.csv", self.fit_csv.clone().into_bytes()),
-            ("calibrated.toml", self.calibrated_model.clone().into_bytes()),
-            ("cycle.csv", self.cycle_csv.clone().into_bytes()),
+            ("calibration.json".to_string(), json),
+            ("fit.csv".to_string(), self.fit_csv.clone().into_bytes()),
         ];
+        if !self.calibrated_model.is_empty() {
+            files.push((
+                "calibrated.toml".into(),
+                self.calibrated_model.clone().into_bytes(),
+            ));
+        }
+        for (name, text) in &self.per_trace_models {
+            files.push((name.clone(), text.clone().into_bytes()));
+        }
+        if !self.cycle_csv.is_empty() {
+            files.push(("cycle.csv".into(), self.cycle_csv.clone().into_bytes()));
+        }
         if !self.summary.profiles.is_empty() {
-            files.push(("profile.csv", profile_csv(&self.summary.profiles).into_bytes()));
+            files.push((
+                "profile.csv".into(),
+                profile_csv(&self.summary.profiles).into_bytes(),
+            ));
         }
         Ok(files)
     }
@@ -623,7 +650,7 @@ fn at_bound(theta: f64, (lo, hi): (f64, f64)) -> bool {
 
 /// The parameters with their intervals, and the warnings about them.
 fn parameters(
-    pr: &Problem<'_>,
+    params: &[Parameter],
     f: &Fitted,
     identifiable: &[bool],
     lin: &stats::Linearised,
@@ -633,8 +660,8 @@ fn parameters(
     let (res, influence) = (&f.res, &f.influence);
     let ind = &f.independent;
     let t_ind = stats::t975(ind.lin.dof);
-    let mut out = Vec::with_capacity(pr.params.len());
-    for (k, par) in pr.params.iter().enumerate() {
+    let mut out = Vec::with_capacity(params.len());
+    for (k, par) in params.iter().enumerate() {
         let th = res.theta[k];
         let (ith, ise) = (ind.theta[k], ind.lin.std_err[k].filter(|_| f.noise.is_some()));
         if influence[k] <= MIN_INFLUENCE_K {
@@ -671,8 +698,8 @@ fn parameters(
     out
 }
 
-fn correlation(pr: &Problem<'_>, lin: &stats::Linearised, warnings: &mut Vec<String>) -> Correlation {
-    let names: Vec<String> = pr.params.iter().map(Parameter::name).collect();
+fn correlation(params: &[Parameter], lin: &stats::Linearised, warnings: &mut Vec<String>) -> Correlation {
+    let names: Vec<String> = params.iter().map(Parameter::name).collect();
     let np = names.len();
     for a in 0..np {
         for b in a + 1..np {
@@ -700,15 +727,14 @@ fn correlation(pr: &Problem<'_>, lin: &stats::Linearised, warnings: &mut Vec<Str
 /// The eigen-directions as reported, with a warning for each the trace does not or only weakly
 /// determines.
 fn identifiability(
-    pr: &Problem<'_>,
+    params: &[Parameter],
     lin: &stats::Linearised,
     t: f64,
     warnings: &mut Vec<String>,
 ) -> Vec<Direction> {
     let mut out = Vec::new();
     for d in &lin.directions {
-        let components: Vec<Component> = pr
-            .params
+        let components: Vec<Component> = params
             .iter()
             .zip(&d.direction)
             .filter(|(_, c)| c.abs() > stats::INVOLVED)
@@ -718,7 +744,7 @@ fn identifiability(
             })
             .collect();
         let label = |c: &Component| {
-            let log = pr.params.iter().any(|q| q.name() == c.key_path && q.log);
+            let log = params.iter().any(|q| q.name() == c.key_path && q.log);
             if log {
                 format!("{:+.3}·ln {}", c.component, c.key_path)
             } else {
@@ -856,19 +882,13 @@ fn weighted_at(f: &Fitted) -> (Evaluation, Option<Vec<residuals::Ar1>>) {
     }
 }
 
-fn assemble(
-    m: &Model,
-    p: &Prepared<'_>,
-    o: &CalibrateOptions,
-    f: &Fitted,
-    clock: Instant,
-) -> Result<CalibrateResult, JobError> {
-    let (pr, res) = (&p.problem, &f.res);
-    let bounds: Vec<(f64, f64)> = pr.params.iter().map(Parameter::theta_bounds).collect();
-    let identifiable = identifiable(&res.theta, &bounds, &f.free);
+/// The linearised statistics of a fit: the covariance (the sandwich under AR(1) errors), the
+/// degrees of freedom (at most the effective rows less the parameters), and the data's standard
+/// errors.
+fn statistics(f: &Fitted, identifiable: &[bool]) -> (stats::Linearised, Vec<Option<f64>>) {
     let lost = f.noise.as_ref().map_or(0, Vec::len);
     let (at, scaled) = weighted_at(f);
-    let mut lin = stats::linearised(&at.j, at.r.norm_squared(), &identifiable, lost);
+    let mut lin = stats::linearised(&at.j, at.r.norm_squared(), identifiable, lost);
     if let (Some(models), false) = (&scaled, f.whitened) {
         let sj = f.layout.covariance_times(&at.j, models);
         stats::sandwich(&mut lin, &(at.j.transpose() * sj));
@@ -879,15 +899,29 @@ fn assemble(
         lin.dof = lin.dof.min(eff.floor().max(1.0) as usize);
     }
     let data_se = lin.std_err.clone();
+    (lin, data_se)
+}
+
+fn assemble(
+    m: &Model,
+    p: &Prepared<'_>,
+    o: &CalibrateOptions,
+    f: &Fitted,
+    clock: Instant,
+) -> Result<CalibrateResult, JobError> {
+    let (pr, res) = (&p.problem, &f.res);
+    let bounds: Vec<(f64, f64)> = pr.params.iter().map(Parameter::theta_bounds).collect();
+    let identifiable = identifiable(&res.theta, &bounds, &f.free);
+    let (mut lin, data_se) = statistics(f, &identifiable);
     if !p.priors.is_empty() {
         stats::posterior(&mut lin, &p.priors.information(&pr.params, &res.theta));
     }
     let t = stats::t975(lin.dof);
     let mut warnings = pr.trace.notes.clone();
-    let mut parameters = parameters(pr, f, &identifiable, &lin, t, &mut warnings);
+    let mut parameters = parameters(&pr.params, f, &identifiable, &lin, t, &mut warnings);
     prior_influence(p, f, &data_se, &mut parameters);
-    let correlation = correlation(pr, &lin, &mut warnings);
-    let identifiability = identifiability(pr, &lin, t, &mut warnings);
+    let correlation = correlation(&pr.params, &lin, &mut warnings);
+    let identifiability = identifiability(&pr.params, &lin, t, &mut warnings);
     singular(p, res)?;
     if res.stop == lm::Stop::Budget {
         warnings.push(format!(
@@ -996,6 +1030,7 @@ fn assemble(
         profiles,
         plausibility,
         warnings,
+        traces: Vec::new(),
     };
     check_finite(&summary)?;
     Ok(CalibrateResult {
@@ -1003,6 +1038,7 @@ fn assemble(
         fit_csv: csv,
         calibrated_model: calibrated,
         cycle_csv: cycle_csv(pr.trace),
+        per_trace_models: Vec::new(),
     })
 }
 
@@ -1106,6 +1142,9 @@ impl super::command::ToArgs for CalibrateOptions {
         // Each option by its name, spelled as a flag by the one rule of `options::flag`.
         let flag = super::options::flag;
         let mut a = vec![flag("trace"), self.trace.clone()];
+        for t in &self.traces {
+            a.extend([flag("trace"), t.clone()]);
+        }
         for f in &self.fit {
             a.extend([flag("fit"), f.clone()]);
         }
@@ -1125,6 +1164,9 @@ impl super::command::ToArgs for CalibrateOptions {
         }
         if let Some(k) = self.segment {
             a.extend([flag("segment"), k.to_string()]);
+        }
+        if let Some(k) = &self.segments {
+            a.extend([flag("segment"), k.clone()]);
         }
         if self.refuse_missing {
             a.push(flag("refuse_missing"));

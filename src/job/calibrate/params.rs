@@ -43,9 +43,13 @@ pub struct Parameter {
     pub log: bool,
     /// The model holds an integer there: written as one (rounded).
     pub integer: bool,
+    /// With several traces, the trace whose own value this is (`KEYPATH@TRACE`); None for a
+    /// parameter shared by every trace (and for every parameter of a single trace).
+    pub owner: Option<String>,
 }
 
-fn split_bounds(s: &str) -> (&str, Option<&str>) {
+/// The key path and the bounds of `KEYPATH[=LO:HI]` (the `=` outside quotes and brackets).
+pub fn split_bounds(s: &str) -> (&str, Option<&str>) {
     let (mut in_quotes, mut depth, mut prev) = (false, 0i32, ' ');
     let mut at = None;
     for (k, c) in s.char_indices() {
@@ -148,6 +152,7 @@ impl Parameter {
             hi,
             log,
             integer,
+            owner: None,
         })
     }
 
@@ -228,9 +233,12 @@ impl Parameter {
         }
     }
 
-    /// The key path as text.
+    /// The key path as text, `@TRACE` appended for a parameter of one trace.
     pub fn name(&self) -> String {
-        self.path.to_string()
+        match &self.owner {
+            Some(t) => format!("{}@{t}", self.path),
+            None => self.path.to_string(),
+        }
     }
 }
 
