@@ -11,7 +11,7 @@
 //! ```
 //!
 //! Differentiating every stage along a parameter θ_j with S = ∂y/∂θ_j (h held fixed: the step
-//! sizes are those the error control chose), with dW = −γh·dJ:
+//! sizes are those the nominal solution's error control chose), with dW = −γh·dJ:
 //!
 //! ```text
 //! W dK_i = γh·(df_i + dJ·K_i) + Σ_j γ c_ij dK_j + γ γ_i h²·d(∂f/∂t),
@@ -32,15 +32,6 @@
 //! The state integrated is the node temperatures alone: the loss and boundary energies of the
 //! scene's state are quadratures that no node row depends on, so leaving them out changes neither
 //! the node stages nor their derivatives (the error test then weighs the nodes only).
-//!
-//! Error control covers the sensitivities as well as the temperatures (full error control, as
-//! SUNDIALS CVODES with `CVodeSetSensErrCon`): a step is accepted when the embedded estimate
-//! Σ e_i dK_i of every parameter's tangent, weighted as the temperatures' are with S in place of
-//! T, passes the test too. The temperatures' test alone is not enough: a node held at the edge
-//! of a thermostat's band (the smoothstep's gain rising from zero within a fraction of a kelvin)
-//! lets long steps pass whose discrete tangent grows by a factor of 2–20 per step, to NaN within
-//! an hour of simulated time (`tests/calibrate_sensitivity_finite.rs`, the MM82 model's inlet
-//! node at its cooler's `open_c`).
 //!
 //! [`integrate_fixed`] replays a given step sequence without error control: the same discrete
 //! solution as a function of the parameters, so that its central differences check the
@@ -311,48 +302,16 @@ impl<'s> Tangent<'s> {
         )
     }
 
-    /// Accept the step: y⁺ = y + Σ m_i K_i, and the tangent S⁺ of every parameter (from the
-    /// stage derivatives `dk` when the error test computed them for this step).
-    fn accept(&mut self, t: f64, st: &StepStages, dk: Option<Vec<[DVector<f64>; 3]>>) {
+    /// Accept the step: y⁺ = y + Σ m_i K_i, and the tangent S⁺ of every parameter.
+    fn accept(&mut self, t: f64, st: &StepStages) {
         let tab = &ROS3;
-        let dk = dk.unwrap_or_else(|| self.tangents(t, st));
-        for (j, d) in dk.iter().enumerate() {
+        for j in 0..self.delta.len() {
+            let dk = self.tangent_stages(t, st, j);
             let mut col = self.s.column_mut(j);
-            col += &d[0] * tab.m[0] + &d[1] * tab.m[1] + &d[2] * tab.m[2];
+            col += &dk[0] * tab.m[0] + &dk[1] * tab.m[1] + &dk[2] * tab.m[2];
         }
         let k = &st.k;
         self.y += &k[0] * tab.m[0] + &k[1] * tab.m[1] + &k[2] * tab.m[2];
-    }
-
-    /// The stage derivatives of every parameter over the step from t.
-    fn tangents(&mut self, t: f64, st: &StepStages) -> Vec<[DVector<f64>; 3]> {
-        (0..self.delta.len())
-            .map(|j| self.tangent_stages(t, st, j))
-            .collect()
-    }
-
-    /// The weighted RMS error estimate of the tangent of every parameter over the step (the
-    /// embedded estimate Σ e_i dK_i, weighted as the temperatures' with S in place of T), the
-    /// largest of them (infinite when a value is not finite).
-    fn tangent_error(&self, dk: &[[DVector<f64>; 3]], rtol: f64, atol: f64) -> f64 {
-        let (n, tab) = (self.n, &ROS3);
-        let mut worst = 0.0f64;
-        for (j, d) in dk.iter().enumerate() {
-            let mut sum = 0.0;
-            for (i, &s0) in self.s.column(j).iter().enumerate() {
-                let s1 = s0 + tab.m[0] * d[0][i] + tab.m[1] * d[1][i] + tab.m[2] * d[2][i];
-                let err = tab.e[0] * d[0][i] + tab.e[1] * d[1][i] + tab.e[2] * d[2][i];
-                let r = err / (atol + rtol * s0.abs().max(s1.abs()));
-                sum += r * r;
-            }
-            let e = (sum / n as f64).sqrt();
-            worst = if e.is_finite() {
-                worst.max(e)
-            } else {
-                f64::INFINITY
-            };
-        }
-        worst
     }
 
     /// Central difference along (d, e_j) at (t, x) of f: (f⁺(x + δd) − f⁻(x − δd)) / 2δ.
@@ -560,28 +519,16 @@ fn integrate_segment(
                 .ok_or_else(|| r.failure(t, "the replayed step sequence ended early".into()))?,
         };
         let (st, err) = r.step(t, h_try, opts.rtol, opts.atol);
-        // The sensitivities are in the error test (full error control, as SUNDIALS CVODES with
-        // `CVodeSetSensErrCon`): a step whose temperatures pass the test may still carry a
-        // tangent that is not the derivative of the solution (a thermostat's band crossed
-        // within a long step: the discrete tangent grows without bound).
-        let (dk, err) = match steps {
-            Steps::Adaptive if err <= 1.0 && !r.delta.is_empty() => {
-                let dk = r.tangents(t, &st);
-                let es = r.tangent_error(&dk, opts.rtol, opts.atol);
-                (Some(dk), err.max(es))
-            }
-            _ => (None, err),
-        };
         let accept = match steps {
             Steps::Adaptive => err <= 1.0,
             Steps::Fixed(_) => err.is_finite(),
         };
         if accept {
-            let (st, h_step, dk) = match r.locate_event(t, &st, opts) {
-                Some((located, h)) => (located, h, None),
-                None => (st, h_try, dk),
+            let (st, h_step) = match r.locate_event(t, &st, opts) {
+                Some(located) => located,
+                None => (st, h_try),
             };
-            r.accept(t, &st, dk);
+            r.accept(t, &st);
             out.steps.push(h_step);
             t = if h_step >= rest * (1.0 - 1e-9) {
                 seg.t1
