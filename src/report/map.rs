@@ -50,11 +50,11 @@ pub struct MapRow {
 }
 
 impl MapRow {
-    /// The row of a solved grid point; `oil` is the oil node index.
-    pub fn of(p: &MapPoint, oil: usize) -> MapRow {
-        let mut row = MapRow {
-            speed_rpm: p.speed_rpm,
-            torque_nm: p.torque_nm,
+    /// The row of an operating point with no result (every value empty, not converged).
+    fn unsolved(speed_rpm: f64, torque_nm: f64) -> MapRow {
+        MapRow {
+            speed_rpm,
+            torque_nm,
             efficiency: None,
             loss_total_w: None,
             loss_w: [None; N_SOURCES],
@@ -64,7 +64,12 @@ impl MapRow {
             limit_cycle_period_s: None,
             oil_min_c: None,
             oil_max_c: None,
-        };
+        }
+    }
+
+    /// The row of a solved grid point; `oil` is the oil node index.
+    pub fn of(p: &MapPoint, oil: usize) -> MapRow {
+        let mut row = MapRow::unsolved(p.speed_rpm, p.torque_nm);
         if let Some(e) = &p.equilibrium {
             row.efficiency = e.efficiency;
             row.loss_total_w = Some(e.by_source.iter().sum());
@@ -168,19 +173,7 @@ impl<'de> Visitor<'de> for RowVisitor {
 
     fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<MapRow, A::Error> {
         let (mut speed, mut torque, mut converged) = (None, None, None);
-        let mut row = MapRow {
-            speed_rpm: 0.0,
-            torque_nm: 0.0,
-            efficiency: None,
-            loss_total_w: None,
-            loss_w: [None; N_SOURCES],
-            oil_temp_c: None,
-            iterations: None,
-            converged: false,
-            limit_cycle_period_s: None,
-            oil_min_c: None,
-            oil_max_c: None,
-        };
+        let mut row = MapRow::unsolved(0.0, 0.0);
         while let Some(key) = map.next_key::<String>()? {
             match key.as_str() {
                 "speed_rpm" => speed = Some(map.next_value::<f64>()?),
