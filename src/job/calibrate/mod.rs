@@ -1010,23 +1010,7 @@ fn assemble(
         correlation,
         identifiability,
         channels,
-        fit: FitStats {
-            evaluations: res.evaluations,
-            iterations: res.iterations,
-            stop: serde_json::to_value(res.stop)
-                .ok()
-                .and_then(|v| v.as_str().map(String::from))
-                .unwrap_or_default(),
-            residual_model: o.residuals.clone(),
-            sigma_k: (noise.iter().map(|a| a.marginal_sd().powi(2)).sum::<f64>() / noise.len().max(1) as f64)
-                .sqrt(),
-            scale: lin.sigma2.sqrt(),
-            dof: lin.dof,
-            t975: t,
-            rtol: o.rtol,
-            atol: o.atol,
-            wall_time_s: clock.elapsed().as_secs_f64(),
-        },
+        fit: fit_stats(res, o, &noise, &lin, t, clock),
         profiles,
         plausibility,
         warnings,
@@ -1185,5 +1169,35 @@ impl super::command::ToArgs for CalibrateOptions {
             a.extend([flag("rated"), r.clone()]);
         }
         a
+    }
+}
+
+/// The fit's figures for `calibration.json`: its evaluations and stop, the residual model and its
+/// marginal σ (root mean square over the channels), the scale and degrees of freedom of the
+/// intervals, the tolerances and the wall time since `clock`.
+pub(super) fn fit_stats(
+    res: &lm::LmResult,
+    o: &CalibrateOptions,
+    noise: &[residuals::Ar1],
+    lin: &stats::Linearised,
+    t: f64,
+    clock: Instant,
+) -> FitStats {
+    let sigma2 = noise.iter().map(|a| a.marginal_sd().powi(2)).sum::<f64>();
+    FitStats {
+        evaluations: res.evaluations,
+        iterations: res.iterations,
+        stop: serde_json::to_value(res.stop)
+            .ok()
+            .and_then(|v| v.as_str().map(String::from))
+            .unwrap_or_default(),
+        residual_model: o.residuals.clone(),
+        sigma_k: (sigma2 / noise.len().max(1) as f64).sqrt(),
+        scale: lin.sigma2.sqrt(),
+        dof: lin.dof,
+        t975: t,
+        rtol: o.rtol,
+        atol: o.atol,
+        wall_time_s: clock.elapsed().as_secs_f64(),
     }
 }

@@ -6,9 +6,7 @@
 
 use std::time::Instant;
 
-use crate::report::calibration::{
-    fit_csv, CalibrationSummary, ChannelErrors, Errors, FitStats, Noise, TraceErrors,
-};
+use crate::report::calibration::{fit_csv, CalibrationSummary, ChannelErrors, Errors, Noise, TraceErrors};
 
 use super::lm::{self, Evaluation, LmOptions};
 use super::params::Parameter;
@@ -424,7 +422,7 @@ fn assemble(
         correlation,
         identifiability,
         channels,
-        fit: fit_stats(f, o, &ar, &lin, t, clock),
+        fit: super::fit_stats(&f.res, o, &ar, &lin, t, clock),
         profiles: Vec::new(),
         plausibility: None,
         warnings,
@@ -438,33 +436,6 @@ fn assemble(
         cycle_csv: String::new(),
         per_trace_models,
     })
-}
-
-fn fit_stats(
-    f: &Fitted,
-    o: &CalibrateOptions,
-    ar: &[Ar1],
-    lin: &stats::Linearised,
-    t: f64,
-    clock: Instant,
-) -> FitStats {
-    let res = &f.res;
-    FitStats {
-        evaluations: res.evaluations,
-        iterations: res.iterations,
-        stop: serde_json::to_value(res.stop)
-            .ok()
-            .and_then(|v| v.as_str().map(String::from))
-            .unwrap_or_default(),
-        residual_model: o.residuals.clone(),
-        sigma_k: (ar.iter().map(|a| a.marginal_sd().powi(2)).sum::<f64>() / ar.len().max(1) as f64).sqrt(),
-        scale: lin.sigma2.sqrt(),
-        dof: lin.dof,
-        t975: t,
-        rtol: o.rtol,
-        atol: o.atol,
-        wall_time_s: clock.elapsed().as_secs_f64(),
-    }
 }
 
 /// A trace name as part of a file name: letters, digits, `-`, `_` and `.` kept, others `_`.
