@@ -202,8 +202,10 @@ impl Model {
         }
     }
 
-    /// Counts of the checked model (JSON).
+    /// Counts of the checked model (JSON), after the checks `geartherm check` makes (the
+    /// model's `[uncertainty]` against the model).
     fn check(&self) -> PyResult<String> {
+        job::Model::check_text(&self.state.text, &self.m.file, &self.m.overrides).map_err(job_error)?;
         to_json(&self.m.check_report())
     }
 

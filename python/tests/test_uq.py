@@ -109,3 +109,22 @@ def test_a_dask_uq_equals_the_local_one_bit_for_bit(tmp_path: pathlib.Path) -> N
         pd.testing.assert_frame_equal(r.bands, local.bands, check_exact=True)
         pd.testing.assert_frame_equal(r.samples, local.samples, check_exact=True)
     assert (tmp_path / "dask" / "uq.json").is_file() and (tmp_path / "dask" / "bands.csv").is_file()
+
+
+def test_check_runs_the_uncertainty_checks_of_geartherm_check() -> None:
+    """`Model.check()` checks `[uncertainty]` against the model as `geartherm check` does: a key
+    path the model does not have is refused with the key path named."""
+    text = linear_model().text + (
+        "\n[[uncertainty.inputs]]\n"
+        "path = 'thermal.links[\"nope\"].conductance_w_per_k'\n"
+        'dist = "uniform"\nlo = 2.0\nhi = 4.0\n'
+    )
+    m = geartherm.Model.from_text(text, "linear.toml")
+    with pytest.raises(
+        geartherm.GearthermError,
+        match=re.escape(
+            "uncertainty.inputs[0].path = 'thermal.links[\"nope\"].conductance_w_per_k': not a key path of the model"
+        ),
+    ):
+        m.check()
+    assert linear_model().check()["thermal_nodes"] == 1

@@ -63,26 +63,17 @@ impl Model {
         let Ok(text) = super::read_text(path) else {
             return loaded;
         };
-        let mut problems = model::Problems::default();
-        let Some(mut doc) = model::parse::parse_document(&text, &mut problems) else {
-            return loaded;
-        };
-        if overrides
-            .iter()
-            .any(|ov| model::overrides::apply(&mut doc, ov).is_err())
-        {
-            return loaded;
-        }
-        let mut without = doc.clone();
-        if without.remove("uncertainty").is_none() {
+        with_uncertainty_checked(&text, path, overrides, loaded)
+    }
+
+    /// [`Model::check_file`] for model text (`file` names it in messages): what Python's
+    /// `Model.check()` runs.
+    pub fn check_text(text: &str, file: &Path, overrides: &[Override]) -> Result<Model, JobError> {
+        let loaded = Model::from_text(text, file, overrides);
+        if matches!(&loaded, Err(e) if e.kind != super::ErrorKind::Model) {
             return loaded;
         }
-        // The probes need the model itself valid.
-        if loaded.is_err() && model::from_document_with(without, path, &[]).is_err() {
-            return loaded;
-        }
-        model::check_uncertainty(&doc, path)?;
-        loaded
+        with_uncertainty_checked(text, file, overrides, loaded)
     }
 
     /// Check model text (`file` names it in messages) with `overrides`.
@@ -175,4 +166,35 @@ impl Model {
             )
         })
     }
+}
+
+/// `loaded` (the model checked without its `[uncertainty]` against the model), then the file's
+/// `[uncertainty]` with the overrides applied checked against the model; every problem of the
+/// section at once when the model without it is valid.
+fn with_uncertainty_checked(
+    text: &str,
+    path: &Path,
+    overrides: &[Override],
+    loaded: Result<Model, JobError>,
+) -> Result<Model, JobError> {
+    let mut problems = model::Problems::default();
+    let Some(mut doc) = model::parse::parse_document(text, &mut problems) else {
+        return loaded;
+    };
+    if overrides
+        .iter()
+        .any(|ov| model::overrides::apply(&mut doc, ov).is_err())
+    {
+        return loaded;
+    }
+    let mut without = doc.clone();
+    if without.remove("uncertainty").is_none() {
+        return loaded;
+    }
+    // The probes need the model itself valid.
+    if loaded.is_err() && model::from_document_with(without, path, &[]).is_err() {
+        return loaded;
+    }
+    model::check_uncertainty(&doc, path)?;
+    loaded
 }
