@@ -28,6 +28,10 @@ use geartherm::job::fmu::{slot, Causality, FmuModel, Payload, Role};
 use geartherm::job::{run, Model, RunOptions};
 use geartherm::scene::Inputs;
 
+#[path = "../examples/common/fmu_plan.rs"]
+mod fmu_plan;
+use fmu_plan::{plan, Point};
+
 const AT6: &str = "models/at6_lepelletier.toml";
 
 type Instantiate = unsafe extern "C" fn(
@@ -113,32 +117,6 @@ fn load(dir: &Path, payload: &Payload) -> Api {
         free: symbol(h, "fmi2FreeInstance"),
         guid: CString::new(slot::guid(&bytes)).unwrap(),
     }
-}
-
-/// One communication point: start, end, (value, derivative) of each boundary.
-type Point = (f64, f64, Vec<f64>, Vec<f64>);
-
-/// The importer's side of a WLTC co-simulation at communication step `step`: per 1 s sample,
-/// its inputs and its communication points.
-fn plan(p: &run::Prepared, step: f64) -> Vec<(Inputs, Vec<Point>)> {
-    let nb = p.scene.thermal().boundary_names.len();
-    let at = |k, t| p.scene.thermal().boundary_temperature_at(k, t).unwrap();
-    p.segs
-        .iter()
-        .map(|seg| {
-            let n = ((seg.t1 - seg.t0) / step).round().max(1.0) as usize;
-            let points = (0..n)
-                .map(|j| {
-                    let a = seg.t0 + (seg.t1 - seg.t0) * j as f64 / n as f64;
-                    let b = seg.t0 + (seg.t1 - seg.t0) * (j + 1) as f64 / n as f64;
-                    let x = (0..nb).map(|k| at(k, a)).collect();
-                    let d = (0..nb).map(|k| (at(k, b) - at(k, a)) / (b - a)).collect();
-                    (a, b, x, d)
-                })
-                .collect();
-            (seg.inputs, points)
-        })
-        .collect()
 }
 
 /// Value references of the variables the importer uses.

@@ -12,6 +12,9 @@
 #[path = "common/cpu.rs"]
 mod cpu;
 use cpu::cpu_time;
+#[path = "common/fmu_plan.rs"]
+mod fmu_plan;
+use fmu_plan::plan;
 
 use std::path::Path;
 use std::sync::Arc;
@@ -19,41 +22,12 @@ use std::sync::Arc;
 use geartherm::job::fmu::instance::Instance;
 use geartherm::job::fmu::{FmuModel, Payload, Role};
 use geartherm::job::{run, Model, RunOptions};
-use geartherm::scene::Inputs;
 
 const AT6: &str = "models/at6_lepelletier.toml";
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
-}
-
-/// The communication points of one segment: (start, end, (value, derivative) per boundary).
-type Points = Vec<(f64, f64, Vec<(f64, f64)>)>;
-
-/// The importer's side of a WLTC co-simulation at communication step `step`, computed before the
-/// clock starts (the boundary values are read from the run's series): per segment its inputs
-/// and communication points.
-fn plan(p: &run::Prepared, step: f64) -> Vec<(Inputs, Points)> {
-    let nb = p.scene.thermal().boundary_names.len();
-    let at = |k, t| p.scene.thermal().boundary_temperature_at(k, t).unwrap();
-    p.segs
-        .iter()
-        .map(|seg| {
-            let n = ((seg.t1 - seg.t0) / step).round().max(1.0) as usize;
-            let points = (0..n)
-                .map(|j| {
-                    let a = seg.t0 + (seg.t1 - seg.t0) * j as f64 / n as f64;
-                    let b = seg.t0 + (seg.t1 - seg.t0) * (j + 1) as f64 / n as f64;
-                    let lines = (0..nb)
-                        .map(|k| (at(k, a), (at(k, b) - at(k, a)) / (b - a)))
-                        .collect();
-                    (a, b, lines)
-                })
-                .collect();
-            (seg.inputs, points)
-        })
-        .collect()
 }
 
 /// One WLTC co-simulation at communication step `step`: (CPU seconds, doSteps).
@@ -79,8 +53,8 @@ fn cosim(fm: &Arc<FmuModel>, p: &run::Prepared, step: f64) -> (f64, usize) {
         inst.set(torque, i.input_torque).unwrap();
         inst.set(vehicle, i.vehicle_speed).unwrap();
         inst.set(gear, i.state as f64).unwrap();
-        for (a, b, lines) in points {
-            for (&r, &(x, d)) in boundaries.iter().zip(lines) {
+        for (a, b, x, d) in points {
+            for ((&r, &x), &d) in boundaries.iter().zip(x).zip(d) {
                 inst.set(r, x).unwrap();
                 inst.set_derivative(r, 1, d).unwrap();
             }

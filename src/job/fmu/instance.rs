@@ -64,6 +64,8 @@ pub struct Instance {
     lines: Vec<(f64, f64)>,
     /// Whether the outputs of each [`Part`] are those of the current state and inputs.
     fresh: [bool; 3],
+    /// The output variables of each [`Part`]: (position in `values`, role), found once.
+    parts: Arc<[Vec<(usize, Role)>; 3]>,
 }
 
 /// Positions in `values` of the inputs read at every step, found once per instance.
@@ -117,6 +119,17 @@ fn part_of(role: Role) -> Option<Part> {
         }
         _ => None,
     }
+}
+
+/// The output variables of each [`Part`] of `vars`: (position, role), in variable order.
+fn output_parts(vars: &[Variable]) -> [Vec<(usize, Role)>; 3] {
+    let mut parts: [Vec<(usize, Role)>; 3] = Default::default();
+    for (k, v) in vars.iter().enumerate() {
+        if let Some(p) = part_of(v.role) {
+            parts[p as usize].push((k, v.role));
+        }
+    }
+    parts
 }
 
 /// A started instance: the model with its parameters, its scene, the stepper, the envelope its
@@ -232,6 +245,7 @@ impl Instance {
             slots: Slots::of(&fm.vars),
             lines: Vec::new(),
             fresh: [false; 3],
+            parts: Arc::new(output_parts(&fm.vars)),
             fm,
         }
     }
@@ -441,7 +455,10 @@ impl Instance {
             self.rtol_set = true;
         }
         let old = std::mem::replace(&mut self.values[vr as usize - 1], x);
-        self.fresh = [false; 3];
+        // An importer sets its inputs at every point, mostly to the values in force.
+        if old.to_bits() != x.to_bits() {
+            self.fresh = [false; 3];
+        }
         if self.phase == Phase::Step && matches!(role, Role::Param(_)) && old != x {
             let time = self.time();
             if let Err(m) = self.retune() {
@@ -565,17 +582,18 @@ impl Instance {
         let Some(run) = self.run.as_mut() else {
             return Err("no run".into());
         };
-        let fm = &self.fm;
+        let outs = &self.parts[part as usize];
         let values = &mut self.values;
         let bad = match part {
-            Part::State => state_outputs(fm, run, inputs, values),
-            Part::Oil => oil_outputs(fm, run, values),
-            Part::Losses => loss_outputs(fm, run, inputs, values),
+            Part::State => state_outputs(outs, run, inputs, values),
+            Part::Oil => oil_outputs(outs, run, values),
+            Part::Losses => loss_outputs(outs, run, inputs, values),
         };
         if let Some(k) = bad {
             let t = run.stepper.time();
             self.phase = Phase::Error;
-            return Err(format!("t = {t} s: output {} is not finite", fm.vars[k].name));
+            let name = &self.fm.vars[k].name;
+            return Err(format!("t = {t} s: output {name} is not finite"));
         }
         self.fresh[part as usize] = true;
         Ok(())
@@ -587,9 +605,9 @@ impl Instance {
     }
 }
 
-/// The outputs of [`Part::State`] into `values` from the stepper's state; the position of the
-/// first that is not finite, if any.
-fn state_outputs(fm: &FmuModel, run: &Run, inputs: Inputs, values: &mut [f64]) -> Option<usize> {
+/// The outputs `outs` of [`Part::State`] into `values` from the stepper's state; the position
+/// of the first that is not finite, if any.
+fn state_outputs(outs: &[(usize, Role)], run: &Run, inputs: Inputs, values: &mut [f64]) -> Option<usize> {
     let (scene, y) = (&run.scene, run.stepper.state());
     // Loss energy per source, J: the sums of `Scene::loss_energy_by_source` in the same order.
     let n = scene.nodes();
@@ -604,8 +622,8 @@ fn state_outputs(fm: &FmuModel, run: &Run, inputs: Inputs, values: &mut [f64]) -
     let w = inputs.input_speed;
     let torque = inputs.input_torque;
     let ratio = run.model.gearbox.gear_states[inputs.state].ratio();
-    for (k, v) in fm.vars.iter().enumerate() {
-        let x = match v.role {
+    for &(k, role) in outs {
+        let x = match role {
             Role::NodeTemp(i) => y[i],
             Role::SourceEnergy(s) => energy[s.index()],
             Role::TotalEnergy => energy.iter().sum(),
@@ -621,17 +639,15 @@ fn state_outputs(fm: &FmuModel, run: &Run, inputs: Inputs, values: &mut [f64]) -
     None
 }
 
-/// The output of [`Part::Oil`] (the viscosity at the oil temperature of the stepper's state)
-/// into `values`; its position if it is not finite.
-fn oil_outputs(fm: &FmuModel, run: &Run, values: &mut [f64]) -> Option<usize> {
+/// The output `outs` of [`Part::Oil`] (the viscosity at the oil temperature of the stepper's
+/// state) into `values`; its position if it is not finite.
+fn oil_outputs(outs: &[(usize, Role)], run: &Run, values: &mut [f64]) -> Option<usize> {
     let nu = run.model.gearbox.oil.nu(run.scene.oil_temp(run.stepper.state()));
-    for (k, v) in fm.vars.iter().enumerate() {
-        if v.role == Role::OilViscosity {
-            if !nu.is_finite() {
-                return Some(k);
-            }
-            values[k] = nu;
+    for &(k, _) in outs {
+        if !nu.is_finite() {
+            return Some(k);
         }
+        values[k] = nu;
     }
     None
 }
@@ -645,9 +661,10 @@ fn source_items(items: &[LossItem]) -> [Vec<usize>; N_SOURCES] {
     by
 }
 
-/// The outputs of [`Part::Losses`] into `values`: the loss items evaluated at the stepper's
-/// state with the inputs in force; the position of the first that is not finite, if any.
-fn loss_outputs(fm: &FmuModel, run: &mut Run, inputs: Inputs, values: &mut [f64]) -> Option<usize> {
+/// The outputs `outs` of [`Part::Losses`] into `values`: the loss items evaluated at the
+/// stepper's state with the inputs in force; the position of the first that is not finite, if
+/// any.
+fn loss_outputs(outs: &[(usize, Role)], run: &mut Run, inputs: Inputs, values: &mut [f64]) -> Option<usize> {
     run.stepper.set_inputs(&run.scene, inputs);
     run.stepper.losses_into(&run.scene, &mut run.q);
     let q = &run.q;
@@ -664,8 +681,8 @@ fn loss_outputs(fm: &FmuModel, run: &mut Run, inputs: Inputs, values: &mut [f64]
         .map(|(_, p)| p)
         .sum();
     let (w, torque) = (inputs.input_speed, inputs.input_torque);
-    for (k, v) in fm.vars.iter().enumerate() {
-        let x = match v.role {
+    for &(k, role) in outs {
+        let x = match role {
             Role::SourceLoss(s) => by[s.index()],
             Role::TotalLoss => total,
             Role::Efficiency => efficiency(torque * w, total).unwrap_or(0.0),
