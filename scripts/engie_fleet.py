@@ -53,7 +53,7 @@ def main():
         cmd += ["--trace", f]
     for f in FIT:
         cmd += ["--fit", f]
-    cmd += ["--out", os.path.join(a.out, "fit")]
+    cmd += ["--max-iterations", "80", "--out", os.path.join(a.out, "fit")]
     load0 = os.getloadavg()
     before = os.times()
     t0 = time.monotonic()

@@ -123,6 +123,8 @@ pub fn minimise<E>(
     let mut nu = 2.0;
     // The cost at every accepted point.
     let mut history = vec![cost(&at)];
+    // After a rejected step: the longest next step, in the norm ‖D^½Δ‖.
+    let mut limit: Option<f64> = None;
     loop {
         let moving = held_at_bounds(&at, &theta, bounds, free);
         let jf = masked(&at.j, &moving);
@@ -169,6 +171,11 @@ pub fn minimise<E>(
             })
             .collect();
         let dx = DVector::from_fn(p, |k, _| trial[k] - theta[k]);
+        if limit.is_some_and(|l| scaled_norm(&dx, &diag) > l) {
+            mu = Some(m * nu);
+            nu *= 2.0;
+            continue;
+        }
         let norm_theta = DVector::from_column_slice(&theta).norm();
         if dx.norm() <= o.x_tol * (norm_theta + o.x_tol) {
             return Ok(LmResult {
@@ -190,6 +197,7 @@ pub fn minimise<E>(
         }
         let next = eval(&trial)?;
         evaluations += 1;
+        limit = None;
         // Gain ratio: actual over predicted decrease of the linear model.
         let predicted = -(g.dot(&dx)) - 0.5 * (&a * &dx).dot(&dx);
         let (c0, c1) = (cost(&at), cost(&next));
@@ -228,8 +236,31 @@ pub fn minimise<E>(
         } else {
             mu = Some(m * nu);
             nu *= 2.0;
+            limit = Some(shrink(g.dot(&dx), c0, c1) * scaled_norm(&dx, &diag));
         }
     }
+}
+
+/// ‖D^½Δ‖.
+fn scaled_norm(dx: &DVector<f64>, diag: &[f64]) -> f64 {
+    dx.iter().zip(diag).map(|(d, w)| d * d * w).sum::<f64>().sqrt()
+}
+
+/// The factor by which a rejected step's length is cut before the next trial: the minimiser of
+/// the parabola through the cost at the start (c0, slope `slope` = gᵀΔ < 0) and at the rejected
+/// point (c1), within [0.1, 0.5]; 0.1 when c1 is not finite. MINPACK's `lmder` cuts its trust
+/// radius on a failed step by this factor (Moré, Garbow & Hillstrom, User Guide for MINPACK-1,
+/// ANL-80-74, 1980). Raising μ alone (μ ← μ·ν) does not shorten a step taken with a damping far
+/// below the smallest eigenvalue of the scaled JᵀJ: the same point would be evaluated again.
+fn shrink(slope: f64, c0: f64, c1: f64) -> f64 {
+    if !c1.is_finite() || slope >= 0.0 {
+        return 0.1;
+    }
+    let curvature = c1 - c0 - slope;
+    if curvature <= 0.0 {
+        return 0.5;
+    }
+    (-slope / (2.0 * curvature)).clamp(0.1, 0.5)
 }
 
 /// The free parameters that move in this step: not those at a bound whose gradient component
@@ -394,5 +425,50 @@ mod tests {
         .unwrap();
         assert_eq!(res.stop, Stop::Singular);
         assert_eq!(res.evaluations, 1);
+    }
+
+    /// A step rejected under a damping far below the scaled JᵀJ's eigenvalues (here: the first
+    /// Gauss–Newton step of r = 10·tanh θ from θ = 3, 100 long) is not tried again nearly
+    /// unchanged: every trial after a rejection is at most half as far from the current point as
+    /// the rejected one, and the fit reaches θ = 0.
+    #[test]
+    fn a_rejected_step_is_shortened_before_the_next_evaluation() {
+        let mut trials: Vec<f64> = Vec::new();
+        let eval = |th: &[f64]| -> Result<Evaluation, ()> {
+            let t = th[0].tanh();
+            Ok(Evaluation {
+                r: DVector::from_vec(vec![10.0 * t]),
+                j: DMatrix::from_vec(1, 1, vec![10.0 * (1.0 - t * t)]),
+            })
+        };
+        let at0 = eval(&[3.0]).unwrap();
+        let res = minimise(
+            |th: &[f64]| {
+                trials.push(th[0]);
+                eval(th)
+            },
+            &[3.0],
+            at0,
+            &[(-200.0, 200.0)],
+            &[true],
+            &LmOptions::default(),
+        )
+        .unwrap();
+        println!("{trials:?}: {:?}, stop {:?}", res.theta, res.stop);
+        assert!(res.theta[0].abs() < 1e-6, "{:?}", res.theta);
+        // Rejected trials (cost above the current point's) and the one after each.
+        let mut current = 3.0_f64;
+        for w in trials.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            if a.tanh().abs() >= current.tanh().abs() {
+                assert!(
+                    (b - current).abs() <= 0.5 * (a - current).abs() + 1e-12,
+                    "{trials:?}"
+                );
+            } else {
+                current = a;
+            }
+        }
+        assert!(res.evaluations <= 20, "{} evaluations", res.evaluations);
     }
 }

@@ -1,0 +1,185 @@
+#!/usr/bin/env python3
+"""Both La Haute Borne turbines in one calibration (docs/validation.md, "Wind-turbine gearbox:
+both turbines in one fit"): the single-node MM82 model
+(validation/engie_la_haute_borne/mm82_sump_only.toml) fitted to R80711's AND R80721's spring
+2017 days 1–14 together, one gearbox type (loss levels and the housing's link to the nacelle
+shared) with a cooler per turbine, both turbines' days 15–27 held out, both turbines' summer
+2016 predicted by each turbine's calibrated model with the band of the fit; beside it the
+single-turbine fit (R80711 days 1–14) predicting the same rows.
+
+    python3 scripts/engie_turbines.py [--data DIR] [--out DIR] [--bin PATH]
+
+DIR holds the four period files R807*_2017-spring.csv, R807*_2016-summer.csv (default
+../shared/data/engie_la_haute_borne; OUT default /tmp/geartherm_turbines). Prints one table
+row per fit and held-out trace (sump RMSE, bias, fraction of the rows inside the 95 % band),
+the fitted values and the run times; writes OUT/figures.json. Nothing is tuned on the held-out
+rows: each fit sees days 1–14 only (--holdout 1209600:2400000 in each trace's own time).
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+
+MODEL = "validation/engie_la_haute_borne/mm82_sump_only.toml"
+PERIODS = ["R80711_2017-spring", "R80711_2016-summer", "R80721_2017-spring", "R80721_2016-summer"]
+HOLDOUT = "1209600:2400000"  # days 15–27 of a spring trace (s from its first row)
+CAP = 'thermal.coolers["oil_cooler"].capacity_rate_w_per_k'
+OPEN = 'thermal.coolers["oil_cooler"].thermostat.open_c'
+SHARED = [
+    "losses.multiplier.sliding=0.05:50",
+    "losses.multiplier.churning=0.01:100",
+    'thermal.links["gearbox-nacelle"].h_w_per_m2k=0.5:100',
+]
+# name: (--fit arguments, turbines fitted). The single-turbine fit is that of
+# scripts/engie_calibration.sh (same parameters, same bounds).
+FITS = {
+    "single R80711": (SHARED + [f"{CAP}=100:30000", f"{OPEN}=45:61"], ["R80711"]),
+    "both, cooler per turbine": (SHARED + [f"{CAP}@*=100:30000", f"{OPEN}=45:61"], ["R80711", "R80721"]),
+    "both, cooler and thermostat per turbine": (SHARED + [f"{CAP}@*=100:30000", f"{OPEN}@*=45:61"],
+                                                ["R80711", "R80721"]),
+}
+
+
+def run(cmd):
+    r = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    if r.returncode != 0:
+        sys.exit(f"{' '.join(cmd)}: exit {r.returncode}\n{r.stderr}")
+
+
+def traces(data, out):
+    src = os.path.join(out, "records")
+    os.makedirs(src, exist_ok=True)
+    for p in PERIODS:
+        link = os.path.join(src, p + ".csv")
+        if not os.path.exists(link):
+            os.symlink(os.path.abspath(os.path.join(data, p + ".csv")), link)
+    subprocess.run([sys.executable, "scripts/engie_traces.py", src, os.path.join(out, "traces")], check=True,
+                   stdout=subprocess.DEVNULL)
+    return os.path.join(out, "traces")
+
+
+def band_json(cal, turbine, trace_name, path):
+    """The fit's calibration.json restricted to the parameters `turbine`'s model holds: the shared
+    ones and its own (`KEY@trace_name` written as KEY), their covariance the sub-block of the
+    fit's (the marginal covariance of those coordinates), the residual process and t quantile
+    unchanged."""
+    keep, params = [], []
+    for k, p in enumerate(cal["parameters"]):
+        key = p["key_path"]
+        if "@" in key.rsplit("]", 1)[-1]:
+            base, owner = key.rsplit("@", 1)
+            if owner != trace_name:
+                continue
+            p = dict(p, key_path=base)
+        keep.append(k)
+        params.append(p)
+    out = dict(cal, parameters=params, covariance=[[cal["covariance"][i][j] for j in keep] for i in keep])
+    with open(path, "w") as fh:
+        json.dump(out, fh)
+    return path
+
+
+def rows_errors(fit_csv, t0=None):
+    """Sump RMSE, bias and the fraction inside the 95 % band over the rows from t0 (s) on."""
+    n = s2 = s1 = inside = 0
+    with open(fit_csv) as fh:
+        for x in csv.DictReader(fh):
+            if t0 is not None and float(x["time_s"]) < t0:
+                continue
+            r = float(x["sump_residual_k"])
+            n += 1
+            s2 += r * r
+            s1 += r
+            inside += abs(r) <= float(x["sump_band95_k"])
+    return {"rows": n, "rmse_k": math.sqrt(s2 / n), "bias_k": s1 / n, "inside_band95": inside / n}
+
+
+def predict(bin_, model, trace, band, out):
+    run([bin_, "calibrate", model, "--trace", trace, "--holdout", "0:1e9", "--band-from", band, "--out", out])
+    return os.path.join(out, "fit.csv")
+
+
+def whole(fit_csv):
+    """The prediction run's own figures over the whole trace (calibration.json's held-out rows)."""
+    h = json.load(open(os.path.join(os.path.dirname(fit_csv), "calibration.json")))["channels"][0]["holdout"]
+    return {k: h[k] for k in ("rows", "rmse_k", "bias_k", "inside_band95")}
+
+
+def one_fit(bin_, tr, name, fit, turbines, out):
+    d = os.path.join(out, name.replace(" ", "_").replace(",", ""))
+    cmd = [bin_, "calibrate", MODEL]
+    for t in turbines:
+        cmd += ["--trace", os.path.join(tr, f"{t}_2017-spring.csv")]
+    for f in fit:
+        cmd += ["--fit", f]
+    cmd += ["--holdout", HOLDOUT, "--max-iterations", "60", "--out", d]
+    before, t0 = os.times(), time.monotonic()
+    run(cmd)
+    after = os.times()
+    cal = json.load(open(os.path.join(d, "calibration.json")))
+    res = {"name": name, "wall_s": time.monotonic() - t0,
+           "cpu_s": after.children_user - before.children_user + after.children_system - before.children_system,
+           "evaluations": cal["fit"]["evaluations"], "stop": cal["fit"]["stop"],
+           "parameters": [{k: p[k] for k in ("key_path", "value", "ci95_low", "ci95_high")} for p in cal["parameters"]],
+           "noise": cal["channels"][0]["noise"], "rows": []}
+    by_trace = {t["name"].split("_")[0]: t for t in cal.get("traces", [])}
+    for turbine in ["R80711", "R80721"]:
+        spring, summer = f"{turbine}_2017-spring", f"{turbine}_2016-summer"
+        if turbine in turbines:
+            own = len(turbines) > 1
+            model = os.path.join(d, f"calibrated_{spring}.toml" if own else "calibrated.toml")
+            band = band_json(cal, turbine, spring, os.path.join(d, f"band_{turbine}.json")) if own else \
+                os.path.join(d, "calibration.json")
+            ch = (by_trace[turbine]["channels"][0] if own else cal["channels"][0])
+            res["rows"].append(dict(ch["fitted"], trace=f"{turbine} spring 2017 days 1–14 (fitted)"))
+            res["rows"].append(dict(ch["holdout"], trace=f"{turbine} spring 2017 days 15–27 (held out)"))
+        else:
+            model, band = os.path.join(d, "calibrated.toml"), os.path.join(d, "calibration.json")
+            f = predict(bin_, model, os.path.join(tr, f"{spring}.csv"), band, os.path.join(d, f"predict_{spring}"))
+            res["rows"].append(dict(rows_errors(f, 1209600.0), trace=f"{turbine} spring 2017 days 15–27 (predicted)"))
+            res["rows"].append(dict(whole(f), trace=f"{turbine} spring 2017 days 1–27 (predicted)"))
+        f = predict(bin_, model, os.path.join(tr, f"{summer}.csv"), band, os.path.join(d, f"predict_{summer}"))
+        res["rows"].append(dict(whole(f), trace=f"{turbine} summer 2016 (predicted)"))
+    return res
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--data", default="../shared/data/engie_la_haute_borne")
+    ap.add_argument("--out", default="/tmp/geartherm_turbines")
+    ap.add_argument("--bin", default="target/release/geartherm")
+    ap.add_argument("--only", help="run only the fit of this name")
+    a = ap.parse_args()
+    tr = traces(a.data, a.out)
+    load0 = os.getloadavg()[0]
+    results = []
+    for name, (fit, turbines) in FITS.items():
+        if a.only and a.only != name:
+            continue
+        r = one_fit(a.bin, tr, name, fit, turbines, a.out)
+        results.append(r)
+        print(f"## {name}: {r['evaluations']} evaluations (stop: {r['stop']}), wall {r['wall_s']:.1f} s, "
+              f"CPU {r['cpu_s']:.1f} s")
+        for p in r["parameters"]:
+            ci = "no interval (at a bound or not determined)" if p["ci95_low"] is None else \
+                f"[{p['ci95_low']:.4g}, {p['ci95_high']:.4g}]"
+            print(f"  {p['key_path']}: {p['value']:.4g} {ci}")
+        n = r["noise"]
+        print(f"  sump residuals (fitted rows): φ {n['phi']:.3f}, σ_a {n['innovation_sd_k']:.3f} K")
+        print("| trace | rows | sump RMSE, K | bias, K | inside the 95 % band |")
+        print("|---|---|---|---|---|")
+        for x in r["rows"]:
+            print(f"| {x['trace']} | {x['rows']} | {x['rmse_k']:.2f} | {x['bias_k']:+.2f} | "
+                  f"{100 * x['inside_band95']:.1f} % |")
+        print(flush=True)
+    print(f"load {load0:.1f} before, {os.getloadavg()[0]:.1f} after")
+    with open(os.path.join(a.out, "figures.json" if not a.only else "figures_one.json"), "w") as fh:
+        json.dump(results, fh, indent=2)
+
+
+if __name__ == "__main__":
+    main()
