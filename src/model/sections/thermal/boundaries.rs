@@ -64,10 +64,23 @@ impl BoundaryTemp {
 
     /// Temperature at time `t`, K.
     pub fn at(&self, t: f64) -> f64 {
+        self.at_from(t, &mut 0)
+    }
+
+    /// [`Self::at`], starting the search for the series piece at `hint` (the index of the first
+    /// point after `t` at the last call, updated): a right-hand side asks at times close to the
+    /// last, so the piece is usually the same or the next one. The same values as [`Self::at`].
+    pub fn at_from(&self, t: f64, hint: &mut usize) -> f64 {
         match self {
             BoundaryTemp::Fixed(v) => *v,
             BoundaryTemp::Series(s) => {
-                let k = s.partition_point(|p| p.0 <= t);
+                let after = |k: usize| (k == 0 || s[k - 1].0 <= t) && (k == s.len() || s[k].0 > t);
+                let k = match *hint {
+                    h if h <= s.len() && after(h) => h,
+                    h if h < s.len() && after(h + 1) => h + 1,
+                    _ => s.partition_point(|p| p.0 <= t),
+                };
+                *hint = k;
                 if k == 0 {
                     s[0].1
                 } else if k == s.len() {
