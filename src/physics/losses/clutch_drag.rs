@@ -248,6 +248,23 @@ mod tests {
     }
 
     #[test]
+    fn drag_with_the_face_factor_is_bitwise_drag() {
+        let p = pack();
+        let face = p.face_factor();
+        for (w, mu) in [
+            (0.0, 0.02),
+            (1.0, 0.02),
+            (50.0, 0.01),
+            (400.0, 0.005),
+            (-300.0, 0.1),
+        ] {
+            let (a, b) = (p.drag(w, mu, 850.0), p.drag_with(w, mu, 850.0, face));
+            assert_eq!(a.power.to_bits(), b.power.to_bits(), "slip {w}");
+            assert_eq!(a.film_radius.to_bits(), b.film_radius.to_bits(), "slip {w}");
+        }
+    }
+
+    #[test]
     fn below_the_critical_slip_the_film_is_complete_and_drag_is_couette() {
         let p = pack();
         let (mu, rho) = (0.02, 850.0);

@@ -162,3 +162,34 @@ fn series(s: &[[f64; 2]], p: &str, problems: &mut Problems) -> Option<BoundaryTe
     }
     ok.then(|| BoundaryTemp::Series(s.iter().map(|pt| (pt[0], c_to_k(pt[1]))).collect()))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lookup_from_a_hint_is_the_plain_lookup() {
+        let b = BoundaryTemp::Series(vec![(0.0, 300.0), (10.0, 310.0), (20.0, 305.0), (30.0, 320.0)]);
+        let mut hint = 0;
+        // Forward, backward, repeated, outside the series and NaN, each against `at`.
+        for t in [
+            -5.0,
+            0.0,
+            3.0,
+            10.0,
+            12.5,
+            12.5,
+            29.9,
+            30.0,
+            45.0,
+            1.0,
+            25.0,
+            f64::NAN,
+            15.0,
+        ] {
+            let (a, b2) = (b.at(t), b.at_from(t, &mut hint));
+            assert_eq!(a.to_bits(), b2.to_bits(), "t = {t}");
+        }
+        assert_eq!(BoundaryTemp::Fixed(290.0).at_from(7.0, &mut hint), 290.0);
+    }
+}
