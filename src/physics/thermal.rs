@@ -113,19 +113,37 @@ pub fn rotating_disc_h_slope(
     dln_nu: f64,
     dln_pr: f64,
 ) -> (f64, f64) {
-    let (h, eps) = disc_h_and_re_exponent(omega, radius, fluid);
+    rotating_disc_h_slope_with(omega, radius, fluid, fluid.prandtl.cbrt(), dln_nu, dln_pr)
+}
+
+/// [`rotating_disc_h_slope`] with the fluid's Pr^(1/3) `pr_cbrt` given (`fluid.prandtl.cbrt()`,
+/// shared by every part turning in the same fluid); the same values.
+pub fn rotating_disc_h_slope_with(
+    omega: f64,
+    radius: f64,
+    fluid: &FluidProperties,
+    pr_cbrt: f64,
+    dln_nu: f64,
+    dln_pr: f64,
+) -> (f64, f64) {
+    let (h, eps) = disc_h_and_re_exponent_with(omega, radius, fluid, pr_cbrt);
     (h, h * (-eps * dln_nu + dln_pr / 3.0))
 }
 
 /// h of [`rotating_disc_h`] and the blend's Reynolds exponent ε (0 at rest).
 fn disc_h_and_re_exponent(omega: f64, radius: f64, fluid: &FluidProperties) -> (f64, f64) {
+    disc_h_and_re_exponent_with(omega, radius, fluid, fluid.prandtl.cbrt())
+}
+
+/// [`disc_h_and_re_exponent`] with Pr^(1/3) `pr_cbrt` given.
+fn disc_h_and_re_exponent_with(omega: f64, radius: f64, fluid: &FluidProperties, pr_cbrt: f64) -> (f64, f64) {
     let re = omega.abs() * radius * radius / fluid.kinematic_viscosity;
     let nu_l = 0.36 * re.sqrt();
     // Re^0.8 as exp(0.8 ln Re) (Re = 0: ln = −∞, the power 0) and x^(1/4) as √√x: the same
     // values to rounding, at a fraction of powf's cost (this runs per link and RHS).
     let nu_t = 0.015 * (0.8 * re.ln()).exp();
     let (l4, t4) = (nu_l.powi(4), nu_t.powi(4));
-    let nu = (l4 + t4).sqrt().sqrt() * fluid.prandtl.cbrt();
+    let nu = (l4 + t4).sqrt().sqrt() * pr_cbrt;
     let eps = if l4 + t4 > 0.0 {
         (0.5 * l4 + 0.8 * t4) / (l4 + t4)
     } else {

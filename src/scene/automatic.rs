@@ -24,6 +24,8 @@ struct PackEntry {
     feed: Option<usize>,
     /// Per gear state: |slip| per unit input speed.
     slip: Vec<f64>,
+    /// The pack's [`ClutchPack::face_factor`] (geometry only), m².
+    face: f64,
 }
 
 #[derive(Debug, Clone)]
@@ -106,6 +108,7 @@ impl AutoLosses {
                 pack: cp.pack,
                 feed,
                 slip,
+                face: cp.pack.face_factor(),
             });
             items.push(LossItem {
                 source: Source::ClutchDrag,
@@ -247,7 +250,7 @@ impl AutoLosses {
             if let Some(c) = p.feed {
                 pack.oil_flow = feed_flow(c);
             }
-            out[p.item] = pack.drag(p.slip[state] * w, oil.mu, oil.rho).power;
+            out[p.item] = pack.drag_with(p.slip[state] * w, oil.mu, oil.rho, p.face).power;
         }
         if self.pump.is_none() && self.converter.is_none() {
             return;

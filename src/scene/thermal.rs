@@ -11,7 +11,7 @@ use crate::model::gearbox::{GearMount, Gearbox};
 use crate::model::thermal::{BoundaryTemp, Fluid, HeatTarget, LinkLaw, NodeRef, ThermalNetwork};
 use crate::physics::oil::{Oil, OilLogSlopes, OilProperties};
 use crate::physics::thermal::{
-    h_power_law, radiation_derivative, radiation_power, rotating_disc_h, rotating_disc_h_slope,
+    h_power_law, radiation_derivative, radiation_power, rotating_disc_h, rotating_disc_h_slope_with,
     thermostat_opening, FluidProperties, HTable, AIR_50C, OIL_CONDUCTIVITY, OIL_SPECIFIC_HEAT,
 };
 
@@ -220,6 +220,8 @@ pub struct NetworkWork {
     pub sample_g: Vec<f64>,
     /// Boundary temperatures at the current time, K.
     pub boundary_t: Vec<f64>,
+    /// Per boundary: where its series lookup starts ([`BoundaryTemp::at_from`]).
+    boundary_hint: Vec<usize>,
     /// Their rates of change, K/s ([`ThermalScene::boundary_slopes`]).
     pub boundary_slope: Vec<f64>,
     /// Mode of every controller ([`ControlTerm`]); the integrators change it only at events.
@@ -620,6 +622,7 @@ impl ThermalScene {
         NetworkWork {
             sample_g: vec![0.0; self.sample.len()],
             boundary_t: self.boundaries.iter().map(|b| b.at(0.0)).collect(),
+            boundary_hint: vec![0; self.boundaries.len()],
             boundary_slope: vec![0.0; self.boundaries.len()],
             mode: self
                 .controls
@@ -696,8 +699,9 @@ impl ThermalScene {
 
     /// Boundary temperatures at time `t` (call at each RHS evaluation; constant ones are cheap).
     pub fn boundary_temperatures(&self, t: f64, work: &mut NetworkWork) {
-        for (x, b) in work.boundary_t.iter_mut().zip(&self.boundaries) {
-            *x = b.at(t);
+        let hints = work.boundary_hint.iter_mut();
+        for ((x, b), h) in work.boundary_t.iter_mut().zip(&self.boundaries).zip(hints) {
+            *x = b.at_from(t, h);
         }
     }
 
@@ -993,6 +997,7 @@ impl ThermalScene {
     ) {
         let fluid = oil_fluid(oil);
         let dln_pr = slopes.nu + slopes.rho;
+        let pr_cbrt = fluid.prandtl.cbrt();
         for ((g, dg), l) in g.iter_mut().zip(dg.iter_mut()).zip(&self.oil_links) {
             (*g, *dg) = match &l.law {
                 OilLaw::Rotating {
@@ -1001,7 +1006,7 @@ impl ThermalScene {
                     speed_per_input,
                 } => {
                     let w = speed_per_input[op.state] * op.input_speed;
-                    let (h, dh) = rotating_disc_h_slope(w, *radius, &fluid, slopes.nu, dln_pr);
+                    let (h, dh) = rotating_disc_h_slope_with(w, *radius, &fluid, pr_cbrt, slopes.nu, dln_pr);
                     (area * h, area * dh)
                 }
                 OilLaw::Advection { consumer } => (

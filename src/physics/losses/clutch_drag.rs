@@ -128,8 +128,12 @@ impl ClutchPack {
     /// `slip` (rad/s): π·ρ·Δω²·h³·(r² − r_i²)/(40·μ·ln(r/r_i)); its limit at r → r_i is
     /// π·ρ·Δω²·h³·2r_i²/(40·μ).
     pub fn film_flow(&self, r: f64, slip: f64, mu: f64, rho: f64) -> f64 {
-        let h = self.clearance;
-        PI * rho * slip * slip * h.powi(3) * g(r, self.inner_radius) / (40.0 * mu)
+        Self::flow_with(self.clearance, slip, mu, rho, g(r, self.inner_radius))
+    }
+
+    /// π·ρ·Δω²·h³·`gr`/(40·μ) with `gr` = (r² − r_i²)/ln(r/r_i).
+    fn flow_with(h: f64, slip: f64, mu: f64, rho: f64, gr: f64) -> f64 {
+        PI * rho * slip * slip * h.powi(3) * gr / (40.0 * mu)
     }
 
     /// Critical slip speed (rad/s) up to which the film is complete: above it the supplied flow
@@ -144,9 +148,14 @@ impl ClutchPack {
     /// density `rho`: r_o while the supply covers the full-film flow Q_n, else
     /// r_e² = r_i² + (q/Q_n)·(r_o² − r_i²) (the wetted fraction of the face is q/Q_n).
     pub fn film_radius(&self, slip: f64, mu: f64, rho: f64) -> f64 {
+        self.film_radius_with(slip, mu, rho, self.face_factor())
+    }
+
+    /// [`Self::film_radius`] with the pack's [`Self::face_factor`] `face` given.
+    fn film_radius_with(&self, slip: f64, mu: f64, rho: f64, face: f64) -> f64 {
         let (ri, ro) = (self.inner_radius, self.outer_radius);
         let q = self.oil_flow / self.interfaces;
-        let need = self.film_flow(ro, slip.abs(), mu, rho);
+        let need = Self::flow_with(self.clearance, slip.abs(), mu, rho, face);
         if q >= need {
             return ro;
         }
@@ -156,6 +165,18 @@ impl ClutchPack {
     /// Drag of the pack at slip speed `slip` (rad/s, either sign), oil dynamic viscosity `mu`
     /// (Pa·s) and density `rho` (kg/m³). No allocation.
     pub fn drag(&self, slip: f64, mu: f64, rho: f64) -> Drag {
+        self.drag_with(slip, mu, rho, self.face_factor())
+    }
+
+    /// The geometric factor (r_o² − r_i²)/ln(r_o/r_i) of the full face, m², that the full-film
+    /// flow `Q_n` and [`Self::drag_with`] take: a constant of the pack.
+    pub fn face_factor(&self) -> f64 {
+        g(self.outer_radius, self.inner_radius)
+    }
+
+    /// [`Self::drag`] with the pack's [`Self::face_factor`] `face` given (computed once per
+    /// pack instead of per call; the same values). No allocation.
+    pub fn drag_with(&self, slip: f64, mu: f64, rho: f64, face: f64) -> Drag {
         let w = slip.abs();
         if w == 0.0 {
             return Drag {
@@ -164,7 +185,7 @@ impl ClutchPack {
                 film_radius: self.outer_radius,
             };
         }
-        let re = self.film_radius(w, mu, rho);
+        let re = self.film_radius_with(w, mu, rho, face);
         let h = self.clearance;
         let film = couette_torque(mu, w, h, self.inner_radius, re);
         let mist = couette_torque(self.mist_viscosity_ratio * mu, w, h, re, self.outer_radius);
@@ -224,6 +245,23 @@ mod tests {
             PI * 0.38 * 7.8 * 0.3f64.powi(4) / (32.0 * 2e-3),
             max_relative = 1e-12
         );
+    }
+
+    #[test]
+    fn drag_with_the_face_factor_is_bitwise_drag() {
+        let p = pack();
+        let face = p.face_factor();
+        for (w, mu) in [
+            (0.0, 0.02),
+            (1.0, 0.02),
+            (50.0, 0.01),
+            (400.0, 0.005),
+            (-300.0, 0.1),
+        ] {
+            let (a, b) = (p.drag(w, mu, 850.0), p.drag_with(w, mu, 850.0, face));
+            assert_eq!(a.power.to_bits(), b.power.to_bits(), "slip {w}");
+            assert_eq!(a.film_radius.to_bits(), b.film_radius.to_bits(), "slip {w}");
+        }
     }
 
     #[test]

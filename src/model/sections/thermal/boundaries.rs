@@ -64,10 +64,23 @@ impl BoundaryTemp {
 
     /// Temperature at time `t`, K.
     pub fn at(&self, t: f64) -> f64 {
+        self.at_from(t, &mut 0)
+    }
+
+    /// [`Self::at`], starting the search for the series piece at `hint` (the index of the first
+    /// point after `t` at the last call, updated): a right-hand side asks at times close to the
+    /// last, so the piece is usually the same or the next one. The same values as [`Self::at`].
+    pub fn at_from(&self, t: f64, hint: &mut usize) -> f64 {
         match self {
             BoundaryTemp::Fixed(v) => *v,
             BoundaryTemp::Series(s) => {
-                let k = s.partition_point(|p| p.0 <= t);
+                let after = |k: usize| (k == 0 || s[k - 1].0 <= t) && (k == s.len() || s[k].0 > t);
+                let k = match *hint {
+                    h if h <= s.len() && after(h) => h,
+                    h if h < s.len() && after(h + 1) => h + 1,
+                    _ => s.partition_point(|p| p.0 <= t),
+                };
+                *hint = k;
                 if k == 0 {
                     s[0].1
                 } else if k == s.len() {
@@ -148,4 +161,35 @@ fn series(s: &[[f64; 2]], p: &str, problems: &mut Problems) -> Option<BoundaryTe
         }
     }
     ok.then(|| BoundaryTemp::Series(s.iter().map(|pt| (pt[0], c_to_k(pt[1]))).collect()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lookup_from_a_hint_is_the_plain_lookup() {
+        let b = BoundaryTemp::Series(vec![(0.0, 300.0), (10.0, 310.0), (20.0, 305.0), (30.0, 320.0)]);
+        let mut hint = 0;
+        // Forward, backward, repeated, outside the series and NaN, each against `at`.
+        for t in [
+            -5.0,
+            0.0,
+            3.0,
+            10.0,
+            12.5,
+            12.5,
+            29.9,
+            30.0,
+            45.0,
+            1.0,
+            25.0,
+            f64::NAN,
+            15.0,
+        ] {
+            let (a, b2) = (b.at(t), b.at_from(t, &mut hint));
+            assert_eq!(a.to_bits(), b2.to_bits(), "t = {t}");
+        }
+        assert_eq!(BoundaryTemp::Fixed(290.0).at_from(7.0, &mut hint), 290.0);
+    }
 }
