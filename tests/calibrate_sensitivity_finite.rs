@@ -70,7 +70,6 @@ fn trace_text() -> String {
 }
 
 #[test]
-#[ignore = "open: the tangents leave the error test, so they reach NaN at a thermostat's edge (docs/calibration.md)"]
 fn sensitivities_stay_finite_at_the_thermostats_edge() {
     let text = std::fs::read_to_string(MODEL).unwrap();
     let sets: Vec<geartherm::model::Override> = POINT
