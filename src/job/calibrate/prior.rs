@@ -89,7 +89,7 @@ impl std::str::FromStr for PriorSpec {
         let (path, rest) = text
             .rsplit_once('=')
             .ok_or_else(|| bad_prior(text, "no '=' between key path and distribution"))?;
-        let (path, owner) = super::stack::split_owner(path.trim());
+        let (path, owner) = super::params::split_owner(path.trim());
         let path: KeyPath = path
             .trim()
             .parse()

@@ -14,7 +14,7 @@ use crate::model::Override;
 use crate::solve::sensitivity::SensitivityOptions;
 
 use super::lm::Evaluation;
-use super::params::{canonical, split_bounds, FitSpec, Parameter};
+use super::params::{canonical, split_bounds, split_owner, FitSpec, Parameter};
 use super::prior::{PriorSpec, Priors};
 use super::problem::{initial_overrides, Problem};
 use super::residuals::Layout;
@@ -172,24 +172,6 @@ pub struct Stack<'a> {
 
 fn fit_error(arg: &str, allowed: &str, msg: String) -> JobError {
     JobError::option("fit", arg, allowed, msg)
-}
-
-/// The `@TRACE` of a key path (the last `@` outside quotes and brackets), if any.
-pub fn split_owner(path: &str) -> (&str, Option<&str>) {
-    let (mut in_quotes, mut depth, mut at) = (false, 0i32, None);
-    for (k, c) in path.char_indices() {
-        match c {
-            '"' => in_quotes = !in_quotes,
-            '[' if !in_quotes => depth += 1,
-            ']' if !in_quotes => depth -= 1,
-            '@' if !in_quotes && depth == 0 => at = Some(k),
-            _ => {}
-        }
-    }
-    match at {
-        Some(k) => (&path[..k], Some(&path[k + 1..])),
-        None => (path, None),
-    }
 }
 
 /// Parse `KEYPATH[@TRACE][=LO:HI]` against the traces' names.

@@ -60,7 +60,7 @@ pub struct BandSource<'a> {
 /// trace `name` (`KEYPATH@name`); with parameters of other traces only, none of `name`'s, the
 /// trace's own values are unknown: invalid input naming the trace.
 fn parameters_of(c: &JsonCalibration, name: &str, file: &str) -> Result<Vec<usize>, JobError> {
-    let owner = |q: &JsonParameter| super::stack::split_owner(&q.key_path).1.map(str::to_string);
+    let owner = |q: &JsonParameter| super::params::split_owner(&q.key_path).1.map(str::to_string);
     let owned: Vec<String> = c.parameters.iter().filter_map(owner).collect();
     if !owned.is_empty() && !owned.iter().any(|o| o == name) {
         let mut traces = owned.clone();
@@ -108,7 +108,7 @@ pub fn band_source<'a>(
     let mut params = Vec::with_capacity(kept.len());
     for &k in &kept {
         let q = &c.parameters[k];
-        let key = super::stack::split_owner(&q.key_path).0;
+        let key = super::params::split_owner(&q.key_path).0;
         let spec: FitSpec = format!("{key}={}:{}", q.lower_bound, q.upper_bound)
             .parse()
             .map_err(|e: String| bad(format!("parameters[{k}]: {e}")))?;
