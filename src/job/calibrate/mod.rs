@@ -976,7 +976,12 @@ fn assemble(
             res.evaluations
         ));
     }
-    let sim = pr.simulate(&res.theta, !pr.params.is_empty())?;
+    // A prediction with a band from a calibration runs at that calibration's parameters: the
+    // model's values, a per-trace parameter of this trace the calibration's value for it.
+    let sim = match &p.band_source {
+        Some(b) => b.problem.simulate(&b.problem.start(), true)?,
+        None => pr.simulate(&res.theta, !pr.params.is_empty())?,
+    };
     if let Some(b) = &sim.breach {
         return Err(breach_error(p, &res.theta, b));
     }
@@ -988,10 +993,7 @@ fn assemble(
         vec![a; pr.channels.len()]
     });
     let (band, band_known) = match &p.band_source {
-        Some(b) => {
-            let s = b.problem.simulate(&b.problem.start(), true)?;
-            (bands::half_widths(&s, &b.covariance, &b.noise, b.t975), true)
-        }
+        Some(b) => (bands::half_widths(&sim, &b.covariance, &b.noise, b.t975), true),
         None => (
             bands::half_widths(&sim, &lin.covariance, &noise, t),
             !f.layout.stretch.is_empty(),

@@ -109,12 +109,15 @@ fn local_cov(s: &Stack<'_>, k: usize, cov: &[Vec<f64>]) -> Vec<Vec<f64>> {
 /// trajectory that leaves the physics envelope as an error (exit 2).
 fn final_sims(s: &Stack<'_>, theta: &[f64]) -> Result<Vec<Simulation>, JobError> {
     use rayon::prelude::*;
+    // A prediction with its band from a calibration runs each segment at that calibration's
+    // parameters (a per-trace one at its trace's value), with their sensitivities.
     let sims: Vec<Simulation> = (0..s.segments.len())
         .into_par_iter()
-        .map(|k| {
-            s.segments[k]
+        .map(|k| match s.bands.get(k) {
+            Some(b) => b.problem.simulate(&b.problem.start(), true),
+            None => s.segments[k]
                 .problem
-                .simulate(&s.local_theta(k, theta), !s.params.is_empty())
+                .simulate(&s.local_theta(k, theta), !s.params.is_empty()),
         })
         .collect::<Result<_, _>>()?;
     for (k, sim) in sims.iter().enumerate() {
@@ -154,10 +157,7 @@ fn residual_rows(
         .map(|k| {
             let (g, sim) = (&s.segments[k], &sims[k]);
             let half = match s.bands.get(k) {
-                Some(b) => {
-                    let at = b.problem.simulate(&b.problem.start(), true)?;
-                    bands::half_widths(&at, &b.covariance, &b.noise, b.t975)
-                }
+                Some(b) => bands::half_widths(sim, &b.covariance, &b.noise, b.t975),
                 None => {
                     let mut local = noise.to_vec();
                     for (c, &col) in g.perm.iter().enumerate() {

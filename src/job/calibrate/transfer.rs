@@ -2,7 +2,10 @@
 //! the previous calibration's covariance of its fitted coordinates carried through the
 //! sensitivities on this trace, plus each channel's residual process as that calibration
 //! estimated it (the same half-width formula as [`super::bands`]). The model run is the
-//! calibrated one (`calibrated.toml`): the parameters are evaluated at the values it holds.
+//! calibrated one (`calibrated.toml`): the parameters are evaluated at the values it holds,
+//! except a parameter of one trace in a calibration over several (`KEYPATH@X`), which a
+//! prediction of trace X takes at the calibration's value for X (the model file holds one
+//! trace's value).
 
 use serde::Deserialize;
 
@@ -14,6 +17,7 @@ use crate::job::JobError;
 #[derive(Deserialize)]
 struct JsonParameter {
     key_path: String,
+    value: f64,
     lower_bound: f64,
     upper_bound: f64,
     scale: String,
@@ -112,8 +116,18 @@ pub fn band_source<'a>(
         let spec: FitSpec = format!("{key}={}:{}", q.lower_bound, q.upper_bound)
             .parse()
             .map_err(|e: String| bad(format!("parameters[{k}]: {e}")))?;
-        let p = Parameter::resolve(&spec, doc)
+        let mut p = Parameter::resolve(&spec, doc)
             .map_err(|e| bad(format!("parameters[{k}] ({}): {e}", q.key_path)))?;
+        if super::params::split_owner(&q.key_path).1.is_some() {
+            // The model file holds one trace's value; trace `name`'s is the calibration's.
+            if !(q.value.is_finite() && (q.lower_bound..=q.upper_bound).contains(&q.value)) {
+                return Err(bad(format!(
+                    "parameters[{k}] ({}): value {} must lie in its bounds [{}, {}]",
+                    q.key_path, q.value, q.lower_bound, q.upper_bound
+                )));
+            }
+            p.start = q.value;
+        }
         if (q.scale == "log") != p.log {
             return Err(bad(format!(
                 "parameters[{k}] ({}): scale {} does not match the model's value {}",
