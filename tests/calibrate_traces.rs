@@ -2,8 +2,8 @@
 //! of a file (a gap in time starts one) from its own measured temperatures, the AR(1) process
 //! restarted at every segment; a stack of one segment is the fit of that segment; bad input
 //! (a trace index out of range, `@N` with one trace, the same file twice, traces measuring
-//! other nodes, an empty segment list, a parameter no trace influences) exits 1 and writes
-//! nothing.
+//! other nodes or with other columns, a node the model does not have, an empty segment list, a
+//! parameter no trace influences) exits 1 and writes nothing.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -319,11 +319,37 @@ fn bad_trace_lists_are_refused() {
         ],
         &["fit", "stavytskyi_ks", "none of the traces"],
     );
-    // Options of a single-segment fit.
+    // Traces with different columns: a boundary column one has and the other lacks.
+    let e = d.join("e.csv");
+    let text = two_segments(11.0, 3)
+        .replace(",boundary:ambient", "")
+        .lines()
+        .map(|l| {
+            let mut cells: Vec<&str> = l.split(',').collect();
+            if cells.len() == 7 {
+                cells.remove(4);
+            }
+            cells.join(",")
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(&e, text + "\n").unwrap();
     refused(
         &d,
-        &["--trace", &a, "--trace", &b, h, "--residuals", "ar1-gls"],
-        &["residuals", "several traces"],
+        &["--trace", &a, "--trace", e.to_str().unwrap(), h],
+        &["trace", "e.csv", "boundary:ambient", "same columns"],
+    );
+    // A measured column the model does not have.
+    let f = d.join("f.csv");
+    std::fs::write(
+        &f,
+        two_segments(11.0, 3).replace(",node:housing", ",node:bearing_x"),
+    )
+    .unwrap();
+    refused(
+        &d,
+        &["--trace", &a, "--trace", f.to_str().unwrap(), h],
+        &["f.csv", "node:bearing_x"],
     );
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -82,7 +82,9 @@ pub struct CalibrateArgs {
     #[arg(long, value_name = "RPM:NM", allow_hyphen_values = true)]
     pub rated: Option<String>,
     /// For a prediction (no --fit, every row held out): the 95 % band from a previous
-    /// calibration's calibration.json (its covariance and residual process).
+    /// calibration's calibration.json (its covariance and residual process). With several
+    /// traces each trace's band, from the calibration's shared parameters and those of the
+    /// trace of the same name.
     #[arg(long, value_name = "calibration.json")]
     pub band_from: Option<PathBuf>,
     /// Print calibration.json on stdout.
@@ -212,13 +214,12 @@ fn calibrate_traces(
         );
         files.push((name, TraceFile::load(path, o.missing())?));
     }
-    if let Some(path) = &args.band_from {
-        let shown = path.display().to_string();
-        let msg = format!("band_from = {shown}: only for a prediction of one trace segment");
-        return Err(crate::job::JobError::option("band_from", &shown, "a run of one segment", msg).into());
-    }
     let inputs = calibrate::stack::inputs(&files, o)?;
-    let stack = calibrate::stack::prepare(m, text, &inputs, o)?;
+    let mut stack = calibrate::stack::prepare(m, text, &inputs, o)?;
+    if let Some(path) = &args.band_from {
+        let json = crate::job::read_text(path)?;
+        stack.band_from(&json, &path.display().to_string())?;
+    }
     let out = OutputDir::begin(&out_dir(args, m))?;
     let result = calibrate::stack_fit::fit(m, &stack, o, &|th| stack.evaluate(th))?;
     finish(args, out, &result, false)

@@ -314,6 +314,10 @@ pub struct TraceErrors {
     pub rows: usize,
     /// Errors per measured channel (its `noise` is the common residual process's).
     pub channels: Vec<ChannelErrors>,
+    /// With parameters of one trace: the trace's calibrated model's losses at its
+    /// highest-power rows (and at the rated point).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plausibility: Option<Plausibility>,
 }
 
 /// `fit.csv`: `time_s,holdout`, then per channel `<node>_measured_c,<node>_simulated_c,
@@ -372,6 +376,47 @@ fn trace_table(s: &CalibrationSummary) -> String {
                 e(&c.holdout)
             ));
         }
+    }
+    t
+}
+
+/// The calibrated losses at the highest-power rows and the rated point, each line starting
+/// with `label`.
+fn plausibility_text(label: &str, p: &Plausibility) -> String {
+    let mut t = String::new();
+    let line = |what: &str, x: &LossAt| {
+        let by: Vec<String> = x
+            .loss_by_source_w
+            .iter()
+            .map(|(k, v)| format!("{k} {:.1}", v / 1e3))
+            .collect();
+        format!(
+            "{label}{what}: {:.0} kW at {:.0} rpm, {:.0} N m, oil {:.1} °C: loss {:.1} kW ({}), efficiency {}\n",
+            x.power_w / 1e3,
+            x.input_speed_rpm,
+            x.input_torque_nm,
+            x.oil_temp_c,
+            x.loss_total_w / 1e3,
+            by.join(", "),
+            x.efficiency.map_or("—".into(), |e| format!("{e:.4}"))
+        )
+    };
+    t.push_str(&line(
+        &format!("highest-power rows ({})", p.rows),
+        &p.highest_power,
+    ));
+    if let Some(r) = &p.rated {
+        t.push_str(&line("rated point", r));
+    }
+    if let Some(r) = &p.reference {
+        t.push_str(&format!(
+            "  {label}{} gearbox: {} ({}); the model: {:.2} % ({})\n",
+            r.kind,
+            r.statement,
+            r.source,
+            100.0 * r.loss_share,
+            if r.inside { "within" } else { "OUTSIDE" }
+        ));
     }
     t
 }
@@ -468,39 +513,11 @@ pub fn to_text(s: &CalibrationSummary) -> String {
         ));
     }
     if let Some(p) = &s.plausibility {
-        let line = |what: &str, x: &LossAt| {
-            let by: Vec<String> = x
-                .loss_by_source_w
-                .iter()
-                .map(|(k, v)| format!("{k} {:.1}", v / 1e3))
-                .collect();
-            format!(
-                "{what}: {:.0} kW at {:.0} rpm, {:.0} N m, oil {:.1} °C: loss {:.1} kW ({}), efficiency {}\n",
-                x.power_w / 1e3,
-                x.input_speed_rpm,
-                x.input_torque_nm,
-                x.oil_temp_c,
-                x.loss_total_w / 1e3,
-                by.join(", "),
-                x.efficiency.map_or("—".into(), |e| format!("{e:.4}"))
-            )
-        };
-        t.push_str(&line(
-            &format!("highest-power rows ({})", p.rows),
-            &p.highest_power,
-        ));
-        if let Some(r) = &p.rated {
-            t.push_str(&line("rated point", r));
-        }
-        if let Some(r) = &p.reference {
-            t.push_str(&format!(
-                "  {} gearbox: {} ({}); the model: {:.2} % ({})\n",
-                r.kind,
-                r.statement,
-                r.source,
-                100.0 * r.loss_share,
-                if r.inside { "within" } else { "OUTSIDE" }
-            ));
+        t.push_str(&plausibility_text("", p));
+    }
+    for tr in &s.traces {
+        if let Some(p) = &tr.plausibility {
+            t.push_str(&plausibility_text(&format!("trace {}: ", tr.name), p));
         }
     }
     for p in &s.profiles {

@@ -339,7 +339,8 @@ impl<'a> Prepared<'a> {
             ));
         }
         let doc = self.problem.document().clone();
-        self.band_source = Some(transfer::band_source(&self.problem, &doc, json, file)?);
+        let name = transfer::trace_name(&self.problem.trace.source);
+        self.band_source = Some(transfer::band_source(&self.problem, &doc, json, file, &name)?);
         Ok(())
     }
 }
@@ -482,29 +483,63 @@ pub fn fit(m: &Model, p: &Prepared<'_>, o: &CalibrateOptions) -> Result<Calibrat
         .map(|k| at0.j.column(k).iter().fold(0.0, |a: f64, x| a.max(x.abs())))
         .collect();
     let free: Vec<bool> = influence.iter().map(|&x| x > MIN_INFLUENCE_K).collect();
-    let bounds: Vec<(f64, f64)> = pr.params.iter().map(Parameter::theta_bounds).collect();
+    let setup = Setup {
+        params: &pr.params,
+        priors: &p.priors,
+        layout: residuals::Layout::of(&p.held, pr.channels.len()),
+        fail: &|r| singular(p, r),
+    };
+    let fitted = solve(&|th| evaluate(p, th), &setup, (&theta0, at0), influence, free, o)?;
+    assemble(m, p, o, &fitted, clock)
+}
+
+/// What the fit of one segment and the fit over several traces share: the parameters, their
+/// priors, the fitted rows' layout, and the error of a fit that stopped on a singular point.
+struct Setup<'a> {
+    /// The parameters.
+    params: &'a [Parameter],
+    /// Their priors (a MAP fit when not empty).
+    pub priors: &'a prior::Priors,
+    /// The fitted rows' layout (a stretch per segment and held-out window).
+    pub layout: residuals::Layout,
+    /// The error of a fit stopped on `Singular` (exit 2 naming the trace).
+    pub fail: &'a dyn Fn(&lm::LmResult) -> Result<(), JobError>,
+}
+
+/// The fit from `start` (θ₀ and its evaluation): least squares, then under the residual model
+/// of `o` the weighted, MAP or prewhitened (`ar1-gls`) fit (docs/calibration.md, "The residual
+/// model", "Priors"). `eval` gives the unweighted residuals and Jacobian of the fitted rows.
+fn solve(
+    eval: &dyn Fn(&[f64]) -> Result<Evaluation, JobError>,
+    s: &Setup<'_>,
+    start: (&[f64], Evaluation),
+    influence: Vec<f64>,
+    free: Vec<bool>,
+    o: &CalibrateOptions,
+) -> Result<Fitted, JobError> {
+    let bounds: Vec<(f64, f64)> = s.params.iter().map(Parameter::theta_bounds).collect();
     let lmo = LmOptions {
         max_iterations: o.max_iterations,
         ..LmOptions::default()
     };
-    let ols = lm::minimise(|th| evaluate(p, th), &theta0, at0, &bounds, &free, &lmo)?;
-    singular(p, &ols)?;
+    let ols = lm::minimise(eval, start.0, start.1, &bounds, &free, &lmo)?;
+    (s.fail)(&ols)?;
     let id_ols = identifiable(&ols.theta, &bounds, &free);
     let independent = Independent {
         lin: stats::linearised(&ols.at.j, ols.at.r.norm_squared(), &id_ols, 0),
         theta: ols.theta.clone(),
     };
-    let layout = residuals::Layout::of(&p.held, pr.channels.len());
+    let layout = &s.layout;
     let known = !layout.stretch.is_empty();
     let mut channel_weights = None;
     let (res, noise) = match o.residuals.as_str() {
         "ar1-gls" if known => {
             let (res, models) = residuals::refit(
-                |th| evaluate(p, th),
-                |e, th| p.priors.augment(e, &pr.params, th),
-                |e| p.priors.strip(e),
+                eval,
+                |e, th| s.priors.augment(e, s.params, th),
+                |e| s.priors.strip(e),
                 ols,
-                &layout,
+                layout,
                 &bounds,
                 &free,
                 &lmo,
@@ -514,8 +549,8 @@ pub fn fit(m: &Model, p: &Prepared<'_>, o: &CalibrateOptions) -> Result<Calibrat
         "ar1" if known => {
             let models = layout.estimate(&ols.at.r);
             let weights: Vec<f64> = models.iter().map(residuals::Ar1::long_run_sd).collect();
-            let res = map_fit(p, ols, &weights, &bounds, &free, &lmo)?;
-            let models = if p.priors.is_empty() && !unequal(&weights) {
+            let res = map_fit(eval, s, ols, &weights, &bounds, &free, &lmo)?;
+            let models = if s.priors.is_empty() && !unequal(&weights) {
                 models
             } else {
                 layout.estimate(&res.at.r)
@@ -524,23 +559,23 @@ pub fn fit(m: &Model, p: &Prepared<'_>, o: &CalibrateOptions) -> Result<Calibrat
             (res, Some(models))
         }
         _ => {
-            let dof = ols.at.r.len().saturating_sub(pr.params.len()).max(1);
+            let dof = ols.at.r.len().saturating_sub(s.params.len()).max(1);
             let sd = (ols.at.r.norm_squared() / dof as f64).sqrt().max(1e-12);
-            let weights = vec![sd; pr.channels.len()];
-            (map_fit(p, ols, &weights, &bounds, &free, &lmo)?, None)
+            let weights = vec![sd; layout.nc];
+            (map_fit(eval, s, ols, &weights, &bounds, &free, &lmo)?, None)
         }
     };
-    let fitted = Fitted {
+    (s.fail)(&res)?;
+    Ok(Fitted {
         res,
         weights: channel_weights,
         noise,
         whitened: o.residuals == "ar1-gls" && known,
-        layout,
+        layout: s.layout.clone(),
         independent,
         influence,
         free,
-    };
-    assemble(m, p, o, &fitted, clock)
+    })
 }
 
 /// Channels' noise scales that differ (each finite and above zero): a fit of several channels
@@ -555,27 +590,27 @@ fn unequal(weights: &[f64]) -> bool {
 /// weights (several channels) the weighted least-squares fit. The result's evaluation is the
 /// data's, unweighted; its evaluations count those of `ols`.
 fn map_fit(
-    p: &Prepared<'_>,
+    eval: &dyn Fn(&[f64]) -> Result<Evaluation, JobError>,
+    s: &Setup<'_>,
     ols: lm::LmResult,
     weights: &[f64],
     bounds: &[(f64, f64)],
     free: &[bool],
     lmo: &LmOptions,
 ) -> Result<lm::LmResult, JobError> {
-    if p.priors.is_empty() && !unequal(weights) {
+    if s.priors.is_empty() && !unequal(weights) {
         return Ok(ols);
     }
-    let params = &p.problem.params;
     let ev = |th: &[f64]| -> Result<Evaluation, JobError> {
-        let e = prior::weighted(evaluate(p, th)?, weights);
-        Ok(p.priors.augment(e, params, th))
+        let e = prior::weighted(eval(th)?, weights);
+        Ok(s.priors.augment(e, s.params, th))
     };
-    let at0 = p
+    let at0 = s
         .priors
-        .augment(prior::weighted(ols.at, weights), params, &ols.theta);
+        .augment(prior::weighted(ols.at, weights), s.params, &ols.theta);
     let mut res = lm::minimise(ev, &ols.theta, at0, bounds, free, lmo)?;
     let back: Vec<f64> = weights.iter().map(|w| 1.0 / w).collect();
-    res.at = prior::weighted(p.priors.strip(res.at), &back);
+    res.at = prior::weighted(s.priors.strip(res.at), &back);
     res.evaluations += ols.evaluations;
     res.iterations += ols.iterations;
     Ok(res)
@@ -607,11 +642,16 @@ struct Fitted {
 }
 
 /// Each prior's influence: its width against the posterior's and the data's.
-fn prior_influence(p: &Prepared<'_>, f: &Fitted, data_se: &[Option<f64>], out: &mut [FittedParameter]) {
-    let params = &p.problem.params;
-    for q in &p.priors.list {
+fn prior_influence(
+    priors: &prior::Priors,
+    params: &[Parameter],
+    f: &Fitted,
+    data_se: &[Option<f64>],
+    out: &mut [FittedParameter],
+) {
+    for q in &priors.list {
         let k = q.param;
-        let prior_sd = p.priors.sd_theta(q, params, &f.res.theta);
+        let prior_sd = priors.sd_theta(q, params, &f.res.theta);
         let post = out[k].std_error;
         let share = match (post, data_se[k]) {
             (Some(a), Some(d)) if d > 0.0 => Some(1.0 - (a / d).powi(2)),
@@ -919,7 +959,7 @@ fn assemble(
     let t = stats::t975(lin.dof);
     let mut warnings = pr.trace.notes.clone();
     let mut parameters = parameters(&pr.params, f, &identifiable, &lin, t, &mut warnings);
-    prior_influence(p, f, &data_se, &mut parameters);
+    prior_influence(&p.priors, &pr.params, f, &data_se, &mut parameters);
     let correlation = correlation(&pr.params, &lin, &mut warnings);
     let identifiability = identifiability(&pr.params, &lin, t, &mut warnings);
     singular(p, res)?;
@@ -936,7 +976,12 @@ fn assemble(
             res.evaluations
         ));
     }
-    let sim = pr.simulate(&res.theta, !pr.params.is_empty())?;
+    // A prediction with a band from a calibration runs at that calibration's parameters: the
+    // model's values, a per-trace parameter of this trace the calibration's value for it.
+    let sim = match &p.band_source {
+        Some(b) => b.problem.simulate(&b.problem.start(), true)?,
+        None => pr.simulate(&res.theta, !pr.params.is_empty())?,
+    };
     if let Some(b) = &sim.breach {
         return Err(breach_error(p, &res.theta, b));
     }
@@ -948,10 +993,7 @@ fn assemble(
         vec![a; pr.channels.len()]
     });
     let (band, band_known) = match &p.band_source {
-        Some(b) => {
-            let s = b.problem.simulate(&b.problem.start(), true)?;
-            (bands::half_widths(&s, &b.covariance, &b.noise, b.t975), true)
-        }
+        Some(b) => (bands::half_widths(&sim, &b.covariance, &b.noise, b.t975), true),
         None => (
             bands::half_widths(&sim, &lin.covariance, &noise, t),
             !f.layout.stretch.is_empty(),
@@ -959,15 +1001,17 @@ fn assemble(
     };
     let rated = o.rated.as_deref().map(plausibility::rated_point).transpose()?;
     let plausibility = plausibility::assess(
-        pr,
+        &[(pr, &sim.temps_c)],
         &res.theta,
-        &sim.temps_c,
         o.gearbox_kind.as_deref(),
         rated,
         &mut warnings,
     )?;
     let objective = profile::Objective {
-        p,
+        eval: &|th| evaluate(p, th),
+        params: &pr.params,
+        priors: &p.priors,
+        fail: &|r| singular(p, r),
         noise: &noise,
         whitened: f.whitened,
         layout: &f.layout,

@@ -242,6 +242,24 @@ impl Parameter {
     }
 }
 
+/// The `@TRACE` of a key path (the last `@` outside quotes and brackets), if any.
+pub fn split_owner(path: &str) -> (&str, Option<&str>) {
+    let (mut in_quotes, mut depth, mut at) = (false, 0i32, None);
+    for (k, c) in path.char_indices() {
+        match c {
+            '"' => in_quotes = !in_quotes,
+            '[' if !in_quotes => depth += 1,
+            ']' if !in_quotes => depth -= 1,
+            '@' if !in_quotes && depth == 0 => at = Some(k),
+            _ => {}
+        }
+    }
+    match at {
+        Some(k) => (&path[..k], Some(&path[k + 1..])),
+        None => (path, None),
+    }
+}
+
 /// The key path with every `["name"]` selector replaced by the index of the entry it names in
 /// `doc`: two spellings of one key (`thermal.nodes[4].mass_kg`, `thermal.nodes["housing"].
 /// mass_kg`) give the same canonical path. A selector that names nothing is kept.

@@ -131,47 +131,62 @@ fn mean(points: &[LossAt]) -> LossAt {
     }
 }
 
-/// The plausibility report of the calibrated model at θ, with the simulated temperatures
-/// `temps_c` (°C, `[row][channel]`); None for a vehicle trace or a trace that does not measure the
-/// oil node (noted in `warnings`). A loss share outside the kind's sourced bounds is warned.
+/// The plausibility report of the calibrated model at θ over the rows of `parts` (each a
+/// problem, one segment of one trace, with its simulated temperatures, °C, `[row][channel]`;
+/// every part holds the same parameters, θ); None for a vehicle trace or a trace that does not
+/// measure the oil node (noted in `warnings`). A loss share outside the kind's sourced bounds is
+/// warned.
 pub fn assess(
-    pr: &Problem<'_>,
+    parts: &[(&Problem<'_>, &[Vec<f64>])],
     theta: &[f64],
-    temps_c: &[Vec<f64>],
     kind: Option<&str>,
     rated: Option<(f64, f64)>,
     warnings: &mut Vec<String>,
 ) -> Result<Option<Plausibility>, JobError> {
+    let Some(&(pr, _)) = parts.first() else {
+        return Ok(None);
+    };
     let gb = pr.gearbox_at(theta)?;
     let Some(net) = gb.thermal.as_ref() else {
         return Ok(None);
     };
-    let Some(oil) = pr.channels.iter().position(|&n| n == net.oil_node) else {
+    let oil: Option<Vec<usize>> = parts
+        .iter()
+        .map(|(p, _)| p.channels.iter().position(|&n| n == net.oil_node))
+        .collect();
+    let Some(oil) = oil else {
         warnings.push("plausibility: the trace does not measure the oil node: losses not evaluated".into());
         return Ok(None);
     };
-    let rows = &pr.trace.cycle.rows;
-    if pr.trace.cycle.kind != crate::cycle::CycleKind::Rig || rows.len() != temps_c.len() {
+    let rig = |p: &Problem<'_>, t: &[Vec<f64>]| {
+        p.trace.cycle.kind == crate::cycle::CycleKind::Rig && p.trace.cycle.rows.len() == t.len()
+    };
+    if !parts.iter().all(|&(p, t)| rig(p, t)) {
         return Ok(None);
     }
     let scene =
         LossScene::compile(&gb).map_err(|e| JobError::invalid(format!("{}: {e}", pr.file.display())))?;
     let state_of = |g: &Option<String>| g.as_deref().and_then(|g| gb.state_index(g)).unwrap_or(0);
-    let mut order: Vec<usize> = (0..rows.len()).collect();
-    let power = |r: usize| (rows[r].input_speed * rows[r].input_torque).abs();
+    let mut order: Vec<(usize, usize)> = parts
+        .iter()
+        .enumerate()
+        .flat_map(|(k, (p, _))| (0..p.trace.cycle.rows.len()).map(move |r| (k, r)))
+        .collect();
+    let row = |(k, r): (usize, usize)| &parts[k].0.trace.cycle.rows[r];
+    let power = |x: (usize, usize)| (row(x).input_speed * row(x).input_torque).abs();
     order.sort_by(|&a, &b| power(b).total_cmp(&power(a)));
-    let top = ((rows.len() as f64 * TOP_SHARE).ceil() as usize).clamp(1, rows.len());
+    let top = ((order.len() as f64 * TOP_SHARE).ceil() as usize).clamp(1, order.len());
     let points: Vec<LossAt> = order[..top]
         .iter()
-        .map(|&r| {
-            let x = &rows[r];
+        .map(|&(k, r)| {
+            let x = row((k, r));
             loss_at(
                 &gb,
                 &scene,
                 state_of(&x.gear),
                 x.input_speed,
                 x.input_torque,
-                temps_c[r][oil],
+                parts[k].1[r][oil[k]],
             )
         })
         .collect();
@@ -181,7 +196,7 @@ pub fn assess(
         loss_at(
             &gb,
             &scene,
-            state_of(&rows[order[0]].gear),
+            state_of(&row(order[0]).gear),
             w,
             t,
             highest.oil_temp_c,

@@ -44,6 +44,9 @@ pub struct PriorSpec {
     pub width: f64,
     /// The argument as written, for messages.
     pub text: String,
+    /// The trace of a per-trace parameter (`KEYPATH@TRACE=…`, a fit over several traces): its
+    /// index, its name or `*`.
+    pub owner: Option<String>,
 }
 
 fn bad_prior(text: &str, why: &str) -> JobError {
@@ -86,6 +89,7 @@ impl std::str::FromStr for PriorSpec {
         let (path, rest) = text
             .rsplit_once('=')
             .ok_or_else(|| bad_prior(text, "no '=' between key path and distribution"))?;
+        let (path, owner) = super::params::split_owner(path.trim());
         let path: KeyPath = path
             .trim()
             .parse()
@@ -112,6 +116,7 @@ impl std::str::FromStr for PriorSpec {
             location,
             width,
             text: text.to_string(),
+            owner: owner.map(|o| o.trim().to_string()),
         })
     }
 }
@@ -122,7 +127,8 @@ impl std::fmt::Display for PriorSpec {
             Kind::Normal => "normal",
             Kind::Lognormal => "lognormal",
         };
-        write!(f, "{}={k}:{}:{}", self.path, self.location, self.width)
+        let at = self.owner.as_ref().map_or(String::new(), |o| format!("@{o}"));
+        write!(f, "{}{at}={k}:{}:{}", self.path, self.location, self.width)
     }
 }
 
@@ -222,8 +228,14 @@ impl Priors {
     /// parameter whose range reaches zero is invalid input naming the key path.
     pub fn resolve(specs: &[PriorSpec], params: &[Parameter], doc: &toml::Table) -> Result<Priors, JobError> {
         let canon: Vec<KeyPath> = params.iter().map(|p| canonical(&p.path, doc)).collect();
-        let mut list: Vec<Prior> = Vec::with_capacity(specs.len());
+        let mut out = Priors::default();
         for s in specs {
+            if let Some(o) = &s.owner {
+                return Err(bad_prior(
+                    &s.text,
+                    &format!("@{o} names a trace, but one trace is fitted: a prior of one trace's parameter needs several --trace"),
+                ));
+            }
             let c = canonical(&s.path, doc);
             let Some(k) = canon.iter().position(|x| *x == c) else {
                 return Err(bad_prior(
@@ -231,26 +243,39 @@ impl Priors {
                     &format!("{} is not a fitted parameter (add it to fit)", s.path),
                 ));
             };
-            if list.iter().any(|p| p.param == k) {
-                return Err(bad_prior(&s.text, &format!("{} has two priors", s.path)));
-            }
-            let p = &params[k];
-            if s.kind == Kind::Lognormal && p.lo <= 0.0 {
-                return Err(bad_prior(
-                    &s.text,
-                    &format!(
-                        "a log-normal prior needs a positive parameter; {} may take values in [{}, {}], which \
-                         reaches zero or below",
-                        s.path, p.lo, p.hi
-                    ),
-                ));
-            }
-            list.push(Prior {
-                param: k,
-                spec: s.clone(),
-            });
+            out.add(s, k, &params[k])?;
         }
-        Ok(Priors { list })
+        Ok(out)
+    }
+
+    /// Add the prior `s` on parameter `k` (`p`): refused when `p` has a prior already, or for a
+    /// log-normal prior on a range that reaches zero.
+    pub fn add(&mut self, s: &PriorSpec, k: usize, p: &Parameter) -> Result<(), JobError> {
+        if self.list.iter().any(|q| q.param == k) {
+            return Err(bad_prior(&s.text, &format!("{} has two priors", p.name())));
+        }
+        if s.kind == Kind::Lognormal && p.lo <= 0.0 {
+            return Err(bad_prior(
+                &s.text,
+                &format!(
+                    "a log-normal prior needs a positive parameter; {} may take values in [{}, {}], which \
+                     reaches zero or below",
+                    p.name(),
+                    p.lo,
+                    p.hi
+                ),
+            ));
+        }
+        self.list.push(Prior {
+            param: k,
+            spec: s.clone(),
+        });
+        Ok(())
+    }
+
+    /// A prior's refusal (invalid input naming the argument).
+    pub fn refuse(s: &PriorSpec, why: &str) -> JobError {
+        bad_prior(&s.text, why)
     }
 
     /// No prior.

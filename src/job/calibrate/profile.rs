@@ -6,10 +6,10 @@
 //! with `ar1-gls`) plus the prior rows, so D is about χ²₁ near the optimum; the 95 % interval is
 //! where D ≤ t(0.975, ν)² (F(1, ν), the linearised interval's quantile squared).
 
-use super::lm::{self, Evaluation, LmOptions};
+use super::lm::{self, Evaluation, LmOptions, LmResult};
 use super::params::{canonical, Parameter};
 use super::residuals::{Ar1, Layout};
-use super::{evaluate, prior, stats, Prepared};
+use super::{prior, stats};
 use crate::job::JobError;
 use crate::model::overrides::KeyPath;
 use crate::report::calibration::{Profile, ProfilePoint};
@@ -50,8 +50,15 @@ pub fn resolve(keys: &[String], params: &[Parameter], doc: &toml::Table) -> Resu
 
 /// The fit's objective for the profiles.
 pub struct Objective<'a> {
-    /// The prepared problem.
-    pub p: &'a Prepared<'a>,
+    /// The unweighted residuals and Jacobian of the fitted rows at θ (one segment, or every
+    /// segment of several traces stacked).
+    pub eval: &'a dyn Fn(&[f64]) -> Result<Evaluation, JobError>,
+    /// The fitted parameters.
+    pub params: &'a [Parameter],
+    /// Their priors.
+    pub priors: &'a prior::Priors,
+    /// The error of a refit stopped on a singular point (exit 2 naming the trace).
+    pub fail: &'a dyn Fn(&LmResult) -> Result<(), JobError>,
     /// The channels' residual processes.
     pub noise: &'a [Ar1],
     /// Prewhitened rows (`ar1-gls`), else rows scaled by the long-run standard deviation.
@@ -62,14 +69,14 @@ pub struct Objective<'a> {
 
 impl Objective<'_> {
     fn eval(&self, th: &[f64]) -> Result<Evaluation, JobError> {
-        let e = evaluate(self.p, th)?;
+        let e = (self.eval)(th)?;
         let e = if self.whitened {
             self.layout.whiten(&e, self.noise)
         } else {
             let w: Vec<f64> = self.noise.iter().map(Ar1::long_run_sd).collect();
             prior::weighted(e, &w)
         };
-        Ok(self.p.priors.augment(e, &self.p.problem.params, th))
+        Ok(self.priors.augment(e, self.params, th))
     }
 
     /// Refit from θ with the parameters of `free`; the end point and its objective.
@@ -79,20 +86,14 @@ impl Objective<'_> {
         free: &[bool],
         iterations: usize,
     ) -> Result<(Vec<f64>, f64, usize), JobError> {
-        let bounds: Vec<(f64, f64)> = self
-            .p
-            .problem
-            .params
-            .iter()
-            .map(Parameter::theta_bounds)
-            .collect();
+        let bounds: Vec<(f64, f64)> = self.params.iter().map(Parameter::theta_bounds).collect();
         let lmo = LmOptions {
             max_iterations: iterations,
             ..LmOptions::default()
         };
         let at = self.eval(th)?;
         let r = lm::minimise(|x| self.eval(x), th, at, &bounds, free, &lmo)?;
-        super::singular(self.p, &r)?;
+        (self.fail)(&r)?;
         Ok((r.theta.clone(), r.at.r.norm_squared(), r.evaluations))
     }
 }
@@ -118,7 +119,7 @@ fn side(
     step: f64,
     evaluations: &mut usize,
 ) -> Result<Vec<(f64, f64)>, JobError> {
-    let (lo, hi) = obj.p.problem.params[k].theta_bounds();
+    let (lo, hi) = obj.params[k].theta_bounds();
     let mut at = theta.to_vec();
     let mut prev = theta[k];
     let mut points = Vec::with_capacity(STEPS);
@@ -166,7 +167,7 @@ pub fn profile(
     dof: usize,
     free: &[bool],
 ) -> Result<Profile, JobError> {
-    let par = &obj.p.problem.params[k];
+    let par = &obj.params[k];
     let mut evaluations = 0;
     let (best, s0, n) = obj.refit(theta, free, POINT_ITERATIONS)?;
     evaluations += n;

@@ -14,12 +14,14 @@ use crate::model::Override;
 use crate::solve::sensitivity::SensitivityOptions;
 
 use super::lm::Evaluation;
-use super::params::{canonical, split_bounds, FitSpec, Parameter};
+use super::params::{canonical, split_bounds, split_owner, FitSpec, Parameter};
+use super::prior::{PriorSpec, Priors};
 use super::problem::{initial_overrides, Problem};
 use super::residuals::Layout;
 use super::trace_file::TraceFile;
 use super::{checks, document, CalibrateOptions};
 use crate::job::{JobError, Model};
+use crate::model::overrides::KeyPath;
 
 /// One trace of a fit over several: its name (`KEYPATH@NAME`), its file cut into segments and
 /// the segments fitted (0-based).
@@ -159,28 +161,17 @@ pub struct Stack<'a> {
     pub text: &'a str,
     /// The command's overrides (`--set`).
     pub base: Vec<Override>,
+    /// The priors (a MAP fit when not empty).
+    pub priors: Priors,
+    /// Index of each parameter whose profile is computed.
+    pub profile: Vec<usize>,
+    /// Per segment, the previous calibration its prediction band is taken from
+    /// (`--band-from`; empty: the band is this fit's own).
+    pub bands: Vec<super::transfer::BandSource<'a>>,
 }
 
 fn fit_error(arg: &str, allowed: &str, msg: String) -> JobError {
     JobError::option("fit", arg, allowed, msg)
-}
-
-/// The `@TRACE` of a key path (the last `@` outside quotes and brackets), if any.
-fn split_owner(path: &str) -> (&str, Option<&str>) {
-    let (mut in_quotes, mut depth, mut at) = (false, 0i32, None);
-    for (k, c) in path.char_indices() {
-        match c {
-            '"' => in_quotes = !in_quotes,
-            '[' if !in_quotes => depth += 1,
-            ']' if !in_quotes => depth -= 1,
-            '@' if !in_quotes && depth == 0 => at = Some(k),
-            _ => {}
-        }
-    }
-    match at {
-        Some(k) => (&path[..k], Some(&path[k + 1..])),
-        None => (path, None),
-    }
 }
 
 /// Parse `KEYPATH[@TRACE][=LO:HI]` against the traces' names.
@@ -198,36 +189,130 @@ pub fn parse_fit(arg: &str, names: &[String]) -> Result<(FitSpec, Owner), JobErr
     let Some(owner) = owner.map(str::trim) else {
         return Ok((spec, Owner::Shared));
     };
+    let owner = owner_of(owner, names, &format!("fit = {arg}"))
+        .map_err(|(msg, allowed_here)| fit_error(arg, allowed_here.unwrap_or(allowed), msg))?;
+    Ok((spec, owner))
+}
+
+/// The trace `owner` names (`*`, an index or a name) among `names`; the message (starting with
+/// `what`) and, for one trace only, the allowed form.
+fn owner_of(owner: &str, names: &[String], what: &str) -> Result<Owner, (String, Option<&'static str>)> {
     let n = names.len();
     if n < 2 {
         let msg = format!(
-            "fit = {arg}: @{owner} names a trace, but one trace is fitted: a parameter of one trace needs \
+            "{what}: @{owner} names a trace, but one trace is fitted: a parameter of one trace needs \
              several --trace"
         );
-        return Err(fit_error(arg, "KEYPATH[=LO:HI] with one trace", msg));
+        return Err((msg, Some("KEYPATH[=LO:HI] with one trace")));
     }
     if owner == "*" {
-        return Ok((spec, Owner::Each));
+        return Ok(Owner::Each);
     }
-    let index = match owner.parse::<usize>() {
-        Ok(i) if i < n => i,
-        Ok(i) => {
-            let msg = format!(
-                "fit = {arg}: trace {i} does not exist: the traces are 0 … {} ({})",
+    match owner.parse::<usize>() {
+        Ok(i) if i < n => Ok(Owner::One(i)),
+        Ok(i) => Err((
+            format!(
+                "{what}: trace {i} does not exist: the traces are 0 … {} ({})",
                 n - 1,
                 names.join(", ")
-            );
-            return Err(fit_error(arg, allowed, msg));
-        }
-        Err(_) => names.iter().position(|x| x == owner).ok_or_else(|| {
-            let msg = format!(
-                "fit = {arg}: no trace is named \"{owner}\" (traces: {})",
-                names.join(", ")
-            );
-            fit_error(arg, allowed, msg)
-        })?,
+            ),
+            None,
+        )),
+        Err(_) => names
+            .iter()
+            .position(|x| x == owner)
+            .map(Owner::One)
+            .ok_or_else(|| {
+                (
+                    format!(
+                        "{what}: no trace is named \"{owner}\" (traces: {})",
+                        names.join(", ")
+                    ),
+                    None,
+                )
+            }),
+    }
+}
+
+/// The stack's parameters a `KEYPATH[@TRACE]` names (several for `@*`): `what` starts the
+/// message of a key that is not fitted (so, or not for that trace).
+fn owned_params(
+    path: &KeyPath,
+    owner: Option<&str>,
+    s: (&[Parameter], &[Option<usize>], &[String]),
+    doc: &toml::Table,
+    what: &str,
+) -> Result<Vec<usize>, String> {
+    let (params, owners, names) = s;
+    let owner = match owner {
+        None => Owner::Shared,
+        Some(o) => owner_of(o.trim(), names, what).map_err(|e| e.0)?,
     };
-    Ok((spec, Owner::One(index)))
+    let c = canonical(path, doc);
+    let out: Vec<usize> = (0..params.len())
+        .filter(|&q| canonical(&params[q].path, doc) == c)
+        .filter(|&q| match owner {
+            Owner::Shared => owners[q].is_none(),
+            Owner::One(i) => owners[q] == Some(i),
+            Owner::Each => owners[q].is_some(),
+        })
+        .collect();
+    if out.is_empty() {
+        let fitted: Vec<String> = params.iter().map(Parameter::name).collect();
+        let whose = match owner {
+            Owner::Shared => "a parameter shared by every trace".to_string(),
+            Owner::One(i) => format!("a parameter of trace {} ({i})", names[i]),
+            Owner::Each => "a parameter of each trace".to_string(),
+        };
+        return Err(format!(
+            "{what}: {path} is not fitted as {whose} (fitted: {})",
+            fitted.join(", ")
+        ));
+    }
+    Ok(out)
+}
+
+/// The priors of a fit over several traces: `KEYPATH[@TRACE]=DIST:…`, each on the parameters
+/// its key path and trace name (`@*`: the parameter of every trace).
+fn resolve_priors(
+    specs: &[PriorSpec],
+    s: (&[Parameter], &[Option<usize>], &[String]),
+    doc: &toml::Table,
+) -> Result<Priors, JobError> {
+    let mut out = Priors::default();
+    for spec in specs {
+        let what = format!("prior = {}", spec.text);
+        let which = owned_params(&spec.path, spec.owner.as_deref(), s, doc, &what)
+            .map_err(|e| Priors::refuse(spec, e.trim_start_matches(&format!("{what}: "))))?;
+        for q in which {
+            out.add(spec, q, &s.0[q])?;
+        }
+    }
+    Ok(out)
+}
+
+/// The parameters of `--profile KEYPATH[@TRACE]` (each once).
+fn resolve_profile(
+    keys: &[String],
+    s: (&[Parameter], &[Option<usize>], &[String]),
+    doc: &toml::Table,
+) -> Result<Vec<usize>, JobError> {
+    let mut out = Vec::new();
+    for k in keys {
+        let what = format!("profile = {k}");
+        let bad = |m: String| JobError::option("profile", k, "the key path of a fitted parameter[@TRACE]", m);
+        let (path, owner) = split_owner(k.trim());
+        let path: KeyPath = path
+            .trim()
+            .parse()
+            .map_err(|e| bad(format!("{what}: bad key path: {e}")))?;
+        for q in owned_params(&path, owner, s, doc, &what).map_err(bad)? {
+            if !out.contains(&q) {
+                out.push(q);
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// The stack's parameters (each `@*` expanded into one per trace), resolved against `doc`,
@@ -265,33 +350,6 @@ fn resolve_params(
         }
     }
     Ok(out.into_iter().map(|(_, p, o, _)| (p, o)).unzip())
-}
-
-/// Options a fit over several traces does not take (exit 1 naming the option).
-fn refuse_single_trace_options(o: &CalibrateOptions) -> Result<(), JobError> {
-    let refuse = |name: &str, value: &str| {
-        let msg = format!(
-            "{name} = {value}: not available in a fit over several traces or segments (fit one segment \
-             with --segment K for it)"
-        );
-        Err(JobError::option(name, value, "a fit of one segment", msg))
-    };
-    if o.residuals == "ar1-gls" {
-        return refuse("residuals", "ar1-gls");
-    }
-    if let Some(p) = o.prior.first() {
-        return refuse("prior", p);
-    }
-    if let Some(p) = o.profile.first() {
-        return refuse("profile", p);
-    }
-    if let Some(k) = &o.gearbox_kind {
-        return refuse("gearbox_kind", k);
-    }
-    if let Some(r) = &o.rated {
-        return refuse("rated", r);
-    }
-    Ok(())
 }
 
 /// The traces' names once each and their files once each, each trace with a segment.
@@ -374,6 +432,45 @@ fn channel_perm(nodes: &[(String, String)], pr: &Problem<'_>, first: &str) -> Re
     ))
 }
 
+/// The columns of a trace's header besides its measured ones: its cycle's and its boundaries'.
+fn input_columns(t: &super::Trace) -> Vec<String> {
+    use crate::cycle::CycleKind;
+    let mut cols: Vec<String> = match (t.cycle.kind, t.cycle.has_gear) {
+        (CycleKind::Rig, _) => vec!["input_speed_rpm".into(), "input_torque_nm".into(), "gear".into()],
+        (CycleKind::Vehicle, true) => vec!["speed_kmh".into(), "gear".into()],
+        (CycleKind::Vehicle, false) => vec!["speed_kmh".into()],
+    };
+    cols.extend(t.boundaries.iter().map(|c| c.column.clone()));
+    cols
+}
+
+/// Traces fitted together have the same input and boundary columns (in any order): a column one
+/// trace has and another lacks is invalid input naming both files and the column.
+fn same_columns(first: &super::Trace, this: &super::Trace) -> Result<(), JobError> {
+    let (a, b) = (input_columns(first), input_columns(this));
+    let missing = a
+        .iter()
+        .find(|c| !b.contains(c))
+        .map(|c| (c, &first.source, &this.source));
+    let extra = b
+        .iter()
+        .find(|c| !a.contains(c))
+        .map(|c| (c, &this.source, &first.source));
+    let Some((col, has, lacks)) = missing.or(extra) else {
+        return Ok(());
+    };
+    Err(JobError::option(
+        "trace",
+        &this.source,
+        "traces with the same columns",
+        format!(
+            "trace = {}: column {col} is in {has}, not in {lacks}: traces fitted together must have the same \
+             columns (cycle, boundary:NAME and node:NAME)",
+            this.source
+        ),
+    ))
+}
+
 /// The model at a segment's start checks, its boundary columns lie in the model file's range and
 /// its measured values in the physics envelope.
 fn check_segment(m: &Model, problem: &Problem<'_>) -> Result<(), JobError> {
@@ -391,13 +488,14 @@ pub fn prepare<'a>(
     o: &CalibrateOptions,
 ) -> Result<Stack<'a>, JobError> {
     check_traces(traces)?;
-    refuse_single_trace_options(o)?;
     let mut plain = o.clone();
     plain.fit.clear();
-    let (_, windows, _) = plain.check()?;
+    let (_, windows, prior_specs) = plain.check()?;
     let names: Vec<String> = traces.iter().map(|t| t.name.clone()).collect();
     let doc = document(m, text, &m.overrides)?;
     let (params, owners) = resolve_params(&o.fit, &names, &doc)?;
+    let priors = resolve_priors(&prior_specs, (&params, &owners, &names), &doc)?;
+    let profile = resolve_profile(&o.profile, (&params, &owners, &names), &doc)?;
     let opts = SensitivityOptions {
         rtol: o.rtol,
         atol: o.atol,
@@ -427,6 +525,7 @@ pub fn prepare<'a>(
                     .collect();
             }
             let perm = channel_perm(&nodes, &problem, &traces[0].file.source)?;
+            same_columns(&traces[0].file.segments[traces[0].segments[0]].trace, &seg.trace)?;
             check_segment(m, &problem)?;
             let held = seg
                 .trace
@@ -459,9 +558,45 @@ pub fn prepare<'a>(
         windows,
         text,
         base: m.overrides.clone(),
+        priors,
+        profile,
+        bands: Vec::new(),
     };
     stack.check_size()?;
     Ok(stack)
+}
+
+impl<'a> Stack<'a> {
+    /// Take every segment's prediction band from a previous calibration (`calibration.json`
+    /// text, `file` naming it; trace X's segments with the calibration's parameters of X and
+    /// the shared ones): invalid input when this run fits parameters or rows.
+    pub fn band_from(&mut self, json: &str, file: &str) -> Result<(), JobError> {
+        let fits_rows = self.segments.iter().any(|g| g.held.iter().any(|h| !h));
+        if !self.params.is_empty() || fits_rows {
+            return Err(JobError::option(
+                "band_from",
+                file,
+                "a run that fits nothing (no fit, every row held out)",
+                format!(
+                    "band_from = {file}: only for a prediction (no fit, holdout over the whole of every \
+                     trace); this run fits its own band"
+                ),
+            ));
+        }
+        let mut out = Vec::with_capacity(self.segments.len());
+        for g in &self.segments {
+            let doc = g.problem.document().clone();
+            out.push(super::transfer::band_source(
+                &g.problem,
+                &doc,
+                json,
+                file,
+                &self.names[g.trace],
+            )?);
+        }
+        self.bands = out;
+        Ok(())
+    }
 }
 
 impl Stack<'_> {

@@ -6,16 +6,19 @@
 
 use std::time::Instant;
 
-use crate::report::calibration::{fit_csv, CalibrationSummary, ChannelErrors, Errors, Noise, TraceErrors};
+use crate::report::calibration::{
+    fit_csv, CalibrationSummary, ChannelErrors, Errors, Noise, Plausibility, Profile, TraceErrors,
+};
 
-use super::lm::{self, Evaluation, LmOptions};
+use super::lm::{self, Evaluation};
 use super::params::Parameter;
 use super::problem::Simulation;
 use super::residuals::{Ar1, Layout};
 use super::stack::{Stack, TraceInput};
 use super::{
-    bands, check_finite, correlation, identifiability, identifiable, model_file, parameters, stats, unequal,
-    CalibrateOptions, CalibrateResult, Fitted, Independent, MIN_INFLUENCE_K,
+    bands, check_finite, correlation, identifiability, identifiable, model_file, parameters, plausibility,
+    prior_influence, profile, solve, stats, CalibrateOptions, CalibrateResult, Fitted, Setup,
+    MIN_INFLUENCE_K,
 };
 use crate::job::{JobError, Model};
 
@@ -56,7 +59,8 @@ fn influenced(s: &Stack<'_>, influence: &[f64]) -> Result<(), JobError> {
 }
 
 /// Fit the stack; `eval` gives the stacked residuals and Jacobian at θ (the segments integrated
-/// here or on Dask workers).
+/// here or on Dask workers). The residual model, the priors (a MAP fit) and the profiles are
+/// those of a fit of one segment ([`super::solve`]) over the stacked rows.
 pub fn fit(
     m: &Model,
     s: &Stack<'_>,
@@ -71,65 +75,14 @@ pub fn fit(
         .collect();
     influenced(s, &influence)?;
     let free = vec![true; s.params.len()];
-    let bounds: Vec<(f64, f64)> = s.params.iter().map(Parameter::theta_bounds).collect();
-    let lmo = LmOptions {
-        max_iterations: o.max_iterations,
-        ..LmOptions::default()
+    let setup = Setup {
+        params: &s.params,
+        priors: &s.priors,
+        layout: s.layout(),
+        fail: &|r| singular(s, r),
     };
-    let ols = lm::minimise(eval, &theta0, at0, &bounds, &free, &lmo)?;
-    singular(s, &ols)?;
-    let id_ols = identifiable(&ols.theta, &bounds, &free);
-    let independent = Independent {
-        lin: stats::linearised(&ols.at.j, ols.at.r.norm_squared(), &id_ols, 0),
-        theta: ols.theta.clone(),
-    };
-    let layout = s.layout();
-    let known = !layout.stretch.is_empty();
-    let (res, noise, weights) = if o.residuals == "ar1" && known {
-        let models = layout.estimate(&ols.at.r);
-        let w: Vec<f64> = models.iter().map(Ar1::long_run_sd).collect();
-        if unequal(&w) {
-            let res = map_weighted(eval, ols, &w, &bounds, &free, &lmo)?;
-            let models = layout.estimate(&res.at.r);
-            (res, Some(models), Some(w))
-        } else {
-            (ols, Some(models), None)
-        }
-    } else {
-        (ols, None, None)
-    };
-    let f = Fitted {
-        res,
-        weights,
-        noise,
-        whitened: false,
-        layout,
-        independent,
-        influence,
-        free,
-    };
-    assemble(m, s, o, &f, clock)
-}
-
-/// The weighted least-squares fit from `ols`: each channel's rows divided by its noise scale
-/// `w` (docs/calibration.md, "The residual model"); its evaluation unweighted, its evaluations
-/// counting those of `ols`.
-fn map_weighted(
-    eval: &dyn Fn(&[f64]) -> Result<Evaluation, JobError>,
-    ols: lm::LmResult,
-    w: &[f64],
-    bounds: &[(f64, f64)],
-    free: &[bool],
-    lmo: &LmOptions,
-) -> Result<lm::LmResult, JobError> {
-    let ev = |th: &[f64]| eval(th).map(|e| super::prior::weighted(e, w));
-    let at0 = super::prior::weighted(ols.at, w);
-    let mut res = lm::minimise(ev, &ols.theta, at0, bounds, free, lmo)?;
-    let back: Vec<f64> = w.iter().map(|x| 1.0 / x).collect();
-    res.at = super::prior::weighted(res.at, &back);
-    res.evaluations += ols.evaluations;
-    res.iterations += ols.iterations;
-    Ok(res)
+    let f = solve(eval, &setup, (&theta0, at0), influence, free, o)?;
+    assemble(m, s, o, &f, eval, clock)
 }
 
 fn singular(s: &Stack<'_>, res: &lm::LmResult) -> Result<(), JobError> {
@@ -156,12 +109,15 @@ fn local_cov(s: &Stack<'_>, k: usize, cov: &[Vec<f64>]) -> Vec<Vec<f64>> {
 /// trajectory that leaves the physics envelope as an error (exit 2).
 fn final_sims(s: &Stack<'_>, theta: &[f64]) -> Result<Vec<Simulation>, JobError> {
     use rayon::prelude::*;
+    // A prediction with its band from a calibration runs each segment at that calibration's
+    // parameters (a per-trace one at its trace's value), with their sensitivities.
     let sims: Vec<Simulation> = (0..s.segments.len())
         .into_par_iter()
-        .map(|k| {
-            s.segments[k]
+        .map(|k| match s.bands.get(k) {
+            Some(b) => b.problem.simulate(&b.problem.start(), true),
+            None => s.segments[k]
                 .problem
-                .simulate(&s.local_theta(k, theta), !s.params.is_empty())
+                .simulate(&s.local_theta(k, theta), !s.params.is_empty()),
         })
         .collect::<Result<_, _>>()?;
     for (k, sim) in sims.iter().enumerate() {
@@ -188,19 +144,28 @@ fn final_sims(s: &Stack<'_>, theta: &[f64]) -> Result<Vec<Simulation>, JobError>
 /// Per segment: residual and band half-width, `[row][channel]` in the stack's channel order.
 type Rows = Vec<(Vec<Vec<f64>>, Vec<Vec<f64>>)>;
 
-fn residual_rows(s: &Stack<'_>, sims: &[Simulation], cov: &[Vec<f64>], noise: &[Ar1], t: f64) -> Rows {
-    sims.iter()
-        .enumerate()
-        .map(|(k, sim)| {
-            let g = &s.segments[k];
-            let local_noise: Vec<Ar1> = {
-                let mut v = noise.to_vec();
-                for (c, &col) in g.perm.iter().enumerate() {
-                    v[col] = noise[c];
+fn residual_rows(
+    s: &Stack<'_>,
+    sims: &[Simulation],
+    cov: &[Vec<f64>],
+    noise: &[Ar1],
+    t: f64,
+) -> Result<Rows, JobError> {
+    use rayon::prelude::*;
+    (0..sims.len())
+        .into_par_iter()
+        .map(|k| {
+            let (g, sim) = (&s.segments[k], &sims[k]);
+            let half = match s.bands.get(k) {
+                Some(b) => bands::half_widths(sim, &b.covariance, &b.noise, b.t975),
+                None => {
+                    let mut local = noise.to_vec();
+                    for (c, &col) in g.perm.iter().enumerate() {
+                        local[col] = noise[c];
+                    }
+                    bands::half_widths(sim, &local_cov(s, k, cov), &local, t)
                 }
-                v
             };
-            let half = bands::half_widths(sim, &local_cov(s, k, cov), &local_noise, t);
             let res = (0..sim.temps_c.len())
                 .map(|r| {
                     g.perm
@@ -213,7 +178,7 @@ fn residual_rows(s: &Stack<'_>, sims: &[Simulation], cov: &[Vec<f64>], noise: &[
                 .iter()
                 .map(|h| g.perm.iter().map(|&c| h[c]).collect())
                 .collect();
-            (res, half)
+            Ok((res, half))
         })
         .collect()
 }
@@ -331,18 +296,8 @@ fn model_text(
     Ok(text)
 }
 
-fn assemble(
-    m: &Model,
-    s: &Stack<'_>,
-    o: &CalibrateOptions,
-    f: &Fitted,
-    clock: Instant,
-) -> Result<CalibrateResult, JobError> {
-    let res = &f.res;
-    let bounds: Vec<(f64, f64)> = s.params.iter().map(Parameter::theta_bounds).collect();
-    let ident = identifiable(&res.theta, &bounds, &f.free);
-    let (lin, _) = super::statistics(f, &ident);
-    let t = stats::t975(lin.dof);
+/// The traces' reader notes (once each; the segment notes left out) and the fit's stop.
+fn first_warnings(s: &Stack<'_>, res: &lm::LmResult) -> Vec<String> {
     let mut warnings: Vec<String> = Vec::new();
     for g in &s.segments {
         for n in &g.problem.trace.notes {
@@ -351,67 +306,216 @@ fn assemble(
             }
         }
     }
-    let params = parameters(&s.params, f, &ident, &lin, t, &mut warnings);
-    let correlation = correlation(&s.params, &lin, &mut warnings);
-    let identifiability = identifiability(&s.params, &lin, t, &mut warnings);
     if res.stop == lm::Stop::Budget {
         warnings.push(format!(
             "the fit stopped after {} evaluations (max_iterations) before converging",
             res.evaluations
         ));
     }
-    let sims = final_sims(s, &res.theta)?;
-    let ar = f.noise.clone().unwrap_or_else(|| {
-        vec![
-            Ar1 {
-                phi: 0.0,
-                sigma: lin.sigma2.sqrt()
-            };
-            s.nodes.len()
-        ]
-    });
-    let rows = residual_rows(s, &sims, &lin.covariance, &ar, t);
-    let known = !f.layout.stretch.is_empty();
-    let noise = noise_table(f, &ar);
-    let all: Vec<usize> = (0..s.segments.len()).collect();
-    let channels = channel_table(s, &rows, &all, &noise, known);
-    let traces = (0..s.names.len())
+    if res.stop == lm::Stop::Stall {
+        warnings.push(format!(
+            "the fit stopped after {} evaluations: the cost fell by less than 1e-4 of itself over the \
+             last 5 accepted steps, below what the integration's tolerance resolves",
+            res.evaluations
+        ));
+    }
+    warnings
+}
+
+/// The segments of trace `ti`.
+fn segments_of(s: &Stack<'_>, ti: usize) -> Vec<usize> {
+    (0..s.segments.len())
+        .filter(|&k| s.segments[k].trace == ti)
+        .collect()
+}
+
+/// The calibrated losses (docs/calibration.md, "Plausibility") over the segments `which` (one
+/// trace's, or every segment when every parameter is shared), their warnings prefixed by
+/// `label`.
+fn plausibility_of(
+    s: &Stack<'_>,
+    sims: &[Simulation],
+    which: &[usize],
+    theta: &[f64],
+    o: &CalibrateOptions,
+    label: &str,
+    warnings: &mut Vec<String>,
+) -> Result<Option<Plausibility>, JobError> {
+    let Some(&first) = which.first() else {
+        return Ok(None);
+    };
+    let rated = o.rated.as_deref().map(plausibility::rated_point).transpose()?;
+    let parts: Vec<(&super::problem::Problem<'_>, &[Vec<f64>])> = which
+        .iter()
+        .map(|&k| (&s.segments[k].problem, &sims[k].temps_c[..]))
+        .collect();
+    let mut own = Vec::new();
+    let p = plausibility::assess(
+        &parts,
+        &s.local_theta(first, theta),
+        o.gearbox_kind.as_deref(),
+        rated,
+        &mut own,
+    )?;
+    for w in own {
+        let w = format!("{label}{w}");
+        if !warnings.contains(&w) {
+            warnings.push(w);
+        }
+    }
+    Ok(p)
+}
+
+/// The profile likelihoods asked for, of the stacked objective.
+fn profiles_of(
+    s: &Stack<'_>,
+    f: &Fitted,
+    eval: &dyn Fn(&[f64]) -> Result<Evaluation, JobError>,
+    noise: &[Ar1],
+    lin: &stats::Linearised,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<Profile>, JobError> {
+    let objective = profile::Objective {
+        eval,
+        params: &s.params,
+        priors: &s.priors,
+        fail: &|r| singular(s, r),
+        noise,
+        whitened: f.whitened,
+        layout: &f.layout,
+    };
+    let profiles = s
+        .profile
+        .iter()
+        .map(|&k| profile::profile(&objective, k, &f.res.theta, lin.std_err[k], lin.dof, &f.free))
+        .collect::<Result<Vec<_>, _>>()?;
+    for q in profiles.iter().filter(|q| q.below_fit.is_some()) {
+        warnings.push(format!(
+            "profile of {}: the objective is lower by {:.3} at {} than at the fitted value: the fit stopped short \
+             along a flat valley (the least point of profile.csv is the better one)",
+            q.key_path,
+            q.below_fit.unwrap_or(0.0),
+            q.points.iter().find(|x| x.statistic == 0.0).map_or(f64::NAN, |x| x.value)
+        ));
+    }
+    Ok(profiles)
+}
+
+/// Per trace: its segments, rows, errors per channel and, when the parameters differ per trace,
+/// its calibrated model's losses.
+fn trace_reports(
+    s: &Stack<'_>,
+    sims: &[Simulation],
+    rows: &Rows,
+    (noise, known): (&[Noise], bool),
+    o: &CalibrateOptions,
+    theta: &[f64],
+    warnings: &mut Vec<String>,
+) -> Result<Vec<TraceErrors>, JobError> {
+    let per_trace = s.owners.iter().any(Option::is_some);
+    (0..s.names.len())
         .map(|ti| {
-            let which: Vec<usize> = all
-                .iter()
-                .copied()
-                .filter(|&k| s.segments[k].trace == ti)
-                .collect();
-            TraceErrors {
+            let which = segments_of(s, ti);
+            let label = format!("trace {}: ", s.names[ti]);
+            let plausibility = if per_trace {
+                plausibility_of(s, sims, &which, theta, o, &label, warnings)?
+            } else {
+                None
+            };
+            Ok(TraceErrors {
                 name: s.names[ti].clone(),
                 source: s.sources[ti].clone(),
                 index: ti,
                 segments: which.iter().map(|&k| s.segments[k].index).collect(),
                 rows: which.iter().map(|&k| s.segments[k].held.len()).sum(),
-                channels: channel_table(s, &rows, &which, &noise, known),
-            }
+                channels: channel_table(s, rows, &which, noise, known),
+                plausibility,
+            })
         })
-        .collect();
+        .collect()
+}
+
+/// The residual process of each channel: the fit's, or with `--band-from` the calibration's
+/// (in the stack's channel order); without either, independent errors of variance σ².
+fn channel_noise(s: &Stack<'_>, f: &Fitted, sigma2: f64) -> Vec<Ar1> {
+    if let Some(b) = s.bands.first() {
+        return s.segments[0].perm.iter().map(|&c| b.noise[c]).collect();
+    }
+    f.noise.clone().unwrap_or_else(|| {
+        vec![
+            Ar1 {
+                phi: 0.0,
+                sigma: sigma2.sqrt()
+            };
+            s.nodes.len()
+        ]
+    })
+}
+
+/// The calibrated model texts: `calibrated.toml` (every parameter shared) or one per trace.
+fn model_texts(
+    s: &Stack<'_>,
+    m: &Model,
+    theta: &[f64],
+    comment: &str,
+) -> Result<(String, Vec<(String, String)>), JobError> {
+    if !s.owners.iter().any(Option::is_some) {
+        return Ok((model_text(s, m, theta, None, comment)?, Vec::new()));
+    }
+    let models = (0..s.names.len())
+        .map(|ti| {
+            Ok((
+                format!("calibrated_{}.toml", file_safe(&s.names[ti])),
+                model_text(s, m, theta, Some(ti), comment)?,
+            ))
+        })
+        .collect::<Result<Vec<_>, JobError>>()?;
+    Ok((String::new(), models))
+}
+
+fn assemble(
+    m: &Model,
+    s: &Stack<'_>,
+    o: &CalibrateOptions,
+    f: &Fitted,
+    eval: &dyn Fn(&[f64]) -> Result<Evaluation, JobError>,
+    clock: Instant,
+) -> Result<CalibrateResult, JobError> {
+    let res = &f.res;
+    let bounds: Vec<(f64, f64)> = s.params.iter().map(Parameter::theta_bounds).collect();
+    let ident = identifiable(&res.theta, &bounds, &f.free);
+    let (mut lin, data_se) = super::statistics(f, &ident);
+    if !s.priors.is_empty() {
+        stats::posterior(&mut lin, &s.priors.information(&s.params, &res.theta));
+    }
+    let t = stats::t975(lin.dof);
+    let mut warnings = first_warnings(s, res);
+    let mut params = parameters(&s.params, f, &ident, &lin, t, &mut warnings);
+    prior_influence(&s.priors, &s.params, f, &data_se, &mut params);
+    let correlation = correlation(&s.params, &lin, &mut warnings);
+    let identifiability = identifiability(&s.params, &lin, t, &mut warnings);
+    let sims = final_sims(s, &res.theta)?;
+    let fit_noise = f.noise.clone().unwrap_or_else(|| channel_noise(s, f, lin.sigma2));
+    let rows = residual_rows(s, &sims, &lin.covariance, &fit_noise, t)?;
+    let known = !f.layout.stretch.is_empty() || !s.bands.is_empty();
+    let ar = channel_noise(s, f, lin.sigma2);
+    let noise = noise_table(f, &ar);
+    let all: Vec<usize> = (0..s.segments.len()).collect();
+    let channels = channel_table(s, &rows, &all, &noise, known);
+    let plausibility = if s.owners.iter().any(Option::is_some) {
+        None
+    } else {
+        plausibility_of(s, &sims, &all, &res.theta, o, "", &mut warnings)?
+    };
+    let traces = trace_reports(s, &sims, &rows, (&noise, known), o, &res.theta, &mut warnings)?;
+    let profiles = profiles_of(s, f, eval, &fit_noise, &lin, &mut warnings)?;
     let covariance: Vec<Vec<Option<f64>>> = lin
         .covariance
         .iter()
         .map(|row| row.iter().map(|&x| x.is_finite().then_some(x)).collect())
         .collect();
     let comment = model_file::covariance_comment(&params, &covariance);
-    let per_trace = s.owners.iter().any(Option::is_some);
-    let (calibrated, per_trace_models) = if per_trace {
-        let models = (0..s.names.len())
-            .map(|ti| {
-                Ok((
-                    format!("calibrated_{}.toml", file_safe(&s.names[ti])),
-                    model_text(s, m, &res.theta, Some(ti), &comment)?,
-                ))
-            })
-            .collect::<Result<Vec<_>, JobError>>()?;
-        (String::new(), models)
-    } else {
-        (model_text(s, m, &res.theta, None, &comment)?, Vec::new())
-    };
+    let (calibrated, per_trace_models) = model_texts(s, m, &res.theta, &comment)?;
     let summary = CalibrationSummary {
         model: m.gearbox.name.clone(),
         trace: s.sources.join(", "),
@@ -423,8 +527,8 @@ fn assemble(
         identifiability,
         channels,
         fit: super::fit_stats(&f.res, o, &ar, &lin, t, clock),
-        profiles: Vec::new(),
-        plausibility: None,
+        profiles,
+        plausibility,
         warnings,
         traces,
     };

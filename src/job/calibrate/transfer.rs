@@ -2,7 +2,10 @@
 //! the previous calibration's covariance of its fitted coordinates carried through the
 //! sensitivities on this trace, plus each channel's residual process as that calibration
 //! estimated it (the same half-width formula as [`super::bands`]). The model run is the
-//! calibrated one (`calibrated.toml`): the parameters are evaluated at the values it holds.
+//! calibrated one (`calibrated.toml`): the parameters are evaluated at the values it holds,
+//! except a parameter of one trace in a calibration over several (`KEYPATH@X`), which a
+//! prediction of trace X takes at the calibration's value for X (the model file holds one
+//! trace's value).
 
 use serde::Deserialize;
 
@@ -14,6 +17,7 @@ use crate::job::JobError;
 #[derive(Deserialize)]
 struct JsonParameter {
     key_path: String,
+    value: f64,
     lower_bound: f64,
     upper_bound: f64,
     scale: String,
@@ -56,14 +60,46 @@ pub struct BandSource<'a> {
     pub t975: f64,
 }
 
+/// The calibration's parameters a prediction of trace `name` takes: the shared ones and those of
+/// trace `name` (`KEYPATH@name`); with parameters of other traces only, none of `name`'s, the
+/// trace's own values are unknown: invalid input naming the trace.
+fn parameters_of(c: &JsonCalibration, name: &str, file: &str) -> Result<Vec<usize>, JobError> {
+    let owner = |q: &JsonParameter| super::params::split_owner(&q.key_path).1.map(str::to_string);
+    let owned: Vec<String> = c.parameters.iter().filter_map(owner).collect();
+    if !owned.is_empty() && !owned.iter().any(|o| o == name) {
+        let mut traces = owned.clone();
+        traces.sort();
+        traces.dedup();
+        let keys: Vec<&str> = c
+            .parameters
+            .iter()
+            .filter(|q| owner(q).is_some())
+            .map(|q| q.key_path.as_str())
+            .collect();
+        return Err(JobError::invalid(format!(
+            "{file}: trace {name}: the calibration fitted parameters per trace ({}) for the traces {}, not for \
+             {name}: the band of trace {name} needs its own values' uncertainty (name the trace as the \
+             calibration did, or calibrate the parameters shared)",
+            keys.join(", "),
+            traces.join(", ")
+        )));
+    }
+    Ok((0..c.parameters.len())
+        .filter(|&k| owner(&c.parameters[k]).map_or(true, |o| o == name))
+        .collect())
+}
+
 /// Read a `calibration.json` (`file` names it) and map it onto `base` (this trace's problem
-/// without parameters): every parameter resolved in the model at hand, every measured node of the
-/// trace among the calibration's channels; else invalid input naming the file and what is missing.
+/// without parameters; `name` the trace's name, `KEYPATH@name` its own parameters in a
+/// calibration over several traces): every parameter resolved in the model at hand, every
+/// measured node of the trace among the calibration's channels; else invalid input naming the
+/// file and what is missing.
 pub fn band_source<'a>(
     base: &Problem<'a>,
     doc: &toml::Table,
     json: &str,
     file: &str,
+    name: &str,
 ) -> Result<BandSource<'a>, JobError> {
     let bad = |m: String| JobError::invalid(format!("{file}: {m}"));
     let c: JsonCalibration =
@@ -72,13 +108,26 @@ pub fn band_source<'a>(
     if c.covariance.len() != np || c.covariance.iter().any(|r| r.len() != np) {
         return Err(bad(format!("covariance: must be {np} × {np}")));
     }
-    let mut params = Vec::with_capacity(np);
-    for (k, q) in c.parameters.iter().enumerate() {
-        let spec: FitSpec = format!("{}={}:{}", q.key_path, q.lower_bound, q.upper_bound)
+    let kept = parameters_of(&c, name, file)?;
+    let mut params = Vec::with_capacity(kept.len());
+    for &k in &kept {
+        let q = &c.parameters[k];
+        let key = super::params::split_owner(&q.key_path).0;
+        let spec: FitSpec = format!("{key}={}:{}", q.lower_bound, q.upper_bound)
             .parse()
             .map_err(|e: String| bad(format!("parameters[{k}]: {e}")))?;
-        let p = Parameter::resolve(&spec, doc)
+        let mut p = Parameter::resolve(&spec, doc)
             .map_err(|e| bad(format!("parameters[{k}] ({}): {e}", q.key_path)))?;
+        if super::params::split_owner(&q.key_path).1.is_some() {
+            // The model file holds one trace's value; trace `name`'s is the calibration's.
+            if !(q.value.is_finite() && (q.lower_bound..=q.upper_bound).contains(&q.value)) {
+                return Err(bad(format!(
+                    "parameters[{k}] ({}): value {} must lie in its bounds [{}, {}]",
+                    q.key_path, q.value, q.lower_bound, q.upper_bound
+                )));
+            }
+            p.start = q.value;
+        }
         if (q.scale == "log") != p.log {
             return Err(bad(format!(
                 "parameters[{k}] ({}): scale {} does not match the model's value {}",
@@ -100,10 +149,13 @@ pub fn band_source<'a>(
             sigma: ch.noise.innovation_sd_k,
         });
     }
-    let covariance = c
-        .covariance
+    let covariance = kept
         .iter()
-        .map(|r| r.iter().map(|x| x.unwrap_or(f64::NAN)).collect())
+        .map(|&a| {
+            kept.iter()
+                .map(|&b| c.covariance[a][b].unwrap_or(f64::NAN))
+                .collect()
+        })
         .collect();
     let problem = base.with_params(params);
     Ok(BandSource {
@@ -112,4 +164,11 @@ pub fn band_source<'a>(
         noise,
         t975: c.fit.t975,
     })
+}
+
+/// A trace's name from its source: the file's stem (as `calibrate --trace` names it).
+pub fn trace_name(source: &str) -> String {
+    std::path::Path::new(source)
+        .file_stem()
+        .map_or_else(|| source.to_string(), |s| s.to_string_lossy().into_owned())
 }
