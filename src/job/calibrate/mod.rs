@@ -963,19 +963,7 @@ fn assemble(
     let correlation = correlation(&pr.params, &lin, &mut warnings);
     let identifiability = identifiability(&pr.params, &lin, t, &mut warnings);
     singular(p, res)?;
-    if res.stop == lm::Stop::Budget {
-        warnings.push(format!(
-            "the fit stopped after {} evaluations (max_iterations) before converging",
-            res.evaluations
-        ));
-    }
-    if res.stop == lm::Stop::Stall {
-        warnings.push(format!(
-            "the fit stopped after {} evaluations: the cost fell by less than 1e-4 of itself over the \
-             last 5 accepted steps, below what the integration's tolerance resolves",
-            res.evaluations
-        ));
-    }
+    warnings.extend(lm::stop_warning(res));
     // A prediction with a band from a calibration runs at that calibration's parameters: the
     // model's values, a per-trace parameter of this trace the calibration's value for it.
     let sim = match &p.band_source {

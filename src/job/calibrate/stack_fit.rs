@@ -306,19 +306,7 @@ fn first_warnings(s: &Stack<'_>, res: &lm::LmResult) -> Vec<String> {
             }
         }
     }
-    if res.stop == lm::Stop::Budget {
-        warnings.push(format!(
-            "the fit stopped after {} evaluations (max_iterations) before converging",
-            res.evaluations
-        ));
-    }
-    if res.stop == lm::Stop::Stall {
-        warnings.push(format!(
-            "the fit stopped after {} evaluations: the cost fell by less than 1e-4 of itself over the \
-             last 5 accepted steps, below what the integration's tolerance resolves",
-            res.evaluations
-        ));
-    }
+    warnings.extend(lm::stop_warning(res));
     warnings
 }
 
