@@ -309,6 +309,23 @@ fn gradient_small(j: &DMatrix<f64>, r: &DVector<f64>, g: &DVector<f64>, tol: f64
     })
 }
 
+/// The warning a fit's stop deserves: a budget run out before converging, or a cost that stalled
+/// below what the integration's tolerance resolves (`None` for a converged stop).
+pub(crate) fn stop_warning(res: &LmResult) -> Option<String> {
+    match res.stop {
+        Stop::Budget => Some(format!(
+            "the fit stopped after {} evaluations (max_iterations) before converging",
+            res.evaluations
+        )),
+        Stop::Stall => Some(format!(
+            "the fit stopped after {} evaluations: the cost fell by less than 1e-4 of itself over the \
+             last 5 accepted steps, below what the integration's tolerance resolves",
+            res.evaluations
+        )),
+        _ => None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -470,22 +487,5 @@ mod tests {
             }
         }
         assert!(res.evaluations <= 20, "{} evaluations", res.evaluations);
-    }
-}
-
-/// The warning a fit's stop deserves: a budget run out before converging, or a cost that stalled
-/// below what the integration's tolerance resolves (`None` for a converged stop).
-pub(crate) fn stop_warning(res: &LmResult) -> Option<String> {
-    match res.stop {
-        Stop::Budget => Some(format!(
-            "the fit stopped after {} evaluations (max_iterations) before converging",
-            res.evaluations
-        )),
-        Stop::Stall => Some(format!(
-            "the fit stopped after {} evaluations: the cost fell by less than 1e-4 of itself over the \
-             last 5 accepted steps, below what the integration's tolerance resolves",
-            res.evaluations
-        )),
-        _ => None,
     }
 }
