@@ -19,6 +19,7 @@ Families (share of the cases; modules under scripts/hostile/):
 | report | crafted run, map and bench directories given to `report` | report.py |
 | uq | generated `[uncertainty]` sections (model or study file) and hostile `uq` options; a journal of other inputs in the output directory; a resumed run; `check` agreeing with `uq` on the model's own inputs | uq.py |
 | fmu | `fmu` export with hostile `--param` key paths and `--out` names (unwritable, no `.fmu`, a directory) | uq.py |
+| calibrate_traces | `calibrate` over several generated traces: shared and per-trace `--fit` keys, priors (command line and file), `--profile`, `--residuals`, `--rated`, `--gearbox-kind`, `--segment`, `--holdout`, `--band-from` a calibration over several traces or a crafted one | calibrate.py |
 | python | bad arguments and DataFrames through the Python API, and through a process pool | pyapi.py, pyworker.py |
 
 Each case runs in its own scratch directory under an 8 GiB address-space limit with a time
@@ -41,11 +42,12 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from hostile import cli, core, pyapi, report, stdio, study, uq  # noqa: E402
+from hostile import calibrate, cli, core, pyapi, report, stdio, study, uq  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 WEIGHTS = {"cli": 0.30, "set": 0.20, "study_spec": 0.08, "study_kill": 0.02, "study_two": 0.015,
-           "study_huge": 0.005, "stdio": 0.10, "report": 0.12, "python": 0.16, "uq": 0.04, "fmu": 0.02}
+           "study_huge": 0.005, "stdio": 0.10, "report": 0.12, "python": 0.16, "uq": 0.04, "fmu": 0.02,
+           "calibrate_traces": 0.04}
 SMALL_STUDY = """[study]
 name = "small"
 model = "{model}"
@@ -109,11 +111,14 @@ def make_case(i, seed, ctx, families):
         return report.make_case(i, rng)
     if fam in ("uq", "fmu"):
         return uq.make_case(i, rng, ROOT, ctx.texts, fam)
+    if fam == "calibrate_traces":
+        return calibrate.make_case(i, rng)
     return pyapi.make_case(i, rng, ROOT, ctx.texts)
 
 
 RUNNERS = {"cli": cli.run_case, "set": cli.run_case, "stdio": stdio.run_case, "report": report.run_case,
-           "python": pyapi.run_case, "uq": uq.run_case, "fmu": uq.run_case}
+           "python": pyapi.run_case, "uq": uq.run_case, "fmu": uq.run_case,
+           "calibrate_traces": calibrate.run_case}
 
 
 def run_case(case, ctx):

@@ -66,3 +66,31 @@ def test_a_dask_fit_equals_the_local_one():
     assert list(local.parameters["value"]) == list(remote.parameters["value"])
     assert list(local.parameters["ci95_low"]) == list(remote.parameters["ci95_low"])
     assert local.fit.equals(remote.fit)
+
+
+def test_options_of_one_segment_over_several_traces():
+    """Priors (on a shared and on a per-trace parameter), a profile of a per-trace parameter,
+    ``ar1-gls`` and a rated point over two traces: the one pipeline of the job layer, Python
+    converting only. A bad prior over several traces is refused with the job layer's message."""
+    m = geartherm.Model.load(MODEL)
+    a, b = _trace(m, 11.0), _trace(m, 20.0)
+    kw = dict(traces=[a, b], names=["a", "b"], fit=[H, f"{M}@*=2:60"])
+    r = m.calibrate(
+        **kw,
+        prior={H: ("lognormal", 400.0, 5.0), f"{M}@b": ("normal", 19.0, 0.0005)},
+        profile=[f"{M}@a"],
+        residuals="ar1-gls",
+        rated=(4000.0, 250.0),
+    )
+    assert r.summary["fit"]["residual_model"] == "ar1-gls"
+    values = dict(zip(r.parameters["key_path"], r.parameters["value"]))
+    # The traces are noise-free (rounded to 0.1 mK): the data outweigh both priors.
+    assert math.isclose(values[f"{M}@b"], 20.0, rel_tol=0.01), values
+    assert math.isclose(values[f"{M}@a"], 11.0, rel_tol=0.01), values
+    assert set(r.priors["key_path"]) == {H, f"{M}@b"}
+    assert ((r.priors["prior_share"] >= 0) & (r.priors["prior_share"] <= 1)).all()
+    assert set(r.profiles["key_path"]) == {f"{M}@a"}
+    for t in r.summary["traces"]:
+        assert t["plausibility"]["rated"]["input_speed_rpm"] == pytest.approx(4000.0)
+    with pytest.raises(geartherm.InputError, match="no trace is named"):
+        m.calibrate(**kw, prior={f"{M}@c": ("normal", 15.0, 1.0)})

@@ -170,7 +170,9 @@ fn file_entry(t: &toml::Table, at: &str) -> Result<String, String> {
         Kind::Lognormal => (field(t, "median", at)?, field(t, "sd_ln", at)?),
     };
     check_numbers(kind, location, width, &|f| format!("{at}.{f}"))?;
-    key.parse::<KeyPath>()
+    super::params::split_owner(key)
+        .0
+        .parse::<KeyPath>()
         .map_err(|e| format!("{at}.key = {key:?}: bad key path: {e}"))?;
     let name = if kind == Kind::Normal {
         "normal"
@@ -397,6 +399,12 @@ mod tests {
         let bad = format!("{ok}[[prior]]\nkey = 'a.b'\ndistribution = 'normal'\nmean = 1\nsd = -2\n");
         let e = from_file(&bad, "p.toml").unwrap_err().to_string();
         assert!(e.contains("p.toml: prior[1].sd = -2"), "{e}");
+        // A trace's own parameter (a fit over several traces) keeps its @TRACE.
+        let own = "[[prior]]\nkey = 'a.b@t1'\ndistribution = 'normal'\nmean = 1\nsd = 2\n";
+        assert_eq!(
+            from_file(own, "p.toml").unwrap(),
+            vec!["a.b@t1=normal:1:2".to_string()]
+        );
         let e = from_file(
             "[[prior]]\nkey='a'\ndistribution='normal'\nmean=1\nsd=1\nmedian=2\n",
             "p.toml",
