@@ -94,6 +94,9 @@ def main():
     print(f"wall {wall:.1f} s, CPU (user+sys) {cpu:.1f} s, load {load0[0]:.1f} before, {load1[0]:.1f} after, "
           f"{os.cpu_count()} cores")
     for p in figures["parameters"]:
+        if p["ci95_low"] is None:
+            print(f"  {p['key_path']}: {p['value']:.4g} (no interval: at a bound or not influenced)")
+            continue
         print(f"  {p['key_path']}: {p['value']:.4g} [{p['ci95_low']:.4g}, {p['ci95_high']:.4g}] "
               f"(independent errors [{p['ci95_independent_low']:.4g}, {p['ci95_independent_high']:.4g}])")
     for t in figures["traces"]:
