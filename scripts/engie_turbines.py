@@ -34,13 +34,21 @@ SHARED = [
     "losses.multiplier.churning=0.01:100",
     'thermal.links["gearbox-nacelle"].h_w_per_m2k=0.5:100',
 ]
-# name: (--fit arguments, turbines fitted). The single-turbine fit is that of
+# The churning law of the model file is Changenet–Velex; `SEETHARAMAN` sets Seetharaman and
+# Kahraman's instead (docs/validation.md, "both turbines in one fit": the Changenet–Velex
+# regime bridge of wheel 1 lies inside the traces' speed and oil-temperature range).
+SEETHARAMAN = ['losses.churning="seetharaman"']
+# name: (--fit arguments, turbines fitted, --set arguments). The single-turbine fit is that of
 # scripts/engie_calibration.sh (same parameters, same bounds).
 FITS = {
-    "single R80711": (SHARED + [f"{CAP}=100:30000", f"{OPEN}=45:61"], ["R80711"]),
-    "both, cooler per turbine": (SHARED + [f"{CAP}@*=100:30000", f"{OPEN}=45:61"], ["R80711", "R80721"]),
+    "single R80711": (SHARED + [f"{CAP}=100:30000", f"{OPEN}=45:61"], ["R80711"], []),
+    "both, cooler per turbine": (SHARED + [f"{CAP}@*=100:30000", f"{OPEN}=45:61"], ["R80711", "R80721"], []),
     "both, cooler and thermostat per turbine": (SHARED + [f"{CAP}@*=100:30000", f"{OPEN}@*=45:61"],
-                                                ["R80711", "R80721"]),
+                                                ["R80711", "R80721"], []),
+    "single R80711, Seetharaman–Kahraman churning": (SHARED + [f"{CAP}=100:30000", f"{OPEN}=45:61"], ["R80711"],
+                                                     SEETHARAMAN),
+    "both, cooler per turbine, Seetharaman–Kahraman churning": (
+        SHARED + [f"{CAP}@*=100:30000", f"{OPEN}=45:61"], ["R80711", "R80721"], SEETHARAMAN),
 }
 
 
@@ -62,11 +70,36 @@ def traces(data, out):
     return os.path.join(out, "traces")
 
 
-def band_json(cal, turbine, trace_name, path):
+def own_ar1(fit_csv, trace_name):
+    """The AR(1) residual process of one trace's fitted sump rows (fit.csv), estimated as
+    `geartherm calibrate` estimates the fit's (src/job/calibrate/residuals.rs): φ by least squares
+    on consecutive fitted rows of a segment with the bias −(1 + 3φ)/n added back, σ_a from the
+    Prais–Winsten innovations."""
+    x, cont = [], []
+    prev = None
+    with open(fit_csv) as fh:
+        for row in csv.DictReader(fh):
+            if row["trace"] != trace_name or row["holdout"] != "0":
+                prev = None
+                continue
+            cont.append(prev is not None and prev == row["segment"])
+            x.append(float(row["sump_residual_k"]))
+            prev = row["segment"]
+    n = len(x)
+    pairs = [i for i in range(1, n) if cont[i]]
+    ls = sum(x[i] * x[i - 1] for i in pairs) / sum(x[i - 1] ** 2 for i in pairs)
+    phi = max(-0.99, min(0.99, ls + (1.0 + 3.0 * ls) / n))
+    ss = sum((x[i] - phi * x[i - 1]) ** 2 if cont[i] else (1.0 - phi * phi) * x[i] ** 2 for i in range(n))
+    sigma = math.sqrt(ss / n)
+    return {"phi": phi, "innovation_sd_k": sigma, "marginal_sd_k": sigma / math.sqrt(1.0 - phi * phi)}
+
+
+def band_json(cal, turbine, trace_name, path, own_noise=None):
     """The fit's calibration.json restricted to the parameters `turbine`'s model holds: the shared
     ones and its own (`KEY@trace_name` written as KEY), their covariance the sub-block of the
-    fit's (the marginal covariance of those coordinates), the residual process and t quantile
-    unchanged."""
+    fit's (the marginal covariance of those coordinates), the t quantile unchanged; the residual
+    process that of the fit (every trace's fitted rows together) or `own_noise` (φ, σ_a) in its
+    place."""
     keep, params = [], []
     for k, p in enumerate(cal["parameters"]):
         key = p["key_path"]
@@ -78,17 +111,21 @@ def band_json(cal, turbine, trace_name, path):
         keep.append(k)
         params.append(p)
     out = dict(cal, parameters=params, covariance=[[cal["covariance"][i][j] for j in keep] for i in keep])
+    if own_noise:
+        out["channels"] = [dict(cal["channels"][0], noise=dict(cal["channels"][0]["noise"], **own_noise))]
     with open(path, "w") as fh:
         json.dump(out, fh)
     return path
 
 
-def rows_errors(fit_csv, t0=None):
-    """Sump RMSE, bias and the fraction inside the 95 % band over the rows from t0 (s) on."""
+def rows_errors(fit_csv, t0=None, t1=None):
+    """Sump RMSE, bias and the fraction inside the 95 % band over the rows from t0 (s) on, before
+    t1 (s) when given."""
     n = s2 = s1 = inside = 0
     with open(fit_csv) as fh:
         for x in csv.DictReader(fh):
-            if t0 is not None and float(x["time_s"]) < t0:
+            t = float(x["time_s"])
+            if (t0 is not None and t < t0) or (t1 is not None and t >= t1):
                 continue
             r = float(x["sump_residual_k"])
             n += 1
@@ -109,13 +146,33 @@ def whole(fit_csv):
     return {k: h[k] for k in ("rows", "rmse_k", "bias_k", "inside_band95")}
 
 
-def one_fit(bin_, tr, name, fit, turbines, out):
+def own_band(bin_, tr, d, cal, turbine, rows):
+    """`turbine`'s held-out spring days and its summer predicted again with the band of its own
+    residual process (band_json's `own_noise`); the fraction inside it added to `rows` (the
+    spring prediction runs from the trace's start, as the fit does: its RMSE is the fit's)."""
+    spring, summer = f"{turbine}_2017-spring", f"{turbine}_2016-summer"
+    model = os.path.join(d, f"calibrated_{spring}.toml")
+    noise = own_ar1(os.path.join(d, "fit.csv"), spring)
+    band = band_json(cal, turbine, spring, os.path.join(d, f"band_own_{turbine}.json"), own_noise=noise)
+    f = predict(bin_, model, os.path.join(tr, f"{spring}.csv"), band, os.path.join(d, f"predict_own_{spring}"))
+    held = rows_errors(f, 1209600.0)
+    fitted = rows_errors(f, None, 1209600.0)
+    f = predict(bin_, model, os.path.join(tr, f"{summer}.csv"), band, os.path.join(d, f"predict_own_{summer}"))
+    for x, e in zip(rows, [fitted, held, whole(f)]):
+        x["inside_own_band95"] = e["inside_band95"]
+        x["rmse_own_run_k"] = e["rmse_k"]
+    return noise
+
+
+def one_fit(bin_, tr, name, fit, turbines, sets, out):
     d = os.path.join(out, name.replace(" ", "_").replace(",", ""))
     cmd = [bin_, "calibrate", MODEL]
     for t in turbines:
         cmd += ["--trace", os.path.join(tr, f"{t}_2017-spring.csv")]
     for f in fit:
         cmd += ["--fit", f]
+    for s in sets:
+        cmd += ["--set", s]
     cmd += ["--holdout", HOLDOUT, "--max-iterations", "60", "--out", d]
     before, t0 = os.times(), time.monotonic()
     run(cmd)
@@ -125,7 +182,8 @@ def one_fit(bin_, tr, name, fit, turbines, out):
            "cpu_s": after.children_user - before.children_user + after.children_system - before.children_system,
            "evaluations": cal["fit"]["evaluations"], "stop": cal["fit"]["stop"],
            "parameters": [{k: p[k] for k in ("key_path", "value", "ci95_low", "ci95_high")} for p in cal["parameters"]],
-           "noise": cal["channels"][0]["noise"], "rows": []}
+           "noise": cal["channels"][0]["noise"], "rows": [],
+           "own_noise": {}}
     by_trace = {t["name"].split("_")[0]: t for t in cal.get("traces", [])}
     for turbine in ["R80711", "R80721"]:
         spring, summer = f"{turbine}_2017-spring", f"{turbine}_2016-summer"
@@ -135,16 +193,60 @@ def one_fit(bin_, tr, name, fit, turbines, out):
             band = band_json(cal, turbine, spring, os.path.join(d, f"band_{turbine}.json")) if own else \
                 os.path.join(d, "calibration.json")
             ch = (by_trace[turbine]["channels"][0] if own else cal["channels"][0])
-            res["rows"].append(dict(ch["fitted"], trace=f"{turbine} spring 2017 days 1–14 (fitted)"))
-            res["rows"].append(dict(ch["holdout"], trace=f"{turbine} spring 2017 days 15–27 (held out)"))
+            res["rows"].append(dict(ch["fitted"], trace=f"{turbine} spring 2017 days 1–14 (fitted)",
+                                    key=f"{turbine} spring 2017 days 1–14"))
+            res["rows"].append(dict(ch["holdout"], trace=f"{turbine} spring 2017 days 15–27 (held out)",
+                                    key=f"{turbine} spring 2017 days 15–27"))
         else:
             model, band = os.path.join(d, "calibrated.toml"), os.path.join(d, "calibration.json")
             f = predict(bin_, model, os.path.join(tr, f"{spring}.csv"), band, os.path.join(d, f"predict_{spring}"))
-            res["rows"].append(dict(rows_errors(f, 1209600.0), trace=f"{turbine} spring 2017 days 15–27 (predicted)"))
+            res["rows"].append(dict(rows_errors(f, None, 1209600.0), trace=f"{turbine} spring 2017 days 1–14 (predicted)",
+                                    key=f"{turbine} spring 2017 days 1–14"))
+            res["rows"].append(dict(rows_errors(f, 1209600.0), trace=f"{turbine} spring 2017 days 15–27 (predicted)",
+                                    key=f"{turbine} spring 2017 days 15–27"))
             res["rows"].append(dict(whole(f), trace=f"{turbine} spring 2017 days 1–27 (predicted)"))
         f = predict(bin_, model, os.path.join(tr, f"{summer}.csv"), band, os.path.join(d, f"predict_{summer}"))
-        res["rows"].append(dict(whole(f), trace=f"{turbine} summer 2016 (predicted)"))
+        res["rows"].append(dict(whole(f), trace=f"{turbine} summer 2016 (predicted)", key=f"{turbine} summer 2016"))
+        if turbine in turbines and len(turbines) > 1:
+            res["own_noise"][spring] = own_band(bin_, tr, d, cal, turbine, res["rows"][-3:])
     return res
+
+
+def print_fit(r):
+    """One fit's residual processes and its table (the band of the fit's residual process, and for a
+    fit of both turbines that of each turbine's own beside it)."""
+    n = r["noise"]
+    print(f"  sump residuals (fitted rows): φ {n['phi']:.3f}, σ_a {n['innovation_sd_k']:.3f} K")
+    for t, m in r.get("own_noise", {}).items():
+        print(f"  {t}'s fitted rows alone: φ {m['phi']:.3f}, σ_a {m['innovation_sd_k']:.3f} K")
+    print("| trace | rows | sump RMSE, K | bias, K | inside the 95 % band | inside the band of the turbine's own "
+          "residual process |")
+    print("|---|---|---|---|---|---|")
+    for x in r["rows"]:
+        own = f"{100 * x['inside_own_band95']:.1f} %" if "inside_own_band95" in x else "—"
+        print(f"| {x['trace']} | {x['rows']} | {x['rmse_k']:.2f} | {x['bias_k']:+.2f} | "
+              f"{100 * x['inside_band95']:.1f} % | {own} |")
+    print(flush=True)
+
+
+def print_summary(results):
+    """docs/validation.md's table: per trace and fit, RMSE / bias / inside the band (the turbine's
+    own residual process in brackets where there is one)."""
+    if not results:
+        return
+    names = [r["name"] for r in results]
+    print("| trace | " + " | ".join(names) + " |")
+    print("|---|" + "---|" * len(names))
+    keys = [f"{t} {p}" for t in ("R80711", "R80721")
+            for p in ("spring 2017 days 1–14", "spring 2017 days 15–27", "summer 2016")]
+    for key in keys:
+        cells = []
+        for r in results:
+            y = next(x for x in r["rows"] if x.get("key") == key)
+            own = f" ({100 * y['inside_own_band95']:.1f} %)" if "inside_own_band95" in y else ""
+            cells.append(f"{y['rmse_k']:.2f} / {y['bias_k']:+.2f} / {100 * y['inside_band95']:.1f} %{own}")
+        print(f"| {key} | " + " | ".join(cells) + " |")
+    print()
 
 
 def main():
@@ -157,10 +259,10 @@ def main():
     tr = traces(a.data, a.out)
     load0 = os.getloadavg()[0]
     results = []
-    for name, (fit, turbines) in FITS.items():
+    for name, (fit, turbines, sets) in FITS.items():
         if a.only and a.only != name:
             continue
-        r = one_fit(a.bin, tr, name, fit, turbines, a.out)
+        r = one_fit(a.bin, tr, name, fit, turbines, sets, a.out)
         results.append(r)
         print(f"## {name}: {r['evaluations']} evaluations (stop: {r['stop']}), wall {r['wall_s']:.1f} s, "
               f"CPU {r['cpu_s']:.1f} s")
@@ -168,14 +270,8 @@ def main():
             ci = "no interval (at a bound or not determined)" if p["ci95_low"] is None else \
                 f"[{p['ci95_low']:.4g}, {p['ci95_high']:.4g}]"
             print(f"  {p['key_path']}: {p['value']:.4g} {ci}")
-        n = r["noise"]
-        print(f"  sump residuals (fitted rows): φ {n['phi']:.3f}, σ_a {n['innovation_sd_k']:.3f} K")
-        print("| trace | rows | sump RMSE, K | bias, K | inside the 95 % band |")
-        print("|---|---|---|---|---|")
-        for x in r["rows"]:
-            print(f"| {x['trace']} | {x['rows']} | {x['rmse_k']:.2f} | {x['bias_k']:+.2f} | "
-                  f"{100 * x['inside_band95']:.1f} % |")
-        print(flush=True)
+        print_fit(r)
+    print_summary(results)
     print(f"load {load0:.1f} before, {os.getloadavg()[0]:.1f} after")
     with open(os.path.join(a.out, "figures.json" if not a.only else "figures_one.json"), "w") as fh:
         json.dump(results, fh, indent=2)
