@@ -173,7 +173,8 @@ def one_fit(bin_, tr, name, fit, turbines, sets, out):
         cmd += ["--fit", f]
     for s in sets:
         cmd += ["--set", s]
-    cmd += ["--holdout", HOLDOUT, "--max-iterations", "60", "--out", d]
+    cmd += ["--holdout", HOLDOUT, "--max-iterations", "60", "--gearbox-kind", "wind-turbine", "--rated=1680:-11600",
+            "--out", d]
     before, t0 = os.times(), time.monotonic()
     run(cmd)
     after = os.times()
@@ -183,7 +184,10 @@ def one_fit(bin_, tr, name, fit, turbines, sets, out):
            "evaluations": cal["fit"]["evaluations"], "stop": cal["fit"]["stop"],
            "parameters": [{k: p[k] for k in ("key_path", "value", "ci95_low", "ci95_high")} for p in cal["parameters"]],
            "noise": cal["channels"][0]["noise"], "rows": [],
-           "own_noise": {}}
+           "own_noise": {}, "weakest": min(cal["identifiability"], key=lambda e: e["relative_eigenvalue"]),
+           "rated": {t["name"]: t["plausibility"]["rated"] for t in cal.get("traces", []) if t.get("plausibility")}}
+    if cal.get("plausibility"):
+        res["rated"][turbines[0]] = cal["plausibility"]["rated"]
     by_trace = {t["name"].split("_")[0]: t for t in cal.get("traces", [])}
     for turbine in ["R80711", "R80721"]:
         spring, summer = f"{turbine}_2017-spring", f"{turbine}_2016-summer"
@@ -217,6 +221,14 @@ def print_fit(r):
     fit of both turbines that of each turbine's own beside it)."""
     n = r["noise"]
     print(f"  sump residuals (fitted rows): φ {n['phi']:.3f}, σ_a {n['innovation_sd_k']:.3f} K")
+    w = r["weakest"]
+    comp = ", ".join(f"{c['component']:+.2f} ln {c['key_path']}" for c in w["components"] if abs(c["component"]) >= 0.1)
+    print(f"  least determined direction ({w['status']}, relative eigenvalue {w['relative_eigenvalue']:.2g}, "
+          f"±{w['ci95_half_width']:.2f} in ln, 95 %): {comp}")
+    for t, x in r["rated"].items():
+        src = ", ".join(f"{k} {w / 1e3:.1f}" for k, w in x["loss_by_source_w"] if w >= 50)
+        print(f"  rated point ({x['power_w'] / 1e3:.0f} kW, oil {x['oil_temp_c']:.1f} °C, {t}'s model): loss "
+              f"{x['loss_total_w'] / 1e3:.1f} kW ({src} kW), efficiency {x['efficiency']:.3f}")
     for t, m in r.get("own_noise", {}).items():
         print(f"  {t}'s fitted rows alone: φ {m['phi']:.3f}, σ_a {m['innovation_sd_k']:.3f} K")
     print("| trace | rows | sump RMSE, K | bias, K | inside the 95 % band | inside the band of the turbine's own "
