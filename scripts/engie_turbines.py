@@ -216,6 +216,44 @@ def one_fit(bin_, tr, name, fit, turbines, sets, out):
     return res
 
 
+def residual_analysis(fit_csv, trace_csv, trace_name, window=18):
+    """Where a trace's fitted-row sump residuals (simulated − measured) come from: their RMSE
+    split into a slow part (the difference of the simulated and measured centred means over
+    `window` rows, 3 h) and a fast part (the rest), the measured sump's own scatter about its
+    centred mean (what no model without the fan's phase can follow), and the residual's bias and
+    RMSE by measured-sump and power bins."""
+    inputs = {}
+    with open(trace_csv) as fh:
+        for x in csv.DictReader(fh):
+            inputs[x["time_s"]] = -float(x["input_torque_nm"]) * float(x["input_speed_rpm"]) * math.pi / 30e3
+    with open(fit_csv) as fh:
+        rows = [x for x in csv.DictReader(fh) if x["trace"] == trace_name]
+    meas = [float(x["sump_measured_c"]) for x in rows]
+    sim = [float(x["sump_simulated_c"]) for x in rows]
+    out = []
+    for i, x in enumerate(rows):
+        if x["holdout"] != "0":
+            continue
+        lo, hi = max(0, i - window // 2), min(len(rows), i + window // 2 + 1)
+        mm, ms = sum(meas[lo:hi]) / (hi - lo), sum(sim[lo:hi]) / (hi - lo)
+        out.append({"r": sim[i] - meas[i], "slow": ms - mm, "fast": (sim[i] - ms) - (meas[i] - mm),
+                    "own": meas[i] - mm, "meas": meas[i], "power_kw": inputs[x["time_s"]]})
+    rms = lambda k, xs=out: math.sqrt(sum(x[k] ** 2 for x in xs) / len(xs))
+    print(f"  {trace_name}, fitted rows ({len(out)}): sump RMSE {rms('r'):.2f} K = slow {rms('slow'):.2f} K ⊕ "
+          f"fast {rms('fast'):.2f} K ({window * 10} min centred means); the measured sump's scatter about its "
+          f"own centred mean {rms('own'):.2f} K")
+    fitted = [i for i in range(1, len(rows)) if rows[i]["holdout"] == "0" and rows[i - 1]["holdout"] == "0"]
+    print(f"  rows where the sump rises by more than 3 K from the row before: simulated "
+          f"{sum(sim[i] - sim[i - 1] > 3.0 for i in fitted)}, measured {sum(meas[i] - meas[i - 1] > 3.0 for i in fitted)}")
+    for key, edges in (("meas", [30, 45, 50, 55, 56, 57, 58, 59, 61]), ("power_kw", [-100, 0, 50, 200, 500, 2100])):
+        cells = []
+        for lo, hi in zip(edges[:-1], edges[1:]):
+            xs = [x for x in out if lo <= x[key] < hi]
+            if xs:
+                cells.append(f"[{lo}, {hi}): {len(xs)} rows, {sum(x['r'] for x in xs) / len(xs):+.2f} / {rms('r', xs):.2f}")
+        print(f"  by {'measured sump, °C' if key == 'meas' else 'power, kW'} (bias / RMSE, K): " + "; ".join(cells))
+
+
 def print_fit(r):
     """One fit's residual processes and its table (the band of the fit's residual process, and for a
     fit of both turbines that of each turbine's own beside it)."""
@@ -267,6 +305,8 @@ def main():
     ap.add_argument("--out", default="/tmp/geartherm_turbines")
     ap.add_argument("--bin", default="target/release/geartherm")
     ap.add_argument("--only", help="run only the fit of this name")
+    ap.add_argument("--residuals", action="store_true",
+                    help="also print where each two-turbine fit's residuals on R80721's fitted days come from")
     a = ap.parse_args()
     tr = traces(a.data, a.out)
     load0 = os.getloadavg()[0]
@@ -283,6 +323,10 @@ def main():
                 f"[{p['ci95_low']:.4g}, {p['ci95_high']:.4g}]"
             print(f"  {p['key_path']}: {p['value']:.4g} {ci}")
         print_fit(r)
+        if a.residuals and len(turbines) > 1:
+            d = os.path.join(a.out, name.replace(" ", "_").replace(",", ""))
+            residual_analysis(os.path.join(d, "fit.csv"), os.path.join(tr, "R80721_2017-spring.csv"), "R80721_2017-spring")
+            print()
     print_summary(results)
     print(f"load {load0:.1f} before, {os.getloadavg()[0]:.1f} after")
     with open(os.path.join(a.out, "figures.json" if not a.only else "figures_one.json"), "w") as fh:
