@@ -5,15 +5,22 @@ both turbines in one fit"): the single-node MM82 model
 2017 days 1–14 together, one gearbox type (loss levels and the housing's link to the nacelle
 shared) with a cooler per turbine, both turbines' days 15–27 held out, both turbines' summer
 2016 predicted by each turbine's calibrated model with the band of the fit; beside it the
-single-turbine fit (R80711 days 1–14) predicting the same rows.
+single-turbine fit (R80711 days 1–14) predicting the same rows; each with the model file's
+churning law (Changenet–Velex) and with Seetharaman and Kahraman's.
 
-    python3 scripts/engie_turbines.py [--data DIR] [--out DIR] [--bin PATH]
+    python3 scripts/engie_turbines.py [--data DIR] [--out DIR] [--bin PATH] [--only NAME]
+                                      [--residuals] [--variants]
 
 DIR holds the four period files R807*_2017-spring.csv, R807*_2016-summer.csv (default
 ../shared/data/engie_la_haute_borne; OUT default /tmp/geartherm_turbines). Prints one table
-row per fit and held-out trace (sump RMSE, bias, fraction of the rows inside the 95 % band),
-the fitted values and the run times; writes OUT/figures.json. Nothing is tuned on the held-out
-rows: each fit sees days 1–14 only (--holdout 1209600:2400000 in each trace's own time).
+row per fit and held-out trace (sump RMSE, bias, fraction of the rows inside the 95 % band of
+the fit's residual process and, for a fit of both turbines, of each turbine's own), the fitted
+values, the least determined direction, the loss at the rated point and the run times, then
+the table of docs/validation.md; writes OUT/figures.json. --residuals adds, per two-turbine
+fit, where the residuals on R80721's fitted days come from; --variants runs the variants tried
+(docs/validation.md's list) instead and prints their table (OUT/figures_variants.json).
+Nothing is tuned on the held-out rows: each fit sees days 1–14 only (--holdout
+1209600:2400000 in each trace's own time).
 """
 import argparse
 import csv
@@ -34,14 +41,121 @@ SHARED = [
     "losses.multiplier.churning=0.01:100",
     'thermal.links["gearbox-nacelle"].h_w_per_m2k=0.5:100',
 ]
-# name: (--fit arguments, turbines fitted). The single-turbine fit is that of
-# scripts/engie_calibration.sh (same parameters, same bounds).
+# The churning law of the model file is Changenet–Velex; `SEETHARAMAN` sets Seetharaman and
+# Kahraman's instead (docs/validation.md, "both turbines in one fit": the Changenet–Velex
+# regime bridge of wheel 1 lies inside the traces' speed and oil-temperature range).
+SEETHARAMAN = ['losses.churning="seetharaman"']
+
+
+def spec(fit, turbines, sets=(), model=MODEL, kind="sump"):
+    """One calibration: its --fit and --set arguments, the turbines whose spring days 1–14 it fits,
+    the model file (or a function of the output directory that writes one) and the traces
+    (`sump`: engie_traces.py's; `sensor`: those with the sump column measured on a sensor node;
+    `four`: engie_traces.py --channels)."""
+    return {"fit": list(fit), "turbines": turbines, "sets": list(sets), "model": model, "kind": kind}
+
+
+BOTH = ["R80711", "R80721"]
+# The single-turbine fit is that of scripts/engie_calibration.sh (same parameters, same bounds).
 FITS = {
-    "single R80711": (SHARED + [f"{CAP}=100:30000", f"{OPEN}=45:61"], ["R80711"]),
-    "both, cooler per turbine": (SHARED + [f"{CAP}@*=100:30000", f"{OPEN}=45:61"], ["R80711", "R80721"]),
-    "both, cooler and thermostat per turbine": (SHARED + [f"{CAP}@*=100:30000", f"{OPEN}@*=45:61"],
-                                                ["R80711", "R80721"]),
+    "single R80711": spec(SHARED + [f"{CAP}=100:30000", f"{OPEN}=45:61"], ["R80711"]),
+    "both, cooler per turbine": spec(SHARED + [f"{CAP}@*=100:30000", f"{OPEN}=45:61"], BOTH),
+    "both, cooler and thermostat per turbine": spec(SHARED + [f"{CAP}@*=100:30000", f"{OPEN}@*=45:61"], BOTH),
+    "single R80711, Seetharaman–Kahraman churning": spec(SHARED + [f"{CAP}=100:30000", f"{OPEN}=45:61"],
+                                                         ["R80711"], SEETHARAMAN),
+    "both, cooler per turbine, Seetharaman–Kahraman churning": spec(
+        SHARED + [f"{CAP}@*=100:30000", f"{OPEN}=45:61"], BOTH, SEETHARAMAN),
 }
+
+# The variants tried on the way (`--variants`; docs/validation.md lists their figures). Each is
+# fitted on both turbines' days 1–14 with a cooler per turbine; the model changes are
+# assumptions of the variant, not of the model file.
+FULL = 'thermal.coolers["oil_cooler"].thermostat.full_c'
+MASS = 'thermal.nodes["gearbox"].mass_kg=1000:60000'
+NACELLE_AIR = ['thermal.coolers["oil_cooler"].cold="nacelle"']
+# The S–K refinements start from 30 (written as a float: a two-trace fit given an integer
+# literal, `--set losses.multiplier.churning=30`, refuses the key as influencing no trace).
+SK30 = SEETHARAMAN + ["losses.multiplier.churning=30.0"]
+CHANNEL_KEYS = [
+    'thermal.links["circulation"].conductance_w_per_k=100:100000',
+    'thermal.links["inlet-nacelle"].h_w_per_m2k=0.1:1000',
+    'thermal.links["hss_bearing_1-oil"].conductance_w_per_k=5:20000',
+    'thermal.links["hss_bearing_2-oil"].conductance_w_per_k=5:20000',
+]
+# Churning heat into the body node instead of the oil.
+HEAT_TO_BODY = '\n[[thermal.heat]]\nsource = "churning"\nto = { gearbox = 1.0 }\n'
+# A sensor lag: the measured sump temperature is that of a 5 kg sensor (steel) joined to the oil
+# by a fitted conductance (time constant m·c/G).
+SENSOR = """
+[[thermal.nodes]]
+name = "sump_sensor"
+mass_kg = 5.0
+cp_j_per_kgk = 480.0
+
+[[thermal.links]]
+name = "sensor"
+between = ["sump", "sump_sensor"]
+conductance_w_per_k = 5.0
+"""
+
+
+def appended(text, file_name):
+    """A model writer (spec's `model`): MODEL with `text` appended, written beside the fit's
+    directory `d` (`calibrate` writes only into a directory of its own outputs)."""
+    def write(d):
+        path = f"{d}_{file_name}"
+        with open(MODEL) as fh:
+            base = fh.read()
+        with open(path, "w") as fh:
+            fh.write(base + text)
+        return path
+    return write
+
+
+def four_starts(sliding, churning, cap, open_c):
+    """The four-channel model's start (--set, floats: see SK30) near the single-node fit's values."""
+    return [f"losses.multiplier.sliding={float(sliding)}", f"losses.multiplier.churning={float(churning)}",
+            'thermal.links["gearbox-nacelle"].h_w_per_m2k=5.4', f"{CAP}={float(cap)}", f"{OPEN}={float(open_c)}"]
+
+
+def variants():
+    """The variants of `--variants`, as they were run (the bounds of each)."""
+    wide = SHARED + [f"{CAP}@*=100:1e6", f"{OPEN}=45:61"]
+    base = SHARED + [f"{CAP}@*=100:30000", f"{OPEN}=45:61"]
+    full = SHARED + [f"{CAP}@*=100:1e6", f"{OPEN}=45:57", f"{FULL}=57.5:75"]
+    return {
+        "cooler bound 1e6 W/K": spec(wide, BOTH),
+        "cooler's air side on the nacelle": spec(wide, BOTH, NACELLE_AIR),
+        "full_c fitted": spec(full, BOTH),
+        "nacelle air side, full_c fitted": spec(full, BOTH, NACELLE_AIR),
+        "nacelle air side, oil-gearbox h fitted": spec(
+            wide + ['thermal.links["oil-gearbox"].h_w_per_m2k=1:2000'], BOTH, NACELLE_AIR),
+        "gearbox mass fitted": spec(wide + [MASS], BOTH),
+        "gearbox mass and full_c fitted": spec(full + [MASS], BOTH),
+        "churning heat into the gearbox body": spec(wide, BOTH, model=appended(HEAT_TO_BODY, "churning_to_body.toml")),
+        "sensor lag": spec(wide + ['thermal.links["sensor"].conductance_w_per_k=0.2:1000'], BOTH,
+                           model=appended(SENSOR, "sump_sensor.toml"), kind="sensor"),
+        "heater capacity per turbine": spec(wide + ['thermal.coolers["oil_heater"].capacity_rate_w_per_k@*=1:1e5'],
+                                            BOTH),
+        "heater set point per turbine": spec(wide + ['thermal.boundaries["heater"].temp_c@*=20:50'], BOTH),
+        "four channels": spec(wide + CHANNEL_KEYS, BOTH, four_starts(1.74, 8.6, 13500, 56.2),
+                              model="models/mm82_wind_gearbox.toml", kind="four"),
+        "churning off": spec([SHARED[0], SHARED[2], f"{CAP}@*=100:1e6", f"{OPEN}=45:61"], BOTH,
+                             ['losses.churning="off"']),
+        "Stavytskyi churning": spec(wide, BOTH, ['losses.churning="stavytskyi"']),
+        "S–K, cooler bound 1e6 W/K": spec(wide, BOTH, SK30),
+        "S–K, nacelle air side": spec(wide, BOTH, SK30 + NACELLE_AIR),
+        "S–K, gearbox mass fitted": spec(base + [MASS], BOTH, SK30),
+        "S–K, heater capacity per turbine": spec(
+            base + ['thermal.coolers["oil_heater"].capacity_rate_w_per_k@*=1:1e5'], BOTH, SK30),
+        "S–K, thermostat per turbine": spec(SHARED + [f"{CAP}@*=100:30000", f"{OPEN}@*=45:61"], BOTH, SK30),
+        "S–K, full_c fitted (58.5–75)": spec(SHARED + [f"{CAP}@*=100:30000", f"{OPEN}=45:58", f"{FULL}=58.5:75"],
+                                            BOTH, SK30),
+        "S–K, full_c fitted (58.6–75)": spec(SHARED + [f"{CAP}@*=100:30000", f"{OPEN}=45:58.5", f"{FULL}=58.6:75"],
+                                            BOTH, SK30),
+        "S–K, four channels": spec(base + CHANNEL_KEYS, BOTH, SEETHARAMAN + four_starts(0.55, 85, 5000, 57.2),
+                                   model="models/mm82_wind_gearbox.toml", kind="four"),
+    }
 
 
 def run(cmd):
@@ -50,23 +164,61 @@ def run(cmd):
         sys.exit(f"{' '.join(cmd)}: exit {r.returncode}\n{r.stderr}")
 
 
-def traces(data, out):
+def traces(data, out, kinds):
+    """The directories of the traces of each kind in `kinds` (spec's `kind`), built under `out`."""
     src = os.path.join(out, "records")
     os.makedirs(src, exist_ok=True)
     for p in PERIODS:
         link = os.path.join(src, p + ".csv")
         if not os.path.exists(link):
             os.symlink(os.path.abspath(os.path.join(data, p + ".csv")), link)
-    subprocess.run([sys.executable, "scripts/engie_traces.py", src, os.path.join(out, "traces")], check=True,
-                   stdout=subprocess.DEVNULL)
-    return os.path.join(out, "traces")
+    dirs = {"sump": os.path.join(out, "traces"), "four": os.path.join(out, "traces_four"),
+            "sensor": os.path.join(out, "traces_sensor")}
+    subprocess.run([sys.executable, "scripts/engie_traces.py", src, dirs["sump"]], check=True, stdout=subprocess.DEVNULL)
+    if "four" in kinds:
+        subprocess.run([sys.executable, "scripts/engie_traces.py", "--channels", src, dirs["four"]], check=True,
+                       stdout=subprocess.DEVNULL)
+    if "sensor" in kinds:
+        os.makedirs(dirs["sensor"], exist_ok=True)
+        for p in PERIODS:
+            with open(os.path.join(dirs["sump"], p + ".csv")) as fh:
+                text = fh.read()
+            head, rest = text.split("\n", 1)
+            with open(os.path.join(dirs["sensor"], p + ".csv"), "w") as fh:
+                fh.write(head.replace("node:sump", "node:sump_sensor") + "\n" + rest)
+    return dirs
 
 
-def band_json(cal, turbine, trace_name, path):
+def own_ar1(fit_csv, trace_name, node="sump"):
+    """The AR(1) residual process of one trace's fitted sump rows (fit.csv), estimated as
+    `geartherm calibrate` estimates the fit's (src/job/calibrate/residuals.rs): φ by least squares
+    on consecutive fitted rows of a segment with the bias −(1 + 3φ)/n added back, σ_a from the
+    Prais–Winsten innovations."""
+    x, cont = [], []
+    prev = None
+    with open(fit_csv) as fh:
+        for row in csv.DictReader(fh):
+            if row["trace"] != trace_name or row["holdout"] != "0":
+                prev = None
+                continue
+            cont.append(prev is not None and prev == row["segment"])
+            x.append(float(row[f"{node}_residual_k"]))
+            prev = row["segment"]
+    n = len(x)
+    pairs = [i for i in range(1, n) if cont[i]]
+    ls = sum(x[i] * x[i - 1] for i in pairs) / sum(x[i - 1] ** 2 for i in pairs)
+    phi = max(-0.99, min(0.99, ls + (1.0 + 3.0 * ls) / n))
+    ss = sum((x[i] - phi * x[i - 1]) ** 2 if cont[i] else (1.0 - phi * phi) * x[i] ** 2 for i in range(n))
+    sigma = math.sqrt(ss / n)
+    return {"phi": phi, "innovation_sd_k": sigma, "marginal_sd_k": sigma / math.sqrt(1.0 - phi * phi)}
+
+
+def band_json(cal, turbine, trace_name, path, own_noise=None):
     """The fit's calibration.json restricted to the parameters `turbine`'s model holds: the shared
     ones and its own (`KEY@trace_name` written as KEY), their covariance the sub-block of the
-    fit's (the marginal covariance of those coordinates), the residual process and t quantile
-    unchanged."""
+    fit's (the marginal covariance of those coordinates), the t quantile unchanged; the residual
+    process that of the fit (every trace's fitted rows together) or `own_noise` (φ, σ_a) in its
+    place."""
     keep, params = [], []
     for k, p in enumerate(cal["parameters"]):
         key = p["key_path"]
@@ -78,23 +230,27 @@ def band_json(cal, turbine, trace_name, path):
         keep.append(k)
         params.append(p)
     out = dict(cal, parameters=params, covariance=[[cal["covariance"][i][j] for j in keep] for i in keep])
+    if own_noise:
+        out["channels"] = [dict(cal["channels"][0], noise=dict(cal["channels"][0]["noise"], **own_noise))]
     with open(path, "w") as fh:
         json.dump(out, fh)
     return path
 
 
-def rows_errors(fit_csv, t0=None):
-    """Sump RMSE, bias and the fraction inside the 95 % band over the rows from t0 (s) on."""
+def rows_errors(fit_csv, t0=None, t1=None, node="sump"):
+    """Sump RMSE, bias and the fraction inside the 95 % band over the rows from t0 (s) on, before
+    t1 (s) when given."""
     n = s2 = s1 = inside = 0
     with open(fit_csv) as fh:
         for x in csv.DictReader(fh):
-            if t0 is not None and float(x["time_s"]) < t0:
+            t = float(x["time_s"])
+            if (t0 is not None and t < t0) or (t1 is not None and t >= t1):
                 continue
-            r = float(x["sump_residual_k"])
+            r = float(x[f"{node}_residual_k"])
             n += 1
             s2 += r * r
             s1 += r
-            inside += abs(r) <= float(x["sump_band95_k"])
+            inside += abs(r) <= float(x[f"{node}_band95_k"])
     return {"rows": n, "rmse_k": math.sqrt(s2 / n), "bias_k": s1 / n, "inside_band95": inside / n}
 
 
@@ -109,14 +265,43 @@ def whole(fit_csv):
     return {k: h[k] for k in ("rows", "rmse_k", "bias_k", "inside_band95")}
 
 
-def one_fit(bin_, tr, name, fit, turbines, out):
-    d = os.path.join(out, name.replace(" ", "_").replace(",", ""))
-    cmd = [bin_, "calibrate", MODEL]
+def own_band(bin_, tr, d, cal, turbine, rows):
+    """`turbine`'s held-out spring days and its summer predicted again with the band of its own
+    residual process (band_json's `own_noise`); the fraction inside it added to `rows` (the
+    spring prediction runs from the trace's start, as the fit does: its RMSE is the fit's)."""
+    spring, summer = f"{turbine}_2017-spring", f"{turbine}_2016-summer"
+    model = os.path.join(d, f"calibrated_{spring}.toml")
+    node = cal["channels"][0]["node"]
+    noise = own_ar1(os.path.join(d, "fit.csv"), spring, node)
+    band = band_json(cal, turbine, spring, os.path.join(d, f"band_own_{turbine}.json"), own_noise=noise)
+    f = predict(bin_, model, os.path.join(tr, f"{spring}.csv"), band, os.path.join(d, f"predict_own_{spring}"))
+    held = rows_errors(f, 1209600.0, node=node)
+    fitted = rows_errors(f, None, 1209600.0, node=node)
+    f = predict(bin_, model, os.path.join(tr, f"{summer}.csv"), band, os.path.join(d, f"predict_own_{summer}"))
+    for x, e in zip(rows, [fitted, held, whole(f)]):
+        x["inside_own_band95"] = e["inside_band95"]
+        x["rmse_own_run_k"] = e["rmse_k"]
+    return noise
+
+
+def run_dir(out, name):
+    """The output directory of the fit `name`."""
+    return os.path.join(out, name.replace(" ", "_").replace(",", "").replace("/", "_per_"))
+
+
+def one_fit(bin_, trs, name, sp, out):
+    """Run the calibration `sp` (see spec), predict the other rows, return its figures."""
+    d = run_dir(out, name)
+    fit, turbines, sets, tr = sp["fit"], sp["turbines"], sp["sets"], trs[sp["kind"]]
+    cmd = [bin_, "calibrate", sp["model"](d) if callable(sp["model"]) else sp["model"]]
     for t in turbines:
         cmd += ["--trace", os.path.join(tr, f"{t}_2017-spring.csv")]
     for f in fit:
         cmd += ["--fit", f]
-    cmd += ["--holdout", HOLDOUT, "--max-iterations", "60", "--out", d]
+    for s in sets:
+        cmd += ["--set", s]
+    cmd += ["--holdout", HOLDOUT, "--max-iterations", "60", "--gearbox-kind", "wind-turbine", "--rated=1680:-11600",
+            "--out", d]
     before, t0 = os.times(), time.monotonic()
     run(cmd)
     after = os.times()
@@ -125,8 +310,13 @@ def one_fit(bin_, tr, name, fit, turbines, out):
            "cpu_s": after.children_user - before.children_user + after.children_system - before.children_system,
            "evaluations": cal["fit"]["evaluations"], "stop": cal["fit"]["stop"],
            "parameters": [{k: p[k] for k in ("key_path", "value", "ci95_low", "ci95_high")} for p in cal["parameters"]],
-           "noise": cal["channels"][0]["noise"], "rows": []}
+           "noise": cal["channels"][0]["noise"], "rows": [],
+           "own_noise": {}, "weakest": min(cal["identifiability"], key=lambda e: e["relative_eigenvalue"]),
+           "rated": {t["name"]: t["plausibility"]["rated"] for t in cal.get("traces", []) if t.get("plausibility")}}
+    if cal.get("plausibility"):
+        res["rated"][turbines[0]] = cal["plausibility"]["rated"]
     by_trace = {t["name"].split("_")[0]: t for t in cal.get("traces", [])}
+    node = cal["channels"][0]["node"]
     for turbine in ["R80711", "R80721"]:
         spring, summer = f"{turbine}_2017-spring", f"{turbine}_2016-summer"
         if turbine in turbines:
@@ -135,16 +325,123 @@ def one_fit(bin_, tr, name, fit, turbines, out):
             band = band_json(cal, turbine, spring, os.path.join(d, f"band_{turbine}.json")) if own else \
                 os.path.join(d, "calibration.json")
             ch = (by_trace[turbine]["channels"][0] if own else cal["channels"][0])
-            res["rows"].append(dict(ch["fitted"], trace=f"{turbine} spring 2017 days 1–14 (fitted)"))
-            res["rows"].append(dict(ch["holdout"], trace=f"{turbine} spring 2017 days 15–27 (held out)"))
+            res["rows"].append(dict(ch["fitted"], trace=f"{turbine} spring 2017 days 1–14 (fitted)",
+                                    key=f"{turbine} spring 2017 days 1–14"))
+            res["rows"].append(dict(ch["holdout"], trace=f"{turbine} spring 2017 days 15–27 (held out)",
+                                    key=f"{turbine} spring 2017 days 15–27"))
         else:
             model, band = os.path.join(d, "calibrated.toml"), os.path.join(d, "calibration.json")
             f = predict(bin_, model, os.path.join(tr, f"{spring}.csv"), band, os.path.join(d, f"predict_{spring}"))
-            res["rows"].append(dict(rows_errors(f, 1209600.0), trace=f"{turbine} spring 2017 days 15–27 (predicted)"))
+            res["rows"].append(dict(rows_errors(f, None, 1209600.0, node=node), trace=f"{turbine} spring 2017 days 1–14 (predicted)",
+                                    key=f"{turbine} spring 2017 days 1–14"))
+            res["rows"].append(dict(rows_errors(f, 1209600.0, node=node), trace=f"{turbine} spring 2017 days 15–27 (predicted)",
+                                    key=f"{turbine} spring 2017 days 15–27"))
             res["rows"].append(dict(whole(f), trace=f"{turbine} spring 2017 days 1–27 (predicted)"))
         f = predict(bin_, model, os.path.join(tr, f"{summer}.csv"), band, os.path.join(d, f"predict_{summer}"))
-        res["rows"].append(dict(whole(f), trace=f"{turbine} summer 2016 (predicted)"))
+        res["rows"].append(dict(whole(f), trace=f"{turbine} summer 2016 (predicted)", key=f"{turbine} summer 2016"))
+        if turbine in turbines and len(turbines) > 1 and len(cal["channels"]) == 1:
+            res["own_noise"][spring] = own_band(bin_, tr, d, cal, turbine, res["rows"][-3:])
     return res
+
+
+def residual_analysis(fit_csv, trace_csv, trace_name, window=18):
+    """Where a trace's fitted-row sump residuals (simulated − measured) come from: their RMSE
+    split into a slow part (the difference of the simulated and measured centred means over
+    `window` rows, 3 h) and a fast part (the rest), the measured sump's own scatter about its
+    centred mean (what no model without the fan's phase can follow), and the residual's bias and
+    RMSE by measured-sump and power bins."""
+    inputs = {}
+    with open(trace_csv) as fh:
+        for x in csv.DictReader(fh):
+            inputs[x["time_s"]] = -float(x["input_torque_nm"]) * float(x["input_speed_rpm"]) * math.pi / 30e3
+    with open(fit_csv) as fh:
+        rows = [x for x in csv.DictReader(fh) if x["trace"] == trace_name]
+    meas = [float(x["sump_measured_c"]) for x in rows]
+    sim = [float(x["sump_simulated_c"]) for x in rows]
+    out = []
+    for i, x in enumerate(rows):
+        if x["holdout"] != "0":
+            continue
+        lo, hi = max(0, i - window // 2), min(len(rows), i + window // 2 + 1)
+        mm, ms = sum(meas[lo:hi]) / (hi - lo), sum(sim[lo:hi]) / (hi - lo)
+        out.append({"r": sim[i] - meas[i], "slow": ms - mm, "fast": (sim[i] - ms) - (meas[i] - mm),
+                    "own": meas[i] - mm, "meas": meas[i], "power_kw": inputs[x["time_s"]]})
+    rms = lambda k, xs=out: math.sqrt(sum(x[k] ** 2 for x in xs) / len(xs))
+    print(f"  {trace_name}, fitted rows ({len(out)}): sump RMSE {rms('r'):.2f} K = slow {rms('slow'):.2f} K ⊕ "
+          f"fast {rms('fast'):.2f} K ({window * 10} min centred means); the measured sump's scatter about its "
+          f"own centred mean {rms('own'):.2f} K")
+    fitted = [i for i in range(1, len(rows)) if rows[i]["holdout"] == "0" and rows[i - 1]["holdout"] == "0"]
+    print(f"  rows where the sump rises by more than 3 K from the row before: simulated "
+          f"{sum(sim[i] - sim[i - 1] > 3.0 for i in fitted)}, measured {sum(meas[i] - meas[i - 1] > 3.0 for i in fitted)}")
+    for key, edges in (("meas", [30, 45, 50, 55, 56, 57, 58, 59, 61]), ("power_kw", [-100, 0, 50, 200, 500, 2100])):
+        cells = []
+        for lo, hi in zip(edges[:-1], edges[1:]):
+            xs = [x for x in out if lo <= x[key] < hi]
+            if xs:
+                cells.append(f"[{lo}, {hi}): {len(xs)} rows, {sum(x['r'] for x in xs) / len(xs):+.2f} / {rms('r', xs):.2f}")
+        print(f"  by {'measured sump, °C' if key == 'meas' else 'power, kW'} (bias / RMSE, K): " + "; ".join(cells))
+
+
+def print_fit(r):
+    """One fit's residual processes and its table (the band of the fit's residual process, and for a
+    fit of both turbines that of each turbine's own beside it)."""
+    n = r["noise"]
+    print(f"  sump residuals (fitted rows): φ {n['phi']:.3f}, σ_a {n['innovation_sd_k']:.3f} K")
+    w = r["weakest"]
+    comp = ", ".join(f"{c['component']:+.2f} ln {c['key_path']}" for c in w["components"] if abs(c["component"]) >= 0.1)
+    print(f"  least determined direction ({w['status']}, relative eigenvalue {w['relative_eigenvalue']:.2g}, "
+          f"±{w['ci95_half_width']:.2f} in ln, 95 %): {comp}")
+    for t, x in r["rated"].items():
+        src = ", ".join(f"{k} {w / 1e3:.1f}" for k, w in x["loss_by_source_w"] if w >= 50)
+        print(f"  rated point ({x['power_w'] / 1e3:.0f} kW, oil {x['oil_temp_c']:.1f} °C, {t}'s model): loss "
+              f"{x['loss_total_w'] / 1e3:.1f} kW ({src} kW), efficiency {x['efficiency']:.3f}")
+    for t, m in r.get("own_noise", {}).items():
+        print(f"  {t}'s fitted rows alone: φ {m['phi']:.3f}, σ_a {m['innovation_sd_k']:.3f} K")
+    print("| trace | rows | sump RMSE, K | bias, K | inside the 95 % band | inside the band of the turbine's own "
+          "residual process |")
+    print("|---|---|---|---|---|---|")
+    for x in r["rows"]:
+        own = f"{100 * x['inside_own_band95']:.1f} %" if "inside_own_band95" in x else "—"
+        print(f"| {x['trace']} | {x['rows']} | {x['rmse_k']:.2f} | {x['bias_k']:+.2f} | "
+              f"{100 * x['inside_band95']:.1f} % | {own} |")
+    print(flush=True)
+
+
+def print_summary(results):
+    """docs/validation.md's table: per trace and fit, RMSE / bias / inside the band (the turbine's
+    own residual process in brackets where there is one)."""
+    if not results:
+        return
+    names = [r["name"] for r in results]
+    print("| trace | " + " | ".join(names) + " |")
+    print("|---|" + "---|" * len(names))
+    keys = [f"{t} {p}" for t in ("R80711", "R80721")
+            for p in ("spring 2017 days 1–14", "spring 2017 days 15–27", "summer 2016")]
+    for key in keys:
+        cells = []
+        for r in results:
+            y = next(x for x in r["rows"] if x.get("key") == key)
+            own = f" ({100 * y['inside_own_band95']:.1f} %)" if "inside_own_band95" in y else ""
+            cells.append(f"{y['rmse_k']:.2f} / {y['bias_k']:+.2f} / {100 * y['inside_band95']:.1f} %{own}")
+        print(f"| {key} | " + " | ".join(cells) + " |")
+    print()
+
+
+def print_variants(results):
+    """docs/validation.md's table of the variants: sump RMSE on both turbines' fitted days,
+    held-out days and summer, R80721's band coverage, the parameters at a bound."""
+    print("| variant | R80711 fitted / held out / summer, K | R80721 fitted / held out / summer, K | "
+          "R80721 inside the band (held out / summer) | no interval (at a bound or not determined) |")
+    print("|---|---|---|---|---|")
+    for r in results:
+        x = {y["key"]: y for y in r["rows"] if "key" in y}
+        cell = lambda t: " / ".join(f"{x[f'{t} {p}']['rmse_k']:.2f}" for p in
+                                    ("spring 2017 days 1–14", "spring 2017 days 15–27", "summer 2016"))
+        bands = " / ".join(f"{100 * x[f'R80721 {p}']['inside_band95']:.1f} %"
+                           for p in ("spring 2017 days 15–27", "summer 2016"))
+        bound = ", ".join(p["key_path"].split(".")[-1] for p in r["parameters"] if p["ci95_low"] is None) or "–"
+        print(f"| {r['name']} | {cell('R80711')} | {cell('R80721')} | {bands} | {bound} |")
+    print()
 
 
 def main():
@@ -153,14 +450,18 @@ def main():
     ap.add_argument("--out", default="/tmp/geartherm_turbines")
     ap.add_argument("--bin", default="target/release/geartherm")
     ap.add_argument("--only", help="run only the fit of this name")
+    ap.add_argument("--variants", action="store_true", help="run the variants tried instead of the fits")
+    ap.add_argument("--residuals", action="store_true",
+                    help="also print where each two-turbine fit's residuals on R80721's fitted days come from")
     a = ap.parse_args()
-    tr = traces(a.data, a.out)
+    runs = variants() if a.variants else FITS
+    trs = traces(a.data, a.out, {sp["kind"] for sp in runs.values()})
     load0 = os.getloadavg()[0]
     results = []
-    for name, (fit, turbines) in FITS.items():
+    for name, sp in runs.items():
         if a.only and a.only != name:
             continue
-        r = one_fit(a.bin, tr, name, fit, turbines, a.out)
+        r = one_fit(a.bin, trs, name, sp, a.out)
         results.append(r)
         print(f"## {name}: {r['evaluations']} evaluations (stop: {r['stop']}), wall {r['wall_s']:.1f} s, "
               f"CPU {r['cpu_s']:.1f} s")
@@ -168,16 +469,16 @@ def main():
             ci = "no interval (at a bound or not determined)" if p["ci95_low"] is None else \
                 f"[{p['ci95_low']:.4g}, {p['ci95_high']:.4g}]"
             print(f"  {p['key_path']}: {p['value']:.4g} {ci}")
-        n = r["noise"]
-        print(f"  sump residuals (fitted rows): φ {n['phi']:.3f}, σ_a {n['innovation_sd_k']:.3f} K")
-        print("| trace | rows | sump RMSE, K | bias, K | inside the 95 % band |")
-        print("|---|---|---|---|---|")
-        for x in r["rows"]:
-            print(f"| {x['trace']} | {x['rows']} | {x['rmse_k']:.2f} | {x['bias_k']:+.2f} | "
-                  f"{100 * x['inside_band95']:.1f} % |")
-        print(flush=True)
+        print_fit(r)
+        if a.residuals and len(sp["turbines"]) > 1:
+            d = run_dir(a.out, name)
+            residual_analysis(os.path.join(d, "fit.csv"), os.path.join(trs[sp["kind"]], "R80721_2017-spring.csv"),
+                              "R80721_2017-spring")
+            print()
+    print_summary(results) if not a.variants else print_variants(results)
     print(f"load {load0:.1f} before, {os.getloadavg()[0]:.1f} after")
-    with open(os.path.join(a.out, "figures.json" if not a.only else "figures_one.json"), "w") as fh:
+    stem = "figures_variants" if a.variants else "figures"
+    with open(os.path.join(a.out, stem + ("_one.json" if a.only else ".json")), "w") as fh:
         json.dump(results, fh, indent=2)
 
 
