@@ -103,6 +103,17 @@ impl std::fmt::Display for FitSpec {
     }
 }
 
+/// True when the model schema refuses a fractional value at `path` of `doc` (a tooth count):
+/// an integer written in the document (`--set losses.multiplier.churning=2`) is fitted as a real
+/// number unless the schema holds an integer there.
+fn schema_wants_integer(doc: &Table, path: &KeyPath) -> bool {
+    let probe = Override {
+        path: path.clone(),
+        value: Value::Float(0.5),
+    };
+    crate::model::schema_takes(doc.clone(), &probe).is_err()
+}
+
 /// True for a key holding a temperature in °C (fitted on a linear scale).
 fn is_temperature(path: &KeyPath) -> bool {
     path.to_string().ends_with("_c")
@@ -113,7 +124,7 @@ impl Parameter {
     pub fn resolve(spec: &FitSpec, doc: &Table) -> Result<Parameter, String> {
         let name = spec.path.to_string();
         let got = overrides::get(doc, &spec.path);
-        let integer = matches!(got, Ok(Value::Integer(_)));
+        let integer = matches!(got, Ok(Value::Integer(_))) && schema_wants_integer(doc, &spec.path);
         let value = match got {
             Ok(Value::Float(x)) => Some(x),
             Ok(Value::Integer(i)) => Some(i as f64),
@@ -314,6 +325,18 @@ mod tests {
         let m = Parameter::resolve(&"a.missing=1:4".parse().unwrap(), &doc).unwrap();
         assert_eq!(m.start, 2.0);
         assert!(Parameter::resolve(&"a.b=3:4".parse().unwrap(), &doc).is_err());
+    }
+
+    #[test]
+    fn an_integer_written_for_a_real_key_is_fitted_as_a_real() {
+        let file = concat!(env!("CARGO_MANIFEST_DIR"), "/models/fzg_c.toml");
+        let mut doc: Table = std::fs::read_to_string(file).unwrap().parse().unwrap();
+        doc["lubrication"]["oil_level_mm"] = Value::Integer(150);
+        let level = Parameter::resolve(&"lubrication.oil_level_mm=100:200".parse().unwrap(), &doc).unwrap();
+        assert!(!level.integer);
+        assert_eq!(level.override_at(150.4).value, Value::Float(150.4));
+        let teeth = Parameter::resolve(&"gears[0].teeth=14:18".parse().unwrap(), &doc).unwrap();
+        assert!(teeth.integer);
     }
 
     #[test]
