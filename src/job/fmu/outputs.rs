@@ -100,12 +100,16 @@ impl ReadTable {
 }
 
 /// The loss items' index and the last loss evaluation of a run (its scene): per source the
-/// items, per item whether it is paid ahead of the input shaft, and the sums of the last
+/// items, the items paid through the input shaft, and the sums of the last
 /// evaluation with the inputs and oil temperature it was made at.
 pub struct LossOutputs {
-    /// Per loss item: its source's index and whether it is paid ahead of the input shaft
-    /// (`LossItem::engine_side`).
-    items: Vec<(usize, bool)>,
+    /// The loss items grouped by source, each source's in item order (the order
+    /// `sum_by_source` and `Scene::loss_energy_by_source` add them): source s has
+    /// `by_source[starts[s]..starts[s + 1]]`.
+    by_source: Vec<usize>,
+    starts: [usize; N_SOURCES + 1],
+    /// The items paid through the input shaft (not `LossItem::engine_side`), in item order.
+    shaft_items: Vec<usize>,
     /// Loss per item of the last evaluation, W.
     q: Vec<f64>,
     /// The inputs (gear, speed, torque and vehicle speed bits) and oil temperature (bits) of
@@ -132,11 +136,16 @@ impl LossOutputs {
     /// The index of `scene`'s loss items, nothing evaluated.
     pub fn of(scene: &Scene) -> LossOutputs {
         let items = &scene.losses().items;
+        let mut by_source = Vec::with_capacity(items.len());
+        let mut starts = [0; N_SOURCES + 1];
+        for s in 0..N_SOURCES {
+            by_source.extend((0..items.len()).filter(|&k| items[k].source.index() == s));
+            starts[s + 1] = by_source.len();
+        }
         LossOutputs {
-            items: items
-                .iter()
-                .map(|it| (it.source.index(), it.engine_side))
-                .collect(),
+            by_source,
+            starts,
+            shaft_items: (0..items.len()).filter(|&k| !items[k].engine_side).collect(),
             q: vec![0.0; items.len()],
             at: None,
             by: [0.0; N_SOURCES],
@@ -151,16 +160,23 @@ impl LossOutputs {
         self.evaluations
     }
 
+    /// The sum over each source's items of `x` (per item), in item order.
+    fn per_source(&self, x: &[f64]) -> [f64; N_SOURCES] {
+        let mut by = [0.0; N_SOURCES];
+        for (s, b) in by.iter_mut().enumerate() {
+            let items = &self.by_source[self.starts[s]..self.starts[s + 1]];
+            *b = items.iter().fold(0.0, |sum, &k| sum + x[k]);
+        }
+        by
+    }
+
     /// Loss energy per source at state `y` of `scene`, J: the sums of
-    /// `Scene::loss_energy_by_source` in the same order (one pass over the items, each source's
-    /// sum in item order).
+    /// `Scene::loss_energy_by_source` in the same order.
     fn energies(&self, scene: &Scene, y: &[f64]) -> [f64; N_SOURCES] {
         let n = scene.nodes();
         let mut energy = [0.0; N_SOURCES];
         if scene.has_item_energies() {
-            for (&e, &(s, _)) in y[n..].iter().zip(&self.items) {
-                energy[s] += e;
-            }
+            energy = self.per_source(&y[n..]);
         } else {
             energy.copy_from_slice(&y[n..n + N_SOURCES]);
         }
@@ -177,19 +193,12 @@ impl LossOutputs {
         stepper.set_inputs(scene, inputs);
         stepper.losses_into(scene, &mut self.q);
         self.evaluations += 1;
-        // One pass over the items: per source and total as `sum_by_source` and `geartherm run`
-        // sum them (item order), and the losses supplied through the input shaft: not the
-        // converter's slip or an engine-driven pump, paid ahead of it (as `timeseries.csv`'s
-        // input torque).
-        let (mut by, mut total, mut shaft) = ([0.0; N_SOURCES], 0.0, 0.0);
-        for (&q, &(s, engine_side)) in self.q.iter().zip(&self.items) {
-            by[s] += q;
-            total += q;
-            if !engine_side {
-                shaft += q;
-            }
-        }
-        (self.by, self.total, self.shaft) = (by, total, shaft);
+        // Per source and total as `sum_by_source` and `geartherm run` sum them (item order),
+        // and the losses supplied through the input shaft: not the converter's slip or an
+        // engine-driven pump, paid ahead of it (as `timeseries.csv`'s input torque).
+        self.by = self.per_source(&self.q);
+        self.total = self.q.iter().sum();
+        self.shaft = self.shaft_items.iter().map(|&k| self.q[k]).sum();
         self.at = at;
     }
 }
