@@ -231,3 +231,58 @@ cooler = "pi_cooler"
     );
     assert!(dy.iter().chain(&jac).all(|x| x.is_finite()));
 }
+
+/// An FMU instance at 0.01 s communication steps: reading every output (one `fmi2GetReal` of
+/// all, the loss model evaluated at the point) allocates nothing, and neither does a doStep
+/// that stays inside a ROS3 step already taken (the state interpolated there).
+#[test]
+fn fmu_output_reads_and_interpolating_do_steps_allocate_nothing() {
+    use geartherm::job::fmu::instance::Instance;
+    use geartherm::job::fmu::{Causality, FmuModel, Payload, Role};
+    use std::sync::Arc;
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let file = root.join("models/at6_lepelletier.toml");
+    let fm = Arc::new(
+        FmuModel::build(Payload {
+            file: file.display().to_string(),
+            text: std::fs::read_to_string(&file).unwrap(),
+            overrides: vec![],
+            params: vec![],
+        })
+        .unwrap(),
+    );
+    let vr = |role: Role| fm.vars.iter().find(|v| v.role == role).unwrap().vr;
+    let outputs: Vec<u32> = (fm.vars.iter())
+        .filter(|v| v.causality == Causality::Output)
+        .map(|v| v.vr)
+        .collect();
+    let mut out = vec![0.0; outputs.len()];
+    let mut i = Instance::new(fm.clone());
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    let (mut reads, mut quiet_steps, mut interpolated, mut t) = (0, 0, 0, 0.0);
+    for k in 0..6 {
+        i.set(vr(Role::Gear), (1 + k % 2) as f64).unwrap();
+        i.set(vr(Role::InputSpeed), 150.0 + 20.0 * k as f64).unwrap();
+        i.set(vr(Role::InputTorque), 60.0 + 15.0 * k as f64).unwrap();
+        for _ in 0..100 {
+            let steps = i.stepper_stats().unwrap().steps;
+            let before = allocs();
+            i.do_step(t, 0.01).unwrap();
+            let step_allocs = allocs() - before;
+            t += 0.01;
+            if i.stepper_stats().unwrap().steps == steps {
+                interpolated += 1;
+                quiet_steps += usize::from(step_allocs == 0);
+            }
+            let before = allocs();
+            i.get_many(&outputs, &mut out).unwrap();
+            reads += allocs() - before;
+        }
+    }
+    println!("{interpolated} of 600 doSteps inside a step taken, {quiet_steps} of them without allocation");
+    assert!(out.iter().all(|x| x.is_finite()));
+    assert_eq!(reads, 0, "reading the outputs allocated");
+    assert!(interpolated > 400, "{interpolated} doSteps inside a step taken");
+    assert_eq!(quiet_steps, interpolated, "an interpolating doStep allocated");
+}

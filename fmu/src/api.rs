@@ -162,7 +162,18 @@ fn set_values<T: Copy>(
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetReal(c: *mut c_void, vr: *const u32, n: usize, out: *mut f64) -> Fmi2Status {
-    get_values(c, vr, n, out, |v| v)
+    with(c, |comp| {
+        let refs = refs(vr, n);
+        if refs.is_empty() {
+            return Ok(());
+        }
+        if out.is_null() {
+            return Err("null value array".into());
+        }
+        // SAFETY: the importer passes room for n values.
+        let out = unsafe { std::slice::from_raw_parts_mut(out, refs.len()) };
+        comp.inst.get_many(refs, out)
+    })
 }
 
 #[no_mangle]

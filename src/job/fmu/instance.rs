@@ -19,15 +19,15 @@
 use crate::physics::units::{c_to_k, RAD_S_PER_RPM};
 use std::sync::Arc;
 
+use super::outputs::{self, LossOutputs, ReadTable};
 use super::variables::{Causality, Role, Variable};
 use super::FmuModel;
 use crate::job::envelope::Envelope;
 use crate::job::limits::{self, Limit};
 use crate::job::run::DEFAULT_MAX_STEPS;
 use crate::job::{JobError, Model};
-use crate::physics::efficiency::efficiency;
-use crate::scene::{Inputs, LossItem, Scene, N_SOURCES};
-use crate::solve::cosim::Stepper;
+use crate::scene::{Inputs, Scene};
+use crate::solve::cosim::{Stepper, StepperStats};
 use crate::solve::transient::{Method, TransientOptions};
 
 /// Where an instance is in FMI's state machine.
@@ -62,10 +62,11 @@ pub struct Instance {
     slots: Slots,
     /// The boundary inputs of the coming step (a buffer of [`Instance::do_step`]).
     lines: Vec<(f64, f64)>,
-    /// Whether the outputs of each [`Part`] are those of the current state and inputs.
-    fresh: [bool; 3],
-    /// The output variables of each [`Part`]: (position in `values`, role), found once.
-    parts: Arc<[Vec<(usize, Role)>; 3]>,
+    /// The groups of outputs ([`outputs::ALL`]'s bits) whose values are those of the current
+    /// state and inputs.
+    fresh: u8,
+    /// Which group of outputs each variable needs, found once (kept by a reset).
+    table: Arc<ReadTable>,
 }
 
 /// Positions in `values` of the inputs read at every step, found once per instance.
@@ -95,43 +96,6 @@ impl Slots {
     }
 }
 
-/// The outputs in three parts computed apart, each when one of its variables is read: what the
-/// state and the inputs give directly (temperatures, energies, speeds), the oil's viscosity, and
-/// what needs the loss items evaluated (loss powers, efficiency, input torque with losses).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Part {
-    State = 0,
-    Oil = 1,
-    Losses = 2,
-}
-
-/// The part of the outputs a variable of role `role` belongs to (None: not an output).
-fn part_of(role: Role) -> Option<Part> {
-    match role {
-        Role::NodeTemp(_)
-        | Role::SourceEnergy(_)
-        | Role::TotalEnergy
-        | Role::OutputSpeed
-        | Role::OutputTorque => Some(Part::State),
-        Role::OilViscosity => Some(Part::Oil),
-        Role::SourceLoss(_) | Role::TotalLoss | Role::Efficiency | Role::InputTorqueWithLosses => {
-            Some(Part::Losses)
-        }
-        _ => None,
-    }
-}
-
-/// The output variables of each [`Part`] of `vars`: (position, role), in variable order.
-fn output_parts(vars: &[Variable]) -> [Vec<(usize, Role)>; 3] {
-    let mut parts: [Vec<(usize, Role)>; 3] = Default::default();
-    for (k, v) in vars.iter().enumerate() {
-        if let Some(p) = part_of(v.role) {
-            parts[p as usize].push((k, v.role));
-        }
-    }
-    parts
-}
-
 /// A started instance: the model with its parameters, its scene, the stepper, the envelope its
 /// states are checked against, and the boundary lines last applied.
 struct Run {
@@ -144,13 +108,8 @@ struct Run {
     applied: Vec<(f64, f64)>,
     /// The scene's boundary lines start at `.0` and end at `.1`, s.
     line_span: (f64, f64),
-    /// The loss items of each source, in item order (for the sums per source, in the order
-    /// `sum_by_source` and `Scene::loss_energy_by_source` add them).
-    source_items: [Vec<usize>; N_SOURCES],
-    /// Whether each loss item is paid ahead of the input shaft (`LossItem::engine_side`).
-    item_engine_side: Vec<bool>,
-    /// Loss per item at the current state (W), a buffer of the outputs.
-    q: Vec<f64>,
+    /// The loss items' index and the last loss evaluation for the outputs.
+    losses: LossOutputs,
     /// The inputs the stepper integrates with since its last restart (the outputs may have
     /// switched its work area to inputs set after the last step).
     step_inputs: Inputs,
@@ -167,14 +126,6 @@ const LINE_SPAN: f64 = 10.0;
 const LINE_TOL: f64 = 1e-10;
 
 impl Run {
-    /// The loss items' sources and sides, packed from the scene, and the loss buffer.
-    fn pack_items(&mut self) {
-        let items = &self.scene.losses().items;
-        self.source_items = source_items(items);
-        self.item_engine_side = items.iter().map(|it| it.engine_side).collect();
-        self.q = vec![0.0; items.len()];
-    }
-
     /// Whether the inputs `lines` at `now` continue the boundary lines applied, up to `t1`.
     fn lines_continue(&self, now: f64, t1: f64, lines: &[(f64, f64)]) -> bool {
         let (t0, t_end) = self.line_span;
@@ -232,6 +183,12 @@ pub fn check_exportable(fm: &FmuModel) -> Result<(), JobError> {
 impl Instance {
     /// A new instance with every start value.
     pub fn new(fm: Arc<FmuModel>) -> Instance {
+        let table = Arc::new(ReadTable::of(&fm.vars));
+        Instance::with_table(fm, table)
+    }
+
+    /// [`Instance::new`] with the read table of `fm`'s variables.
+    fn with_table(fm: Arc<FmuModel>, table: Arc<ReadTable>) -> Instance {
         let values = fm.vars.iter().map(|v| v.start.unwrap_or(0.0)).collect();
         let n = fm.vars.len();
         Instance {
@@ -244,8 +201,8 @@ impl Instance {
             run: None,
             slots: Slots::of(&fm.vars),
             lines: Vec::new(),
-            fresh: [false; 3],
-            parts: Arc::new(output_parts(&fm.vars)),
+            fresh: 0,
+            table,
             fm,
         }
     }
@@ -262,7 +219,7 @@ impl Instance {
 
     /// Back to the start values (FMI `fmi2Reset`).
     pub fn reset(&mut self) {
-        *self = Instance::new(self.fm.clone());
+        *self = Instance::with_table(self.fm.clone(), self.table.clone());
     }
 
     /// Enter the error phase with `m`.
@@ -305,7 +262,7 @@ impl Instance {
         match self.start() {
             Ok(run) => {
                 self.run = Some(run);
-                self.fresh = [false; 3];
+                self.fresh = 0;
                 self.phase = Phase::Step;
                 Ok(())
             }
@@ -375,11 +332,8 @@ impl Instance {
             ..TransientOptions::default()
         };
         let stepper = Stepper::new(&scene, y0, self.inputs(), opts.clone(), self.start_time)?;
-        let items = &scene.losses().items;
         Ok(Run {
-            source_items: source_items(items),
-            item_engine_side: items.iter().map(|it| it.engine_side).collect(),
-            q: vec![0.0; items.len()],
+            losses: LossOutputs::of(&scene),
             step_inputs: self.inputs(),
             opts,
             envelope: Envelope::of(&scene),
@@ -457,7 +411,7 @@ impl Instance {
         let old = std::mem::replace(&mut self.values[vr as usize - 1], x);
         // An importer sets its inputs at every point, mostly to the values in force.
         if old.to_bits() != x.to_bits() {
-            self.fresh = [false; 3];
+            self.fresh = 0;
         }
         if self.phase == Phase::Step && matches!(role, Role::Param(_)) && old != x {
             let time = self.time();
@@ -488,7 +442,7 @@ impl Instance {
         run.envelope = Envelope::of(&scene);
         run.model = model;
         run.scene = scene;
-        run.pack_items();
+        run.losses = LossOutputs::of(&run.scene);
         Ok(())
     }
 
@@ -546,7 +500,7 @@ impl Instance {
         let r = run.stepper.step_ahead(&run.scene, t1, run.line_span.1);
         let breach = run.envelope.check(&run.stepper.state()[..run.scene.nodes()]);
         self.deriv.iter_mut().for_each(|d| *d = 0.0);
-        self.fresh = [false; 3];
+        self.fresh = 0;
         match (r, breach) {
             (Err(e), _) => self.fail(e.to_string()),
             (Ok(()), Err(b)) => self.fail(format!(
@@ -558,11 +512,33 @@ impl Instance {
 
     /// `fmi2GetReal` / `fmi2GetInteger` of one variable.
     pub fn get(&mut self, vr: u32) -> Result<f64, Message> {
-        let v = var_of(&self.fm, vr)?;
-        if let Some(part) = part_of(v.role).filter(|&p| !self.fresh[p as usize]) {
-            self.compute_outputs(part)?;
+        let mut x = [0.0];
+        self.get_many(&[vr], &mut x)?;
+        Ok(x[0])
+    }
+
+    /// `fmi2GetReal` of the variables `vrs` into `out` (as long): each group of outputs they
+    /// need is computed once, when it is not that of the current state and inputs already.
+    pub fn get_many(&mut self, vrs: &[u32], out: &mut [f64]) -> Result<(), Message> {
+        let need = (self.table.needs(vrs)).map_err(|vr| format!("value reference {vr} does not exist"))?;
+        if need & !self.fresh != 0 {
+            self.compute_outputs(need & !self.fresh)?;
         }
-        Ok(self.values[vr as usize - 1])
+        for (o, &vr) in out.iter_mut().zip(vrs) {
+            *o = self.values[vr as usize - 1];
+        }
+        Ok(())
+    }
+
+    /// Evaluations of the loss model for the outputs since the run started (a loss output read
+    /// evaluates it at most once per communication point and set of inputs).
+    pub fn loss_evaluations(&self) -> usize {
+        self.run.as_ref().map_or(0, |r| r.losses.evaluations())
+    }
+
+    /// The stepper's counters since the run started (None before initialisation).
+    pub fn stepper_stats(&self) -> Option<StepperStats> {
+        self.run.as_ref().map(|r| r.stepper.stats())
     }
 
     /// The current time (the start time before initialisation).
@@ -570,8 +546,10 @@ impl Instance {
         self.run.as_ref().map_or(self.start_time, |r| r.stepper.time())
     }
 
-    /// The outputs of `part` from the state at the current time with the inputs in force.
-    fn compute_outputs(&mut self, part: Part) -> Result<(), Message> {
+    /// The outputs of the groups `groups` from the state at the current time with the inputs in
+    /// force.
+    #[inline(never)]
+    fn compute_outputs(&mut self, groups: u8) -> Result<(), Message> {
         if self.run.is_none() {
             if self.phase != Phase::Initialization {
                 return Err("outputs are available from initialization mode on".into());
@@ -582,20 +560,20 @@ impl Instance {
         let Some(run) = self.run.as_mut() else {
             return Err("no run".into());
         };
-        let outs = &self.parts[part as usize];
-        let values = &mut self.values;
-        let bad = match part {
-            Part::State => state_outputs(outs, run, inputs, values),
-            Part::Oil => oil_outputs(outs, run, values),
-            Part::Losses => loss_outputs(outs, run, inputs, values),
+        let at = outputs::Point {
+            gearbox: &run.model.gearbox,
+            scene: &run.scene,
+            stepper: &mut run.stepper,
+            losses: &mut run.losses,
+            inputs,
         };
-        if let Some(k) = bad {
+        if let Some(k) = outputs::compute(&self.table, groups, at, &mut self.values) {
             let t = run.stepper.time();
             self.phase = Phase::Error;
             let name = &self.fm.vars[k].name;
             return Err(format!("t = {t} s: output {name} is not finite"));
         }
-        self.fresh[part as usize] = true;
+        self.fresh |= groups;
         Ok(())
     }
 
@@ -603,98 +581,6 @@ impl Instance {
     pub fn terminate(&mut self) {
         self.phase = Phase::Terminated;
     }
-}
-
-/// The outputs `outs` of [`Part::State`] into `values` from the stepper's state; the position
-/// of the first that is not finite, if any.
-fn state_outputs(outs: &[(usize, Role)], run: &Run, inputs: Inputs, values: &mut [f64]) -> Option<usize> {
-    let (scene, y) = (&run.scene, run.stepper.state());
-    // Loss energy per source, J: the sums of `Scene::loss_energy_by_source` in the same order.
-    let n = scene.nodes();
-    let mut energy = [0.0; N_SOURCES];
-    if scene.has_item_energies() {
-        for (e, items) in energy.iter_mut().zip(&run.source_items) {
-            *e = items.iter().fold(0.0, |sum, &k| sum + y[n + k]);
-        }
-    } else {
-        energy.copy_from_slice(&y[n..n + N_SOURCES]);
-    }
-    let w = inputs.input_speed;
-    let torque = inputs.input_torque;
-    let ratio = run.model.gearbox.gear_states[inputs.state].ratio();
-    for &(k, role) in outs {
-        let x = match role {
-            Role::NodeTemp(i) => y[i],
-            Role::SourceEnergy(s) => energy[s.index()],
-            Role::TotalEnergy => energy.iter().sum(),
-            Role::OutputSpeed => w / ratio,
-            Role::OutputTorque => torque * ratio,
-            _ => continue,
-        };
-        if !x.is_finite() {
-            return Some(k);
-        }
-        values[k] = x;
-    }
-    None
-}
-
-/// The output `outs` of [`Part::Oil`] (the viscosity at the oil temperature of the stepper's
-/// state) into `values`; its position if it is not finite.
-fn oil_outputs(outs: &[(usize, Role)], run: &Run, values: &mut [f64]) -> Option<usize> {
-    let nu = run.model.gearbox.oil.nu(run.scene.oil_temp(run.stepper.state()));
-    for &(k, _) in outs {
-        if !nu.is_finite() {
-            return Some(k);
-        }
-        values[k] = nu;
-    }
-    None
-}
-
-/// The loss items of each source, in item order.
-fn source_items(items: &[LossItem]) -> [Vec<usize>; N_SOURCES] {
-    let mut by: [Vec<usize>; N_SOURCES] = Default::default();
-    for (k, it) in items.iter().enumerate() {
-        by[it.source.index()].push(k);
-    }
-    by
-}
-
-/// The outputs `outs` of [`Part::Losses`] into `values`: the loss items evaluated at the
-/// stepper's state with the inputs in force; the position of the first that is not finite, if
-/// any.
-fn loss_outputs(outs: &[(usize, Role)], run: &mut Run, inputs: Inputs, values: &mut [f64]) -> Option<usize> {
-    run.stepper.set_inputs(&run.scene, inputs);
-    run.stepper.losses_into(&run.scene, &mut run.q);
-    let q = &run.q;
-    // Per source and total as `sum_by_source` and `geartherm run` sum them (item order).
-    let mut by = [0.0; N_SOURCES];
-    for (b, items) in by.iter_mut().zip(&run.source_items) {
-        *b = items.iter().fold(0.0, |sum, &k| sum + q[k]);
-    }
-    let total: f64 = q.iter().sum();
-    // The losses supplied through the input shaft: not the converter's slip or an
-    // engine-driven pump, paid ahead of it (as `timeseries.csv`'s input torque).
-    let shaft: f64 = (run.item_engine_side.iter().zip(q))
-        .filter(|(&engine_side, _)| !engine_side)
-        .map(|(_, p)| p)
-        .sum();
-    let (w, torque) = (inputs.input_speed, inputs.input_torque);
-    for &(k, role) in outs {
-        let x = match role {
-            Role::SourceLoss(s) => by[s.index()],
-            Role::TotalLoss => total,
-            Role::Efficiency => efficiency(torque * w, total).unwrap_or(0.0),
-            Role::InputTorqueWithLosses => torque + if w > 0.0 { shaft / w } else { 0.0 },
-            _ => continue,
-        };
-        if !x.is_finite() {
-            return Some(k);
-        }
-        values[k] = x;
-    }
-    None
 }
 
 /// A limit in rpm as one in rad/s.

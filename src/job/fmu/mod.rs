@@ -9,6 +9,7 @@
 
 pub mod description;
 pub mod instance;
+pub mod outputs;
 pub mod slot;
 pub mod variables;
 
