@@ -82,3 +82,31 @@ fn a_scene_with_other_bearings_or_converter_does_not_read_the_terms() {
     let mut p = job::run::prepare(&m, &job::RunOptions::default()).unwrap();
     assert_eq!(p.scene.use_sample_cache(Arc::clone(&cache)), (false, false));
 }
+
+#[test]
+fn a_cached_schedule_is_the_one_computed_and_a_changed_vehicle_gets_its_own() {
+    use geartherm::cycle::DriveCycle;
+    use geartherm::model::Override;
+    use geartherm::solve::drive::segments;
+    use geartherm::study::schedule_cache::ScheduleCache;
+
+    let uq = uq();
+    let cycle = DriveCycle::resolve("wltc").unwrap();
+    let cache = ScheduleCache::default();
+    let (first, _) = prepared(&uq, 3);
+    let filled = cache.segments(&first.gearbox, &cycle).unwrap();
+    assert_eq!(filled, segments(&first.gearbox, &cycle).unwrap());
+    // Another sample (other oil level, heat transfer, cooler, ambient): the same schedule.
+    let (other, _) = prepared(&uq, 6);
+    assert_eq!(
+        cache.segments(&other.gearbox, &cycle).unwrap(),
+        segments(&other.gearbox, &cycle).unwrap()
+    );
+    // A heavier vehicle needs more torque: its own schedule, not the cached one.
+    let s = &uq.study;
+    let heavier: Override = "vehicle.mass_kg = 2400.0".parse().unwrap();
+    let m = job::Model::from_text(&s.model_text, &s.model_file, &[heavier]).unwrap();
+    let own = segments(&m.gearbox, &cycle).unwrap();
+    assert_ne!(own.1, filled.1);
+    assert_eq!(cache.segments(&m.gearbox, &cycle).unwrap(), own);
+}

@@ -12,6 +12,7 @@ mod checks;
 mod columns;
 pub mod plan;
 pub mod runner;
+pub mod schedule_cache;
 mod selection;
 pub mod spec;
 pub mod uq;
@@ -28,6 +29,7 @@ use crate::model::{self, overrides, KeyPath, Override};
 pub use crate::report::study::{CaseRow, ParamValue};
 use crate::scene::SampleCache;
 pub use columns::{run_outputs, steady_outputs};
+use schedule_cache::ScheduleCache;
 pub use selection::Selection;
 use spec::StudySpec;
 
@@ -96,6 +98,9 @@ pub struct Study {
     /// read by every case whose compiled bearings or converter equal that case's
     /// ([`crate::scene::SampleCache`]).
     sample_caches: Vec<OnceLock<Arc<SampleCache>>>,
+    /// Per job: its cycle's schedule, computed by the first case solved and reused by every
+    /// case whose vehicle, gear ratios and launch device equal that case's.
+    schedules: Vec<ScheduleCache>,
 }
 
 /// FNV-1a, 64 bit: a stable fingerprint (the same on every platform and version).
@@ -233,6 +238,7 @@ impl Study {
             series_points: None,
             uq_plan,
             sample_caches: jobs_cache(jobs_len),
+            schedules: (0..jobs_len).map(|_| ScheduleCache::default()).collect(),
         })
     }
 
@@ -381,7 +387,10 @@ impl Study {
         let m = job::Model::from_document(self.base.clone(), &self.model_file, &ovs)?;
         match self.case_job(c, per_case) {
             Job::Run(o) => {
-                let mut p = job::run::prepare(&m, &o)?;
+                let schedule = |gb: &model::gearbox::Gearbox, cycle: &crate::cycle::DriveCycle| {
+                    self.schedules[c.job].segments(gb, cycle)
+                };
+                let mut p = job::run::prepare_with(&m, &o, &schedule)?;
                 // A table row keeps no range warnings: only a case's own summary.json shows them.
                 p.range_warnings = per_case;
                 if !o.evaluate_all {
