@@ -3,7 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::cycle::{DriveCycle, Schedule};
+use crate::cycle::{CycleError, DriveCycle, Schedule};
+use crate::model::gearbox::Gearbox;
 use crate::physics::units::c_to_k;
 use crate::report::run::{check_finite, run_warnings, summary, timeseries_csv, Summary};
 use crate::scene::{Needs, Scene, SpreadScene};
@@ -143,6 +144,16 @@ pub struct Prepared {
 /// Check the options, read and schedule the cycle, compile the scene for it: everything that
 /// can fail as invalid input fails here, before any output directory is touched.
 pub fn prepare(m: &Model, o: &RunOptions) -> Result<Prepared, JobError> {
+    prepare_with(m, o, &segments)
+}
+
+/// How a cycle is scheduled on a gearbox into solver segments ([`segments`], or a cache of its
+/// results that returns the same values).
+pub type SegmentsFn<'a> = dyn Fn(&Gearbox, &DriveCycle) -> Result<(Schedule, Vec<Segment>), CycleError> + 'a;
+
+/// [`prepare`] with the cycle scheduled by `segments` (a study reuses one schedule for the cases
+/// whose schedule inputs are equal).
+pub fn prepare_with(m: &Model, o: &RunOptions, segments: &SegmentsFn) -> Result<Prepared, JobError> {
     let method = o.check()?;
     let oil = OilRange::of(&m.gearbox.oil);
     oil.check_option_opt(&limits::INITIAL_TEMP_C, o.initial_temp_c)?;

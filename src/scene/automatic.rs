@@ -16,7 +16,7 @@ use crate::physics::oil::OilProperties;
 
 use super::items::{DefaultHeat, LossItem, Skipped, Source};
 
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 struct PackEntry {
     item: usize,
     pack: ClutchPack,
@@ -28,7 +28,7 @@ struct PackEntry {
     face: f64,
 }
 
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 struct PumpEntry {
     item: usize,
     model: PumpModel,
@@ -37,7 +37,7 @@ struct PumpEntry {
 }
 
 /// Compiled automatic-transmission losses.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct AutoLosses {
     packs: Vec<PackEntry>,
     pump: Option<PumpEntry>,

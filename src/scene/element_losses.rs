@@ -22,7 +22,7 @@ fn clean(v: f64) -> f64 {
     }
 }
 
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 struct BearingEntry {
     item: usize,
     model: BearingFriction,
@@ -38,7 +38,7 @@ struct BearingEntry {
     speed_unit: Vec<Option<[f64; 4]>>,
 }
 
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 struct SealEntry {
     item: usize,
     seal: LipSeal,
@@ -46,7 +46,7 @@ struct SealEntry {
 }
 
 /// Compiled bearings and seals.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct ElementLosses {
     bearings: Vec<BearingEntry>,
     seals: Vec<SealEntry>,

@@ -6,6 +6,8 @@
 //! gear state the gear speeds and mesh torques per unit input. Evaluating all losses at an
 //! operating point (`LossScene::evaluate`) is then a loop over flat arrays with no allocation.
 
+use std::sync::Arc;
+
 use crate::model::gearbox::Gearbox;
 use crate::physics::losses::churning::{GearChurning, OilState as ChurnOil};
 
@@ -15,6 +17,7 @@ use super::gear_losses::{
     compile_churning, compile_pocketing, compile_sliding, compile_windage, sliding, with_ratio_terms,
     ChurnEntry, Compiled, Lists, PocketEntry, SlideEntry, StateFactors, WindEntry,
 };
+use super::sample_cache::{sample_key, CacheUse, SampleCache};
 use super::usage::Usage;
 use super::warning::RangeWarning;
 use crate::physics::losses::windage::AIR;
@@ -42,6 +45,8 @@ pub struct SampleTerms {
     churn: Vec<ChurnSample>,
     /// Samples prepared.
     pub prepared: usize,
+    /// Entry of the attached [`SampleCache`] the last sample was found at.
+    cursor: usize,
     /// Pump and converter values of the sample (they need the vehicle speed too).
     pub auto: super::automatic::AutoSample,
     /// What the circuit's sources deliver in this sample.
@@ -73,6 +78,9 @@ pub struct LossScene {
     pub circuit: CircuitScene,
     /// Multiplier of each item (`[losses] multiplier`), when any is given.
     factor: Option<Vec<f64>>,
+    /// Per-sample terms computed once for a cycle, read instead of computed where the compiled
+    /// parts they come from are equal ([`LossScene::use_sample_cache`]).
+    cache: Option<CacheUse>,
 }
 
 impl LossScene {
@@ -144,6 +152,7 @@ impl LossScene {
             auto,
             elements,
             circuit,
+            cache: None,
         })
     }
 
@@ -195,6 +204,7 @@ impl LossScene {
             bearing: vec![Default::default(); self.elements.bearings()],
             churn: vec![ChurnSample::Direct; self.churn.len()],
             prepared: 0,
+            cursor: 0,
             auto: Default::default(),
             circuit: Default::default(),
         }
@@ -216,8 +226,16 @@ impl LossScene {
         vehicle_speed: f64,
         terms: &mut SampleTerms,
     ) {
-        self.auto
-            .prepare(state, input_speed, input_torque, vehicle_speed, &mut terms.auto);
+        let cached = self.cache.as_ref().and_then(|c| {
+            let key = sample_key(state, input_speed, input_torque, vehicle_speed);
+            c.find(key, &mut terms.cursor).map(|i| (c, i))
+        });
+        match cached.and_then(|(c, i)| c.auto(i)) {
+            Some(s) => terms.auto = *s,
+            None => self
+                .auto
+                .prepare(state, input_speed, input_torque, vehicle_speed, &mut terms.auto),
+        }
         terms.circuit = self.circuit.sample(state, input_speed, &terms.auto);
         let key = (state, input_speed.to_bits(), input_torque.to_bits());
         if terms.key == Some(key) {
@@ -246,7 +264,10 @@ impl LossScene {
                 };
             }
         }
-        self.elements.prepare(state, w, t, &mut terms.bearing);
+        match cached.and_then(|(c, i)| c.bearing_terms(i)) {
+            Some(b) => terms.bearing.copy_from_slice(b),
+            None => self.elements.prepare(state, w, t, &mut terms.bearing),
+        }
         let mut input = InputSpeedPowers::new(w);
         for ((e, k), c) in self.churn.iter().zip(&st.churn_speed).zip(&mut terms.churn) {
             let ratio = e.ratio_terms.get(state).unwrap_or(&[0.0; 3]);
@@ -254,6 +275,21 @@ impl LossScene {
         }
         terms.key = Some(key);
         terms.prepared += 1;
+    }
+
+    /// The bearings' load terms and the pump and converter values of every sample of `inputs`
+    /// (a cycle's segments: state, input speed, input torque, vehicle speed), computed once for
+    /// this scene's compiled parts.
+    pub fn sample_cache(&self, inputs: impl IntoIterator<Item = (usize, f64, f64, f64)>) -> SampleCache {
+        SampleCache::build(&self.elements, &self.auto, inputs)
+    }
+
+    /// Read the per-sample terms of `cache` where this scene's compiled parts equal those it was
+    /// built from (bitwise the terms [`Self::prepare_at`] computes); returns which parts are read
+    /// (bearings, pump and converter).
+    pub fn use_sample_cache(&mut self, cache: Arc<SampleCache>) -> (bool, bool) {
+        self.cache = CacheUse::new(cache, &self.elements, &self.auto);
+        self.cache.as_ref().map_or((false, false), CacheUse::parts)
     }
 
     /// Evaluate every loss item (W) at `op` into `out` using the per-sample terms prepared for

@@ -11,6 +11,7 @@ pub mod items;
 pub mod losses;
 pub mod planet_churning;
 pub mod ranges;
+pub mod sample_cache;
 mod sliding_memo;
 pub mod spread;
 pub mod spread_eval;
@@ -24,6 +25,7 @@ pub use losses::{
     SceneError, Skipped, Source, N_SOURCES,
 };
 pub use ranges::{RangeLog, RangeWarning};
+pub use sample_cache::SampleCache;
 pub use spread::SpreadScene;
 pub use spread_eval::{ItemSpread, ModelEnergy, ModelValue, SourceSpread, SpreadWork};
 pub use system::{Inputs, RhsFailure, Scene, Work};

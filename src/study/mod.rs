@@ -12,11 +12,13 @@ mod checks;
 mod columns;
 pub mod plan;
 pub mod runner;
+pub mod schedule_cache;
 mod selection;
 pub mod spec;
 pub mod uq;
 
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
 
 use toml::Value;
 
@@ -25,7 +27,9 @@ use crate::job::{self, JobError, RunOptions, SteadyOptions};
 use crate::model::overrides::scaled;
 use crate::model::{self, overrides, KeyPath, Override};
 pub use crate::report::study::{CaseRow, ParamValue};
+use crate::scene::SampleCache;
 pub use columns::{run_outputs, steady_outputs};
+use schedule_cache::ScheduleCache;
 pub use selection::Selection;
 use spec::StudySpec;
 
@@ -90,6 +94,13 @@ pub struct Study {
     pub series_points: Option<usize>,
     /// An uncertainty plan's sampled quantities and design (None for other plans).
     pub uq_plan: Option<(Vec<uq::plan::InputInfo>, uq::plan::Design)>,
+    /// Per job: the per-sample loss terms of its cycle, computed by the first case solved and
+    /// read by every case whose compiled bearings or converter equal that case's
+    /// ([`crate::scene::SampleCache`]).
+    sample_caches: Vec<OnceLock<Arc<SampleCache>>>,
+    /// Per job: its cycle's schedule, computed by the first case solved and reused by every
+    /// case whose vehicle, gear ratios and launch device equal that case's.
+    schedules: Vec<ScheduleCache>,
 }
 
 /// FNV-1a, 64 bit: a stable fingerprint (the same on every platform and version).
@@ -118,6 +129,10 @@ pub(crate) fn key_of(label: &str) -> String {
         })
         .collect();
     s.chars().take(40).collect()
+}
+
+fn jobs_cache(n: usize) -> Vec<OnceLock<Arc<SampleCache>>> {
+    (0..n).map(|_| OnceLock::new()).collect()
 }
 
 /// An uncertainty plan's sampled quantities and design.
@@ -193,6 +208,7 @@ impl Study {
             &model_file,
         )?;
         let jobs = checks::jobs_of(&spec.job).map_err(invalid)?;
+        let jobs_len = jobs.len();
         if samples.len().saturating_mul(jobs.len()) > plan::MAX_SAMPLES {
             return Err(invalid(format!(
                 "{} samples × {} jobs: more than {} cases",
@@ -221,6 +237,8 @@ impl Study {
             outputs,
             series_points: None,
             uq_plan,
+            sample_caches: jobs_cache(jobs_len),
+            schedules: (0..jobs_len).map(|_| ScheduleCache::default()).collect(),
         })
     }
 
@@ -369,9 +387,17 @@ impl Study {
         let m = job::Model::from_document(self.base.clone(), &self.model_file, &ovs)?;
         match self.case_job(c, per_case) {
             Job::Run(o) => {
-                let mut p = job::run::prepare(&m, &o)?;
+                let schedule = |gb: &model::gearbox::Gearbox, cycle: &crate::cycle::DriveCycle| {
+                    self.schedules[c.job].segments(gb, cycle)
+                };
+                let mut p = job::run::prepare_with(&m, &o, &schedule)?;
                 // A table row keeps no range warnings: only a case's own summary.json shows them.
                 p.range_warnings = per_case;
+                if !o.evaluate_all {
+                    let cache = self.sample_caches[c.job]
+                        .get_or_init(|| Arc::new(p.scene.sample_cache(p.segs.iter().map(|s| s.inputs))));
+                    p.scene.use_sample_cache(Arc::clone(cache));
+                }
                 let r = match self.series_points.filter(|_| self.keeps_series(c.sample)) {
                     Some(points) => {
                         let (r, s) = job::series::solve_with_series(&m, &p, points)?;
