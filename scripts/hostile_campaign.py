@@ -131,12 +131,19 @@ def run_case(case, ctx):
                 "detail": f"{type(e).__name__}: {e}"}
 
 
+# Failure classes of one family (beside core.CLASSES): `later_refused`, a written calibrated
+# model that `check` refuses; `valid_refused`, a valid calibration (no mutation) refused.
+FAMILY_CLASSES = ["later_refused", "valid_refused"]
+
+
 class Tally:
     def __init__(self):
         self.counts = collections.Counter()
         self.by_family = collections.defaultdict(collections.Counter)
         self.exits = collections.defaultdict(collections.Counter)
         self.examples = collections.defaultdict(list)
+        self.fits = collections.Counter()
+        self.valid = collections.Counter()
         self.done = 0
         self.log = None
 
@@ -145,6 +152,8 @@ class Tally:
         fam = r["family"]
         self.by_family[fam]["cases"] += 1
         self.exits[fam][str(r.get("rc", "-"))] += 1
+        self.fits[fam] += bool(r.get("fit"))
+        self.valid[fam] += bool(r.get("valid"))
         for k in sorted(set(r["classes"])):
             self.counts[k] += 1
             self.by_family[fam][k] += 1
@@ -153,14 +162,15 @@ class Tally:
 
     def print(self, a, wall):
         print(f"cases run: {self.done} (seed {a.seed}, jobs {a.jobs}, {wall / 60:.1f} min wall)")
-        print("| family | cases | exit codes / outcomes | failures |")
-        print("|---|---|---|---|")
+        print("| family | cases | exit codes / outcomes | reached a fit | failures |")
+        print("|---|---|---|---|---|")
         for fam in sorted(self.by_family):
             c = self.by_family[fam]
             ex = ", ".join(f"{k}: {v}" for k, v in sorted(self.exits[fam].items()))
             fails = ", ".join(f"{k} {v}" for k, v in sorted(c.items()) if k != "cases") or "0"
-            print(f"| {fam} | {c['cases']} | {ex} | {fails} |")
-        for k in core.CLASSES + ["harness"]:
+            fit = f"{self.fits[fam]} ({100 * self.fits[fam] / c['cases']:.0f} %)" if self.fits[fam] else "-"
+            print(f"| {fam} | {c['cases']} | {ex} | {fit} | {fails} |")
+        for k in core.CLASSES + FAMILY_CLASSES + ["harness"]:
             print(f"{k:>19}: {self.counts.get(k, 0)}")
         for k, ex in self.examples.items():
             for r in ex[:3]:
