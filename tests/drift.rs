@@ -513,3 +513,138 @@ fn uq_accepts_and_refuses_alike_from_the_cli_and_the_use_case() {
         "{accepted} accepted, {refused} refused"
     );
 }
+
+/// The options a calibrate message may name at its start (the CLI adds the flag after it).
+const CALIBRATE_NAMES: &[&str] = &[
+    "fit",
+    "holdout",
+    "rtol",
+    "atol",
+    "max_steps",
+    "max_iterations",
+    "segment",
+    "residuals",
+    "prior",
+    "profile",
+    "gearbox_kind",
+    "rated",
+    "trace",
+];
+
+/// The calibrate rows of `tests/data/option_limits.toml`: the model, the options (base and
+/// `set` on top) and whether the checks accept them.
+fn calibrate_rows() -> Vec<(String, Table, bool)> {
+    let text = std::fs::read_to_string(root().join("tests/data/option_limits.toml")).unwrap();
+    let doc: Table = text.parse().unwrap();
+    let mut base = doc["base"]["calibrate"].as_table().unwrap().clone();
+    let model = base.remove("model").unwrap().as_str().unwrap().to_string();
+    doc["calibrate_row"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| {
+            let mut options = base.clone();
+            options.extend(r["set"].as_table().unwrap().clone());
+            (model.clone(), options, r["expect"].as_str() == Some("accept"))
+        })
+        .collect()
+}
+
+/// `geartherm calibrate` with the row's options: each list item a flag of its own, `segments`
+/// the `--segment` flag.
+fn calibrate_cli(model: &str, options: &Table, out: &Path) -> Outcome {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_geartherm"));
+    cmd.current_dir(root()).arg("calibrate").arg(model);
+    for (k, v) in options {
+        let f = flag(if k == "segments" { "segment" } else { k });
+        let items = match v {
+            Value::Array(a) => a.clone(),
+            other => vec![other.clone()],
+        };
+        for item in items {
+            match item {
+                Value::String(s) => cmd.arg(format!("{f}={s}")),
+                other => cmd.arg(format!("{f}={other}")),
+            };
+        }
+    }
+    let o = cmd.arg("--out").arg(out).output().unwrap();
+    let msg = unspelled_names(String::from_utf8_lossy(&o.stderr).trim(), CALIBRATE_NAMES);
+    match o.status.code() {
+        Some(0) => Outcome::Ok,
+        Some(1) => Outcome::Refused(msg),
+        Some(2) => Outcome::Failed(msg),
+        c => panic!("calibrate: exit {c:?}: {msg}"),
+    }
+}
+
+/// The job layer as the Python binding calls it: options deserialised from a mapping, the
+/// trace read from its text (one segment: `Model.calibrate`; `segments`: the several-trace fit
+/// of `Model.calibrate(segments=…)`, the trace named by its file's stem).
+fn calibrate_library(m: &job::Model, text: &str, options: &Table) -> Outcome {
+    use geartherm::job::calibrate::{self, stack, stack_fit, trace_file, CalibrateOptions};
+    let o: CalibrateOptions = Value::Table(options.clone()).try_into().unwrap();
+    let csv = std::fs::read_to_string(root().join(&o.trace)).unwrap();
+    if o.segments.is_some() {
+        let stem = Path::new(&o.trace)
+            .file_stem()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        return outcome((|| {
+            let file = trace_file::read(&csv, &stem, o.missing())?;
+            let files = [(stem.clone(), file)];
+            let inputs = stack::inputs(&files, &o)?;
+            let s = stack::prepare(m, text, &inputs, &o)?;
+            stack_fit::fit(m, &s, &o, &|th| s.evaluate(th))
+        })());
+    }
+    outcome((|| {
+        let file = trace_file::read(&csv, &o.trace, o.missing())?;
+        let trace = file
+            .select(o.segment)
+            .map_err(|e| job::JobError::invalid(e.to_string()))?;
+        calibrate::calibrate(m, text, trace, &o)
+    })())
+}
+
+/// Calibrate's options at and beyond their limits (the calibrate rows of
+/// `tests/data/option_limits.toml`): the CLI and the job layer the Python binding calls accept
+/// or refuse each alike, with the same message (python/tests/test_drift.py: `Model.calibrate`).
+/// Studies do not calibrate: no study front end applies.
+#[test]
+fn calibrate_accepts_and_refuses_alike_from_the_cli_and_the_job_layer() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (mut refused, mut accepted) = (0, 0);
+    for (k, (model, options, expect_accept)) in calibrate_rows().iter().enumerate() {
+        let text = std::fs::read_to_string(root().join(model)).unwrap();
+        let m = job::Model {
+            file: PathBuf::from(model),
+            ..job::Model::load(&root().join(model), &[]).unwrap()
+        };
+        let out = tmp.path().join(format!("c{k}"));
+        let c = calibrate_cli(model, options, &out);
+        let l = calibrate_library(&m, &text, options);
+        assert_eq!(c, l, "calibrate row {k}: {options:?}: CLI vs job layer");
+        match &c {
+            Outcome::Refused(msg) => {
+                assert!(!expect_accept, "calibrate row {k}: {options:?}: refused: {msg}");
+                assert!(
+                    !out.exists(),
+                    "calibrate row {k}: refused but wrote {}",
+                    out.display()
+                );
+                refused += 1;
+            }
+            _ => {
+                assert!(expect_accept, "calibrate row {k}: {options:?}: accepted: {c:?}");
+                accepted += 1;
+            }
+        }
+    }
+    eprintln!("calibrate: {accepted} rows accepted, {refused} refused alike by the CLI and the job layer");
+    assert!(
+        refused >= 30 && accepted >= 15,
+        "{accepted} accepted, {refused} refused"
+    );
+}

@@ -1,6 +1,7 @@
 """One pipeline: every row of tests/data/option_limits.toml (inputs at and beyond every job
-option's limits) is accepted or refused alike, with the same message, by the Python API and by
-the CLI (tests/drift.rs holds the CLI against a study case)."""
+option's limits, calibrate's among them) is accepted or refused alike, with the same message, by
+the Python API and by the CLI (tests/drift.rs holds the CLI against a study case and the job
+layer)."""
 
 import os
 import subprocess
@@ -54,22 +55,23 @@ def _unspelled(msg, options):
     return msg
 
 
-def _python(model, job, options):
-    o = dict(options)
+def _outcome(call):
+    """("ok", ""), ("failed", message) or ("refused", message) of ``call()``."""
     try:
-        if job == "losses":
-            model.losses(o.pop("gear"), o.pop("speed_rpm"), o.pop("torque_nm"), o.pop("oil_temp_c"))
-        elif job == "steady":
-            model.steady(**o)
-        elif job == "rating":
-            model.rating(**o)
-        else:
-            model.run(**o)
+        call()
     except geartherm.SolveError as e:
         return "failed", str(e)
     except (geartherm.InputError, geartherm.ModelError) as e:
         return "refused", str(e)
     return "ok", ""
+
+
+def _python(model, job, options):
+    o = dict(options)
+    if job == "losses":
+        return _outcome(lambda: model.losses(o.pop("gear"), o.pop("speed_rpm"), o.pop("torque_nm"), o.pop("oil_temp_c")))
+    method = {"steady": model.steady, "rating": model.rating}.get(job, model.run)
+    return _outcome(lambda: method(**o))
 
 
 def test_python_and_cli_accept_and_refuse_alike(tmp_path, monkeypatch):
@@ -83,6 +85,54 @@ def test_python_and_cli_accept_and_refuse_alike(tmp_path, monkeypatch):
         assert (cli[0] == "refused") == (expect == "reject"), f"row {k}: {job} {options}: {cli}"
         seen["refused" if cli[0] == "refused" else "accepted"] += 1
     assert seen["refused"] > 20 and seen["accepted"] > 15
+
+
+# Calibrate's rows (`[[calibrate_row]]`): `Model.calibrate` against `geartherm calibrate`.
+# Studies do not calibrate, so no study front end applies.
+CALIBRATE_NAMES = ["fit", "holdout", "rtol", "atol", "max_steps", "max_iterations", "segment", "residuals", "prior",
+                   "profile", "gearbox_kind", "rated", "trace"]
+
+
+def _calibrate_rows():
+    doc = tomllib.loads((ROOT / "tests" / "data" / "option_limits.toml").read_text())
+    base = dict(doc["base"]["calibrate"])
+    model = base.pop("model")
+    for k, r in enumerate(doc["calibrate_row"]):
+        yield k, model, dict(base, **r["set"]), r["expect"]
+
+
+def _calibrate_cli(model, options, out):
+    """Each list item a flag of its own; ``segments`` is the ``--segment`` flag."""
+    args = [str(BIN), "calibrate", model]
+    for k, v in options.items():
+        flag = "--" + ("segment" if k == "segments" else k).replace("_", "-")
+        args += [f"{flag}={x}" for x in (v if isinstance(v, list) else [v])]
+    p = subprocess.run(args + ["--out", str(out)], cwd=ROOT, capture_output=True, text=True)
+    kind = {0: "ok", 1: "refused", 2: "failed"}[p.returncode]
+    return kind, "" if kind == "ok" else _unspelled(p.stderr.strip(), CALIBRATE_NAMES)
+
+
+def _calibrate_python(model, options):
+    """``Model.calibrate`` with the row's options (``rated``: a pair of floats)."""
+    o = dict(options)
+    trace = o.pop("trace")
+    if "rated" in o:
+        o["rated"] = tuple(float(x) for x in o["rated"].split(":"))
+    return _outcome(lambda: model.calibrate(trace, **o))
+
+
+def test_calibrate_from_python_and_the_cli_accepts_and_refuses_alike(tmp_path, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    seen = {"refused": 0, "accepted": 0}
+    models = {}
+    for k, path, options, expect in _calibrate_rows():
+        model = models.setdefault(path, geartherm.Model.load(path))
+        cli = _calibrate_cli(path, options, tmp_path / f"c{k}")
+        py = _calibrate_python(model, options)
+        assert py == cli, f"calibrate row {k}: {options}"
+        assert (cli[0] == "refused") == (expect == "reject"), f"calibrate row {k}: {options}: {cli}"
+        seen["refused" if cli[0] == "refused" else "accepted"] += 1
+    assert seen["refused"] >= 30 and seen["accepted"] >= 15, seen
 
 
 # Case selection: every shard and case-list form is accepted or refused alike, with the same

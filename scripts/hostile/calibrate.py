@@ -1,11 +1,14 @@
 """`calibrate` over several traces (family ``calibrate_traces``): two or three generated rig
-traces of the helical stage (gaps that cut them into segments, hostile cells, columns missing,
-renamed or reordered, a node the model does not have), shared and per-trace `--fit` keys
-(`KEY@N`, `KEY@name`, `KEY@*`, unknown traces), priors on the command line and in a priors file
-(negative, zero and non-finite widths, unknown traces), `--profile`, `--residuals`, `--rated`,
-`--gearbox-kind`, `--segment`, `--holdout`, and `--band-from` a calibration over several traces
-(made once per campaign) or a crafted one. Half of the cases write into a directory that holds a
-complete previous result set, which a failure must leave byte for byte."""
+traces of the helical stage (one to three segments each, cut by gaps in time), shared and
+per-trace `--fit` keys (`KEY@N`, `KEY@name`, `KEY@*`), priors on the command line and in a
+priors file, `--profile`, `--residuals`, `--rated`, `--gearbox-kind`, `--holdout`, `--band-from`
+a calibration over several traces (made once per campaign), and `--segment` over one trace of
+several segments. About two cases in five are valid calibrations that must run to a result
+(exit 0); each of the others carries one to three hostile mutations (bad cells, times or
+columns; unknown, doubled or unboundable keys and traces; priors of negative, zero or
+non-finite width; options beyond their limits; a crafted `--band-from`). Half of the cases write
+into a directory that holds a complete previous result set, which a failure must leave byte for
+byte; every written `calibrated*.toml` must pass `check`."""
 import atexit
 import json
 import os
@@ -25,27 +28,33 @@ M = 'thermal.nodes["housing"].mass_kg'
 HOSTILE = ["0", "-1", "1e308", "nan", "inf", "-inf", "x", "", "1e-300", "-0.0", "9999"]
 COLUMNS = ["time_s", "input_speed_rpm", "input_torque_nm", "gear", "boundary:ambient", "node:oil",
            "node:housing"]
+# Share of the cases that are valid calibrations (no mutation).
+VALID = 0.4
+# The hostile mutations: what each changes is made by `mutate_*` below (traces) or by the
+# argument builders (options), each given the set of mutations of its case.
+MUTATIONS = ["cells", "times", "columns", "same_trace", "fit", "prior", "priors_file", "option",
+             "segment", "band"]
 
 
-def gen_trace(rng, mass):
-    """A warm-up of the helical stage measured on oil and housing: two segments a day apart
-    (sometimes one, sometimes three), hostile cells and columns with small chances."""
+def gen_trace(rng, mass, segments, n, hostile=()):
+    """A warm-up of the helical stage measured on oil and housing, `segments` segments a day
+    apart of `n` rows each; `hostile` ⊆ {"cells", "times", "columns"} spoils it."""
     cols = list(COLUMNS)
-    r = rng.random()
-    if r < 0.05:
-        cols.remove(rng.choice(cols[4:]))
-    elif r < 0.08:
-        cols[rng.randrange(4, len(cols))] = rng.choice(["node:bearing_x", "boundary:sun", "node:oil"])
-    elif r < 0.15:
+    if "columns" in hostile:
+        r = rng.random()
+        if r < 0.35:
+            cols.remove(rng.choice(cols[4:]))
+        elif r < 0.7:
+            cols[rng.randrange(4, len(cols))] = rng.choice(["node:bearing_x", "boundary:sun", "node:oil"])
+        else:
+            cols.append(rng.choice(["node:bearing_x", "node:housing", "time_s"]))
+    elif rng.random() < 0.2:
         head, tail = cols[:4], cols[4:]
         rng.shuffle(tail)
         cols = head + tail
     rows, t = [",".join(cols)], 0.0
-    # Most traces are clean (the options are what is hostile); a few carry bad cells or times.
-    bad_cells = 0.02 if rng.random() < 0.15 else 0.0
-    bad_times = [0.0, -60.0, 1e-9] if rng.random() < 0.1 else []
-    segments = rng.choice([1, 2, 2, 2, 3])
-    n = rng.choice([12, 20, 30])
+    bad_cells = rng.choice([0.01, 0.05, 0.3]) if "cells" in hostile else 0.0
+    bad_times = [0.0, -60.0, 1e-9, 1e12] if "times" in hostile else []
     tau = 5.0 + mass
     for s in range(segments):
         for k in range(n):
@@ -56,64 +65,96 @@ def gen_trace(rng, mass):
                     "node:housing": f"{x - 2:.4f}", "node:bearing_x": "40", "boundary:sun": "20"}
             cells = [good[c] if rng.random() >= bad_cells else rng.choice(HOSTILE) for c in cols]
             rows.append(",".join(cells))
-            t += rng.choice([60.0] * 30 + bad_times)
+            t += rng.choice([60.0] * 8 + bad_times)
         t += 90_000.0
     return "\n".join(rows) + "\n"
 
 
-def fit_args(rng, names):
-    good = [H, f"{H}=50:5000", f"{M}@*=2:60", f"{M}@0=2:60", f"{M}@{names[-1]}=2:60"]
-    bad = [f"{M}=2:60", "losses.multiplier.churning=0.1:10", f"{M}@9", f"{M}@nobody", "thermal.nodes[9].mass_kg",
-           'thermal.nodes["oil"].mass_kg@*', f"{H}@*=1e-9:1e9", "losses.stavytskyi_ks=0.2:0.9"]
-    out = [rng.choice(good[:2])] if rng.random() < 0.8 else []
-    for _ in range(rng.choice([0, 1, 1, 2])):
-        out.append(rng.choice(good if rng.random() < 0.75 else bad))
+def fit_args(rng, names, bad):
+    """One to three valid `--fit` keys (distinct parameters); with `bad` one hostile key more."""
+    mass = rng.choice([f"{M}@*=2:60", f"{M}@0=2:60", f"{M}@{names[-1]}=2:60", f"{M}=2:60"])
+    h = [H, f"{H}=50:5000"] + ([f"{H}@*=50:5000"] if len(names) > 1 else [])
+    out = [rng.choice(h)] + ([mass] if rng.random() < 0.7 else [])
+    if bad:
+        out.append(rng.choice([f"{M}@9", f"{M}@nobody", "thermal.nodes[9].mass_kg", 'thermal.nodes["oil"].mass_kg@*',
+                               f"{H}@*=1e-9:1e9", "losses.stavytskyi_ks=0.2:0.9", f"{H}=5000:50", f"{M}@*=-2:60",
+                               f"thermal.nodes[1].mass_kg@{names[0]}", f"{H}=nan:1", "losses.multiplier.churning=0.1:10"]))
     return [f"--fit={k}" for k in dict.fromkeys(out)]
 
 
-def prior_args(rng, names, d):
-    widths = ["0.5", "0.5", "2", "0", "-1", "nan", "inf", "1e-300", "1e300"]
-    keys = [H, f"{M}@*", f"{M}@{names[0]}", f"{M}@1", f"{M}@nobody", f"{M}@7", M, "losses.multiplier.churning"]
+def fitted_keys(fits):
+    """The key (with its @TRACE) of each `--fit=` argument."""
+    return [f.split("=", 1)[1].split("=")[0] for f in fits]
+
+
+def prior_args(rng, fits, d, bad, bad_file):
+    """Priors on fitted keys (command line, or a priors file); `bad`/`bad_file` spoil one."""
+    keys = fitted_keys(fits)
     out = []
-    for _ in range(rng.choice([0, 0, 0, 1, 1, 2])):
-        dist = rng.choice(["normal:20", "lognormal:20", "lognormal:-1", "cauchy:1"])
-        out.append(f"--prior={rng.choice(keys)}={dist}:{rng.choice(widths)}")
-    if rng.random() < 0.15:
+    if rng.random() < 0.4 or bad:
+        k = rng.choice(keys)
+        dist = rng.choice(["normal:500:200", "lognormal:500:0.5"] if k.startswith(H) else ["normal:20:10", "lognormal:20:0.5"])
+        if bad:
+            k = rng.choice([k, f"{M}@nobody", f"{M}@7", "losses.multiplier.churning", k + "@a" if "@" not in k else k])
+            dist = rng.choice([dist.rsplit(":", 1)[0] + ":" + w for w in ["0", "-1", "nan", "inf", "1e-300", "x"]]
+                              + ["cauchy:20:1", "lognormal:-1:0.5", "normal:20"])
+        out.append(f"--prior={k}={dist}")
+    free = [k for k in keys if not any(a.startswith(f"--prior={k}=") for a in out)]
+    if (rng.random() < 0.3 and free) or bad_file:
         path = os.path.join(d, "priors.toml")
-        sd = rng.choice(["1", "-1", "0", "nan", '"x"'])
+        k = rng.choice(free or keys)
+        mean, sd = ("500", "200") if k.startswith(H) else ("20", "10")
+        sd = rng.choice(["-1", "0", "nan", '"x"', "inf"]) if bad_file else sd
+        extra = rng.choice(["", "bogus = 1\n", "[[prior]]\n"]) if bad_file else ""
         with open(path, "w") as f:
-            f.write(f"[[prior]]\nkey = '{rng.choice(keys)}'\ndistribution = 'normal'\nmean = 20\nsd = {sd}\n")
+            f.write(f"[[prior]]\nkey = '{k}'\ndistribution = 'normal'\nmean = {mean}\nsd = {sd}\n{extra}")
         out += ["--priors", path]
     return out
 
 
-def option_args(rng, names):
+def option_args(rng, names, fits, bad):
+    """Valid options with their own chances; with `bad` one of them beyond its limits."""
     a = []
+    keys = fitted_keys(fits)
+    if rng.random() < 0.4:
+        a += ["--residuals", rng.choice(["ar1", "ar1-gls", "independent"])]
+    if rng.random() < 0.25:
+        a += [f"--profile={rng.choice(keys)}"]
     if rng.random() < 0.3:
-        a += ["--residuals", rng.choice(["ar1", "ar1-gls", "independent", "ar2"])]
+        a += [f"--rated={rng.choice(['4000:250', '3000:200'])}"]
+    if rng.random() < 0.25:
+        a += ["--gearbox-kind", "wind-turbine"]
+    if rng.random() < 0.3:
+        a += [f"--holdout={rng.choice(['0:300', '600:1100'])}"]
     if rng.random() < 0.2:
-        a += [f"--profile={rng.choice([H, f'{M}@*', f'{M}@{names[0]}', f'{M}@nobody', 'x.y'])}"]
-    if rng.random() < 0.2:
-        a += [f"--rated={rng.choice(['4000:250', '0:1', '1e9:1', '-5:2', 'x', '3000:-100'])}"]
-    if rng.random() < 0.15:
-        a += ["--gearbox-kind", rng.choice(["wind-turbine", "ship"])]
-    if rng.random() < 0.2:
-        a += [f"--holdout={rng.choice(['0:600', '0:1e9', '600:300', 'nan:1', '1200:1800'])}"]
-    if rng.random() < 0.1:
-        a += ["--segment", rng.choice(["all", "0,1", "0", "5", ",", "1,1"])]
-    if rng.random() < 0.1:
-        a += ["--max-iterations", rng.choice(["1", "3", "0", "5000"])]
+        a += ["--max-iterations", rng.choice(["1", "3", "10"])]
+    if bad:
+        a += rng.choice([["--residuals", rng.choice(["ar2", "AR1", ""])], ["--profile=x.y"], [f"--profile={M}@nobody"],
+                         [f"--rated={rng.choice(['0:1', '1e9:1', '-5:2', 'x', '3000:-100', 'nan:1'])}"],
+                         ["--gearbox-kind", rng.choice(["ship", ""])],
+                         [f"--holdout={rng.choice(['0:1e9', '600:300', 'nan:1', '0:0', 'inf:1'])}"],
+                         ["--max-iterations", rng.choice(["0", "1001", "-1", "1e3"])],
+                         ["--rtol", rng.choice(["0", "1", "nan"])], ["--atol", rng.choice(["0", "2", "-1"])]])
     return a
 
 
 def make_case(i, rng):
-    n = rng.choice([1, 2, 2, 2, 3])
+    """A valid several-trace calibration (share VALID) or one with one to three mutations."""
+    muts = set() if rng.random() < VALID else set(rng.sample(MUTATIONS, rng.choice([1, 1, 2, 3])))
+    band = "band" in muts or rng.random() < 0.1
+    single = "segment" not in muts and not band and rng.random() < 0.15
+    # The band's calibration (the template) fitted traces a and b.
+    n = 1 if single else 2 if band else rng.choice([2, 2, 3])
     names = ["a", "b", "c"][:n]
-    traces = {name: gen_trace(rng, rng.choice([8.0, 11.0, 20.0])) for name in names}
-    case = {"id": i, "family": "calibrate_traces", "traces": traces, "names": names,
-            "seed": rng.randrange(2 ** 62), "preload": rng.random() < 0.5,
-            "band": rng.choice([None, None, None, "template", "crafted"])}
-    return case
+    segs = [rng.choice([2, 3]) if single else rng.choice([1, 2, 2]) for _ in names]
+    spoil = muts & {"cells", "times", "columns"}
+    spoilt = rng.randrange(n)
+    traces = {name: gen_trace(rng, rng.choice([8.0, 11.0, 20.0]), segs[j], rng.choice([12, 16, 20]),
+                              spoil if j == spoilt else ())
+              for j, name in enumerate(names)}
+    return {"id": i, "family": "calibrate_traces", "traces": traces, "names": names, "mutations": sorted(muts),
+            "seed": rng.randrange(2 ** 62), "preload": rng.random() < 0.5, "single": single,
+            "band": ("crafted" if "band" in muts else "template") if band else None}
 
 
 def template(ctx):
@@ -132,11 +173,8 @@ def make_template(ctx):
     paths = []
     for name, mass in (("a", 11.0), ("b", 20.0)):
         p = os.path.join(d, f"{name}.csv")
-        text = gen_trace(rng, mass)
-        while text.split("\n", 1)[0] != ",".join(COLUMNS) or not clean(text):
-            text = gen_trace(rng, mass)
         with open(p, "w") as f:
-            f.write(text)
+            f.write(gen_trace(rng, mass, 2, 20))
         paths.append(p)
     out = os.path.join(d, "cal")
     args = [ctx.bin, "calibrate", os.path.join(ctx.root, "models", MODEL), "--trace", paths[0], "--trace",
@@ -148,19 +186,9 @@ def make_template(ctx):
     return out
 
 
-def clean(text):
-    """Every cell a number (or the gear), every time after the one before."""
-    rows = [r.split(",") for r in text.strip().split("\n")[1:]]
-    try:
-        times = [float(r[0]) for r in rows]
-        ok = all(float(x) == float(x) and abs(float(x)) < 1e6 for r in rows for x in r[1:3] + r[4:])
-    except ValueError:
-        return False
-    return ok and all(b > a for a, b in zip(times, times[1:]))
-
-
 def crafted_band(rng, tpl, d):
-    doc = json.load(open(os.path.join(tpl, "calibration.json")))
+    with open(os.path.join(tpl, "calibration.json")) as f:
+        doc = json.load(f)
     k = rng.random()
     if k < 0.3:
         doc["parameters"][rng.randrange(len(doc["parameters"]))]["key_path"] += rng.choice(["@zz", "@*", "x"])
@@ -178,26 +206,44 @@ def crafted_band(rng, tpl, d):
     return path
 
 
-def build_args(case, ctx, d):
-    import random
-    rng = random.Random(case["seed"])
+def write_traces(case, d):
     paths = []
     for name in case["names"]:
         p = os.path.join(d, f"{name}.csv")
         with open(p, "w") as f:
             f.write(case["traces"][name])
         paths.append(p)
-    if rng.random() < 0.05 and len(paths) > 1:
-        paths[1] = paths[0]
+    return paths
+
+
+def build_args(case, ctx, d):
+    import random
+    rng = random.Random(case["seed"])
+    muts = set(case.get("mutations", []))
+    paths = write_traces(case, d)
+    if "same_trace" in muts:
+        paths.append(paths[0])
     args = ["calibrate", os.path.join(ctx.root, "models", MODEL)]
     for p in paths:
         args += ["--trace", p]
-    args += fit_args(rng, case["names"]) + prior_args(rng, case["names"], d) + option_args(rng, case["names"])
+    names = case["names"] if not case["single"] else ["a"]
+    fits = fit_args(rng, names, "fit" in muts)
+    if case["single"]:
+        fits = [f.split("@")[0] + ("=" + f.split("=", 2)[2] if f.count("=") == 2 else "") if "@" in f else f
+                for f in fits]
+        fits = list(dict.fromkeys(fits))
+    args += fits + prior_args(rng, fits, d, "prior" in muts, "priors_file" in muts)
+    args += option_args(rng, names, fits, "option" in muts)
+    if case["single"]:
+        args += ["--segment", rng.choice(["all", "0,1"])]
+    elif "segment" in muts:
+        args += ["--segment", rng.choice(["all", "0,1", "0", "5", ",", "1,1"])]
     tpl = template(ctx) if case["band"] else None
     if tpl:
         band = os.path.join(tpl, "calibration.json") if case["band"] == "template" else crafted_band(rng, tpl, d)
-        args = [a for a in args if not a.startswith(("--fit", "--holdout"))] + ["--holdout=0:1e9", "--band-from",
-                                                                                  band]
+        args = [a for j, a in enumerate(args) if not (a == "--priors" or (j and args[j - 1] == "--priors"))]
+        args = [a for a in args if not a.startswith(("--fit", "--holdout", "--prior", "--profile"))]
+        args += ["--holdout=0:1e9", "--band-from", band]
         if rng.random() < 0.5:
             args[1] = os.path.join(tpl, rng.choice(["calibrated_a.toml", "calibrated_b.toml"]))
     return args
@@ -215,11 +261,68 @@ def expected(args, written):
     return (one or per_trace) and (written - models - single) == base
 
 
+def rig_cycle(case, d):
+    """The rig cycle (time, speed, torque, gear) of the case's first trace, or None when its
+    first columns are not those."""
+    lines = case["traces"][case["names"][0]].strip().split("\n")
+    if not lines[0].startswith(",".join(COLUMNS[:4]) + ","):
+        return None
+    path = os.path.join(d, "cycle_of_a.csv")
+    with open(path, "w") as f:
+        f.write("\n".join(",".join(line.split(",")[:4]) for line in lines) + "\n")
+    return path
+
+
+def check_written(res, ctx, case, out, d):
+    """Every written calibrated model passes `check` and `run` takes it (on the first trace's
+    rig cycle): an accepted calibration writes models that later commands accept."""
+    cycle = rig_cycle(case, d)
+    for name in sorted(os.listdir(out)):
+        if not (name.startswith("calibrated") and name.endswith(".toml")):
+            continue
+        model = os.path.join(out, name)
+        runs = [["check", model]]
+        if cycle:
+            runs.append(["run", model, "--cycle", cycle, "--quiet", "--summary-only", "--out", os.path.join(d, "r")])
+        for args in runs:
+            p = core.run([ctx.bin] + args, cwd=d, timeout=ctx.limit)
+            if p.timed_out or p.rc not in (0, 2):
+                res["classes"].append("later_refused")
+                res["detail"] = f"{args[0]} {name}: exit {p.rc}: {p.err.decode(errors='replace')[-300:]}"
+
+
+def names_input(err, args):
+    """A refusal's message names something the user gave: a file, a key path, a value or an
+    option."""
+    words = set()
+    for a in args[1:]:
+        for part in a.split("=", 1) if a.startswith("--") else [a]:
+            words |= {part, part.lstrip("-"), part.lstrip("-").replace("-", "_"), os.path.basename(part)}
+            words |= set(part.split("@")) | set(part.split(":"))
+    words |= {"trace", "fit", "prior", "segment", "band", "calibration.json"}
+    return any(w and len(w) > 1 and w in err for w in words - {"calibrate"})
+
+
+def refusal(res, p, args, before, out, outparent):
+    """A refused case: nothing written, the previous result set unchanged, a message."""
+    beside = sorted(os.listdir(outparent))
+    if before:
+        core.unchanged(res, before, out)
+    elif beside:
+        res["classes"].append("stray")
+        res["detail"] = f"exit {p.rc} but wrote {beside}"
+    err = p.err.decode(errors="replace").strip()
+    if p.rc == 1 and not names_input(err, args):
+        res["classes"].append("bad_message")
+        res["detail"] = f"exit 1 with message {err!r}"
+
+
 def run_case(case, ctx):
     res = core.new_result(case)
     with tempfile.TemporaryDirectory(prefix="hostile_") as d:
         args = build_args(case, ctx, d)
-        res["cmd"] = " ".join(a.replace(d, "DIR") for a in args)[:600]
+        res["cmd"] = f"[{','.join(case.get('mutations', [])) or 'valid'}] " + \
+            " ".join(a.replace(d, "DIR") for a in args)[:600]
         outparent = os.path.join(d, "outs")
         os.mkdir(outparent)
         out = os.path.join(outparent, "o")
@@ -230,22 +333,20 @@ def run_case(case, ctx):
         core.classify(res, p, {0, 1, 2})
         if p.timed_out:
             return res
-        beside = sorted(os.listdir(outparent))
         if p.rc != 0:
-            if before:
-                core.unchanged(res, before, out)
-            elif beside:
-                res["classes"].append("stray")
-                res["detail"] = f"exit {p.rc} but wrote {beside}"
-            if p.rc == 1 and not p.err.strip():
-                res["classes"].append("bad_message")
-                res["detail"] = "exit 1 without a message"
+            refusal(res, p, args, before, out, outparent)
+            if not case.get("mutations"):
+                res["classes"].append("valid_refused")
+                res["detail"] = f"valid case exit {p.rc}: {p.err.decode(errors='replace')[-300:]}"
             return res
+        res["fit"] = any(a.startswith("--fit") for a in args)
+        res["valid"] = not case.get("mutations")
         written = set(os.listdir(out))
         if not expected(args, written):
             res["classes"].append("stray")
             res["detail"] = f"result set {sorted(written)}"
         core.check_files(res, out)
+        check_written(res, ctx, case, out, d)
         if core.non_finite_in(p.out.decode(errors="replace").replace(d, "DIR")):
             res["classes"].append("non_finite")
             res["detail"] = "stdout"

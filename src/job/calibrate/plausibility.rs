@@ -56,14 +56,23 @@ pub fn check_kind(kind: &str) -> Result<(), JobError> {
     ))
 }
 
-/// Parse a rated point `RPM:NM` (input speed, rpm, and torque, N·m).
+/// Parse a rated point `RPM:NM` (input speed, rpm, and torque, N·m): the speed in
+/// (0, [`limits::SPEED_RPM`]], the torque within [`limits::TORQUE_NM`] and not 0 (negative:
+/// power flowing from the output, as at a wind turbine's generator shaft), as every job's.
 pub fn rated_point(s: &str) -> Result<(f64, f64), JobError> {
+    use crate::job::limits::{SPEED_RPM, TORQUE_NM};
     let bad = || {
         JobError::option(
             "rated",
             s,
-            "RPM:NM, speed > 0 and a finite torque",
-            format!("rated = {s}: must be RPM:NM (input speed > 0 rpm, input torque in N m)"),
+            format!(
+                "RPM:NM, speed in (0, {}] rpm and a torque in [{}, {}] N m, not 0",
+                SPEED_RPM.hi, TORQUE_NM.lo, TORQUE_NM.hi
+            ),
+            format!(
+                "rated = {s}: must be RPM:NM (input speed in (0, {}] rpm, input torque in [{}, {}] N m, not 0)",
+                SPEED_RPM.hi, TORQUE_NM.lo, TORQUE_NM.hi
+            ),
         )
     };
     let (a, b) = s.split_once(':').ok_or_else(bad)?;
@@ -71,7 +80,8 @@ pub fn rated_point(s: &str) -> Result<(f64, f64), JobError> {
         a.trim().parse().map_err(|_| bad())?,
         b.trim().parse().map_err(|_| bad())?,
     );
-    if n.is_finite() && n > 0.0 && n <= 1e5 && t.is_finite() && t.abs() <= 1e6 && t != 0.0 {
+    let speed = n > 0.0 && n <= SPEED_RPM.hi;
+    if speed && (TORQUE_NM.lo..=TORQUE_NM.hi).contains(&t) && t != 0.0 {
         Ok((n, t))
     } else {
         Err(bad())

@@ -35,8 +35,9 @@ pub struct TraceInput<'a> {
 }
 
 /// The segments of `--segment SPEC` for a file of `n` segments: `all`, or `K1,K2,…` (0-based,
-/// each once).
-pub fn segment_list(spec: &str, n: usize, source: &str) -> Result<Vec<usize>, JobError> {
+/// each once). `trace` is the trace's name (the CLI and Python name a trace file alike by its
+/// stem; their sources differ: a path, or the name Python was given).
+pub fn segment_list(spec: &str, n: usize, trace: &str) -> Result<Vec<usize>, JobError> {
     let allowed = format!("all, or K1,K2,… in 0 … {}", n.saturating_sub(1));
     let bad = |msg: String| JobError::option("segment", spec, allowed.clone(), msg);
     if spec.trim() == "all" {
@@ -49,7 +50,7 @@ pub fn segment_list(spec: &str, n: usize, source: &str) -> Result<Vec<usize>, Jo
             .map_err(|_| bad(format!("segment = {spec}: \"{part}\" is not a segment number")))?;
         if k >= n {
             return Err(bad(format!(
-                "segment = {spec}: {k} must lie in [0, {}] ({source} has {n} segment(s))",
+                "segment = {spec}: {k} must lie in [0, {}] (trace {trace} has {n} segment(s))",
                 n.saturating_sub(1)
             )));
         }
@@ -90,7 +91,7 @@ pub fn inputs<'a>(
         .iter()
         .map(|(name, file)| {
             let segments = match &o.segments {
-                Some(spec) if files.len() == 1 => segment_list(spec, file.segments.len(), &file.source)?,
+                Some(spec) if files.len() == 1 => segment_list(spec, file.segments.len(), name)?,
                 _ => (0..file.segments.len()).collect(),
             };
             Ok(TraceInput {
