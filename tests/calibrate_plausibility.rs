@@ -2,10 +2,12 @@
 //! efficiency at the trace's highest-power rows and at a rated point, the same numbers the
 //! `losses` job gives there, and a warning when a sourced figure for the gearbox kind is missed.
 
+#[path = "common/calibrate_rig.rs"]
+mod rig;
+
 use std::path::Path;
 
 use geartherm::job::calibrate::{self, CalibrateOptions, Trace};
-use geartherm::job::losses::{losses, LossesOptions};
 use geartherm::job::Model;
 
 const MODEL: &str = "models/helical_stage.toml";
@@ -56,23 +58,7 @@ fn losses_at_the_highest_power_and_at_a_rated_point() {
     assert!((hp.efficiency.unwrap() - eta).abs() < 1e-12);
     // The rated point: the same losses as `losses` on the calibrated model at that oil temperature.
     let rated = p.rated.as_ref().unwrap();
-    let cal = Model::from_text(&r.calibrated_model, Path::new("calibrated.toml"), &[]).unwrap();
-    let direct = losses(
-        &cal,
-        &LossesOptions {
-            gear: "1".into(),
-            speed_rpm: 4000.0,
-            torque_nm: 250.0,
-            oil_temp_c: rated.oil_temp_c,
-        },
-    )
-    .unwrap();
-    assert!(
-        (direct.total_w - rated.loss_total_w).abs() < 1e-9 * direct.total_w,
-        "{} vs {}",
-        direct.total_w,
-        rated.loss_total_w
-    );
+    rig::assert_rated_loss_is_the_losses_job(&r.calibrated_model, rated.oil_temp_c, rated.loss_total_w);
     // The reference: a share outside 1.5–6 % is warned, inside is not.
     let rf = p.reference.as_ref().unwrap();
     let share = rated.loss_total_w / rated.power_w;

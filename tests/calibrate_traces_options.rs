@@ -13,7 +13,6 @@ use std::process::Command;
 
 use geartherm::job::calibrate::{self, lm::Evaluation, residuals::Ar1, stack, stack_fit, trace_file};
 use geartherm::job::calibrate::{CalibrateOptions, CalibrateResult, Missing, Trace};
-use geartherm::job::losses::{losses, LossesOptions};
 use geartherm::job::Model;
 use nalgebra::{DMatrix, DVector};
 use rig::{Normal, Rig, H, M, MODEL};
@@ -281,23 +280,7 @@ fn losses_per_trace_at_the_rated_point() {
         assert_eq!(p.rows, 2);
         assert!((p.highest_power.input_speed_rpm - 4000.0).abs() < 1e-6);
         let rated = p.rated.as_ref().unwrap();
-        let cal = Model::from_text(model, Path::new("calibrated.toml"), &[]).unwrap();
-        let direct = losses(
-            &cal,
-            &LossesOptions {
-                gear: "1".into(),
-                speed_rpm: 4000.0,
-                torque_nm: 250.0,
-                oil_temp_c: rated.oil_temp_c,
-            },
-        )
-        .unwrap();
-        assert!(
-            (direct.total_w - rated.loss_total_w).abs() < 1e-9 * direct.total_w,
-            "{} vs {}",
-            direct.total_w,
-            rated.loss_total_w
-        );
+        rig::assert_rated_loss_is_the_losses_job(model, rated.oil_temp_c, rated.loss_total_w);
         let rf = p.reference.as_ref().unwrap();
         let warned = r
             .summary

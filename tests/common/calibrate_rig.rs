@@ -80,3 +80,23 @@ pub fn exact(rig: &Rig, truth: [f64; 2]) -> Vec<Vec<f64>> {
         .unwrap()
         .temps_c
 }
+
+/// The calibrated model `calibrated` (TOML text) loses `loss_total_w` in gear 1 at 4000 rpm and
+/// 250 N·m with oil at `oil_temp_c`, as the `losses` job computes it (to 1e-9 relative): the
+/// plausibility report's rated point is the `losses` job's answer there.
+pub fn assert_rated_loss_is_the_losses_job(calibrated: &str, oil_temp_c: f64, loss_total_w: f64) {
+    use geartherm::job::losses::{losses, LossesOptions};
+    let cal = Model::from_text(calibrated, Path::new("calibrated.toml"), &[]).unwrap();
+    let options = LossesOptions {
+        gear: "1".into(),
+        speed_rpm: 4000.0,
+        torque_nm: 250.0,
+        oil_temp_c,
+    };
+    let direct = losses(&cal, &options).unwrap();
+    assert!(
+        (direct.total_w - loss_total_w).abs() < 1e-9 * direct.total_w,
+        "{} vs {loss_total_w}",
+        direct.total_w
+    );
+}
