@@ -6,7 +6,11 @@ segments), with one churning multiplier shared by the two turbines (the loss lev
 cooler capacity rate per turbine (docs/calibration.md, "Several traces"; the figures in
 docs/validation.md and docs/performance.md).
 
-    python3 scripts/engie_fleet.py [--data DIR] [--out DIR] [--bin PATH]
+    python3 scripts/engie_fleet.py [--data DIR] [--out DIR] [--bin PATH] [--set KEY=VALUE ...]
+
+`--set` (repeatable) is passed to `calibrate` (e.g. `--set 'losses.churning="seetharaman"'
+--set losses.multiplier.churning=30.0`: Seetharaman and Kahraman's churning law, the law of the
+two-turbine fit in docs/validation.md, started from a multiplier of 30).
 
 Builds the two traces with scripts/engie_traces.py under OUT/traces (default OUT
 /tmp/geartherm_fleet), runs the one `geartherm calibrate` command and prints its wall time, the
@@ -46,6 +50,7 @@ def main():
     ap.add_argument("--data", default="../shared/data/engie_la_haute_borne")
     ap.add_argument("--out", default="/tmp/geartherm_fleet")
     ap.add_argument("--bin", default="target/release/geartherm")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     a = ap.parse_args()
     files = traces(a.data, a.out)
     cmd = [a.bin, "calibrate", MODEL]
@@ -53,6 +58,8 @@ def main():
         cmd += ["--trace", f]
     for f in FIT:
         cmd += ["--fit", f]
+    for v in a.set:
+        cmd += ["--set", v]
     cmd += ["--max-iterations", "80", "--out", os.path.join(a.out, "fit")]
     load0 = os.getloadavg()
     before = os.times()
