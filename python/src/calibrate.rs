@@ -14,15 +14,17 @@ pub fn priors_from_file(text: &str, name: &str) -> PyResult<Vec<String>> {
 use geartherm::job::calibrate::{stack, stack_fit, trace_file, CalibrateResult, TraceFile};
 use geartherm::job::{self, JobError};
 
-/// The trace files of (CSV text, name) pairs, read as `calibrate` reads them.
-pub fn read_traces(
-    traces: &[(String, String)],
-    o: &job::CalibrateOptions,
-) -> PyResult<Vec<(String, TraceFile)>> {
+/// One trace as Python gives it: its CSV text, its name (`KEY@NAME`, the files written) and the
+/// label its messages name (the path of a file, as `geartherm calibrate` names it; the name for
+/// a DataFrame).
+pub type TraceText = (String, String, String);
+
+/// The trace files of [`TraceText`]s, read as `calibrate` reads them.
+pub fn read_traces(traces: &[TraceText], o: &job::CalibrateOptions) -> PyResult<Vec<(String, TraceFile)>> {
     traces
         .iter()
-        .map(|(csv, name)| {
-            trace_file::read(csv, name, o.missing())
+        .map(|(csv, name, label)| {
+            trace_file::read(csv, label, o.missing())
                 .map(|f| (name.clone(), f))
                 .map_err(|e| crate::job_error(e.into()))
         })

@@ -293,14 +293,14 @@ impl Model {
             files,
         ))
     }
-    /// Calibrate over several traces ((CSV text, name) pairs; a mapping of
+    /// Calibrate over several traces ((CSV text, name, file label) triples; a mapping of
     /// `job::CalibrateOptions`): a [`Calibration`]. With `evaluator` (θ → every segment's
     /// (residuals, Jacobian) in order) the segments are evaluated by it, on Dask workers.
     #[pyo3(signature = (traces, options, evaluator=None))]
     fn calibrate_traces(
         &self,
         py: Python<'_>,
-        traces: Vec<(String, String)>,
+        traces: Vec<calibrate::TraceText>,
         options: &Bound<'_, PyAny>,
         evaluator: Option<Py<PyAny>>,
     ) -> PyResult<Calibration> {
@@ -327,7 +327,7 @@ impl Model {
     fn evaluate_segments(
         &self,
         py: Python<'_>,
-        traces: Vec<(String, String)>,
+        traces: Vec<calibrate::TraceText>,
         options: &Bound<'_, PyAny>,
         theta: Vec<f64>,
         which: Vec<usize>,
@@ -340,7 +340,11 @@ impl Model {
     }
     /// The number of segments a calibration over `traces` fits (the indices of
     /// [`Self::evaluate_segments`] run over 0 … this).
-    fn segment_count(&self, traces: Vec<(String, String)>, options: &Bound<'_, PyAny>) -> PyResult<usize> {
+    fn segment_count(
+        &self,
+        traces: Vec<calibrate::TraceText>,
+        options: &Bound<'_, PyAny>,
+    ) -> PyResult<usize> {
         let o: job::CalibrateOptions = self::options("calibrate", options)?;
         let files = calibrate::read_traces(&traces, &o)?;
         let inputs = job::calibrate::stack::inputs(&files, &o).map_err(job_error)?;

@@ -94,3 +94,21 @@ def test_options_of_one_segment_over_several_traces():
         assert t["plausibility"]["rated"]["input_speed_rpm"] == pytest.approx(4000.0)
     with pytest.raises(geartherm.InputError, match="no trace is named"):
         m.calibrate(**kw, prior={f"{M}@c": ("normal", 15.0, 1.0)})
+
+
+def test_a_trace_file_is_named_by_its_path_as_the_cli_names_it(tmp_path):
+    """With several traces, a bad cell in a trace file: Python's message names the file by the
+    path given, as `geartherm calibrate --trace PATH` does; a DataFrame by its name."""
+    m = geartherm.Model.load(MODEL)
+    a, b = _trace(m, 11.0), _trace(m, 20.0)
+    b["node:oil"] = b["node:oil"].astype(object)
+    b.loc[3, "node:oil"] = "warm"
+    path_a, path_b = tmp_path / "a.csv", tmp_path / "b.csv"
+    a.to_csv(path_a, index=False)
+    b.to_csv(path_b, index=False)
+    with pytest.raises(geartherm.InputError) as file_err:
+        m.calibrate(traces=[path_a, path_b], fit=[H])
+    assert str(path_b) in str(file_err.value), str(file_err.value)
+    with pytest.raises(geartherm.InputError) as frame_err:
+        m.calibrate(traces=[a, b], names=["a", "b"], fit=[H])
+    assert "b" in str(frame_err.value) and str(path_b) not in str(frame_err.value)

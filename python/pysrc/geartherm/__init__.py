@@ -760,14 +760,16 @@ class Model:
             from .calibration import calibrate_traces
 
             given = list(traces) if traces is not None else [trace]
-            pairs = []
+            triples = []
             for i, t in enumerate(given):
                 default = os.path.splitext(os.path.basename(os.fspath(t)))[0] if isinstance(t, (str, os.PathLike)) else f"trace{i}"
-                text_i, _ = _trace_text(t, None)
-                pairs.append((text_i, names[i] if names is not None else default))
+                name_i = names[i] if names is not None else default
+                text_i, path_i = _trace_text(t, None)
+                label_i = path_i if isinstance(t, (str, os.PathLike)) else name_i
+                triples.append((text_i, name_i, label_i))
             if segments is not None:
                 o["segments"] = segments
-            return calibrate_traces(self._m, pairs, o, client)
+            return calibrate_traces(self._m, triples, o, client)
         return CalibrationResult(*self._m.calibrate(text, label, o))
 
 

@@ -272,22 +272,24 @@ def _trace_text(trace: Union[PathLike, "pandas.DataFrame"], name: Optional[str])
     return trace.to_csv(index=False), name or "trace"
 
 
-def _segments_of(native, pairs, options, theta, which):
+def _segments_of(native, traces, options, theta, which):
     """A Dask worker's share: the residuals and Jacobians of the segments ``which`` at θ."""
-    return native.evaluate_segments(pairs, options, list(theta), list(which))
+    return native.evaluate_segments(traces, options, list(theta), list(which))
 
 
-def calibrate_traces(native, pairs, options, client=None) -> CalibrationResult:
-    """Calibrate over several traces ((CSV text, name) pairs). With a Dask ``client`` every
-    evaluation of the fit spreads the segments over the workers (each integrates its segments'
-    residuals and sensitivities through ``evaluate_segments``); the Levenberg–Marquardt steps,
-    the statistics and the report are computed here, by the same code as the local fit."""
+def calibrate_traces(native, traces, options, client=None) -> CalibrationResult:
+    """Calibrate over several traces ((CSV text, name, label) triples: the label names the file
+    in messages, its path as ``geartherm calibrate`` names it, or the name for a DataFrame).
+    With a Dask ``client`` every evaluation of the fit spreads the segments over the workers
+    (each integrates its segments' residuals and sensitivities through ``evaluate_segments``);
+    the Levenberg–Marquardt steps, the statistics and the report are computed here, by the same
+    code as the local fit."""
     if client is None:
-        return CalibrationResult(*native.calibrate_traces(pairs, options))
-    n = native.segment_count(pairs, options)
+        return CalibrationResult(*native.calibrate_traces(traces, options))
+    n = native.segment_count(traces, options)
     workers = max(1, len(client.scheduler_info().get("workers", {})))
     chunks = [list(range(k, n, workers)) for k in range(min(workers, n))]
-    shared = client.scatter([native, pairs, options], broadcast=True)
+    shared = client.scatter([native, traces, options], broadcast=True)
 
     def evaluator(theta):
         futures = [client.submit(_segments_of, *shared, list(theta), c, pure=False) for c in chunks]
@@ -297,4 +299,4 @@ def calibrate_traces(native, pairs, options, client=None) -> CalibrationResult:
                 parts[k] = e
         return parts
 
-    return CalibrationResult(*native.calibrate_traces(pairs, options, evaluator))
+    return CalibrationResult(*native.calibrate_traces(traces, options, evaluator))
