@@ -1,12 +1,13 @@
 //! The per-sample loss terms an uncertainty study shares between its cases
 //! (`scene::SampleCache`): a case solved with the terms computed from another case's scene equals
-//! the same case solved with its own terms, bit for bit, and a scene whose compiled bearings or
-//! converter differ does not read them.
+//! the same case solved with its own terms, bit for bit, and a scene whose compiled bearings,
+//! converter or sliding power laws differ does not read them.
 
 use std::path::Path;
 use std::sync::Arc;
 
 use geartherm::job::{self, run::Prepared};
+use geartherm::scene::sample_cache::CacheParts;
 use geartherm::study::uq::run::{Uq, UqOptions};
 use geartherm::study::{run_outputs, Case, Job};
 
@@ -22,8 +23,17 @@ fn uq() -> Uq {
 
 /// The model and prepared run of `sample` (overrides applied as the study applies them).
 fn prepared(uq: &Uq, sample: usize) -> (job::Model, Prepared) {
+    prepared_with(uq, sample, &[])
+}
+
+/// As [`prepared`] with `more` overrides after the sample's.
+fn prepared_with(uq: &Uq, sample: usize, more: &[&str]) -> (job::Model, Prepared) {
     let s = &uq.study;
-    let (ovs, _) = s.overrides(sample).unwrap();
+    let (mut ovs, _) = s.overrides(sample).unwrap();
+    ovs.extend(
+        more.iter()
+            .map(|t| t.parse::<geartherm::model::Override>().unwrap()),
+    );
     let m = job::Model::from_text(&s.model_text, &s.model_file, &ovs).unwrap();
     let case = Case {
         index: sample,
@@ -63,7 +73,12 @@ fn a_case_solved_from_another_cases_terms_equals_its_own_solve_bit_for_bit() {
         let (_, mut cached) = prepared(&uq, sample);
         // The study varies heat transfer, oil level, cooler, multipliers and the ambient: the
         // bearings and the converter compile the same.
-        assert_eq!(cached.scene.use_sample_cache(Arc::clone(&cache)), (true, true));
+        let all = CacheParts {
+            bearings: true,
+            auto: true,
+            slide: true,
+        };
+        assert_eq!(cached.scene.use_sample_cache(Arc::clone(&cache)), all);
         let a = bits(&m, &fresh);
         let b = bits(&m, &cached);
         assert!(!a.0.is_empty() && !a.1.is_empty());
@@ -80,7 +95,28 @@ fn a_scene_with_other_bearings_or_converter_does_not_read_the_terms() {
     let ev = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/ev_reducer.toml");
     let m = job::Model::load(&ev, &[]).unwrap();
     let mut p = job::run::prepare(&m, &job::RunOptions::default()).unwrap();
-    assert_eq!(p.scene.use_sample_cache(Arc::clone(&cache)), (false, false));
+    assert_eq!(
+        p.scene.use_sample_cache(Arc::clone(&cache)),
+        CacheParts::default()
+    );
+}
+
+#[test]
+fn a_scene_with_another_friction_law_reads_the_bearing_terms_and_not_the_sliding_powers() {
+    let uq = uq();
+    let (_, donor) = prepared(&uq, 1);
+    let cache = Arc::new(donor.scene.sample_cache(donor.segs.iter().map(|s| s.inputs)));
+    let other = ["losses.friction=\"constant\"", "losses.friction_coefficient=0.05"];
+    let (m, fresh) = prepared_with(&uq, 3, &other);
+    let (_, mut cached) = prepared_with(&uq, 3, &other);
+    let parts = cached.scene.use_sample_cache(Arc::clone(&cache));
+    let expected = CacheParts {
+        bearings: true,
+        auto: true,
+        slide: false,
+    };
+    assert_eq!(parts, expected);
+    assert_eq!(bits(&m, &fresh), bits(&m, &cached));
 }
 
 #[test]

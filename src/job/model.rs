@@ -96,6 +96,21 @@ impl Model {
         })
     }
 
+    /// Check a variant of a base document read once (`file` names it in messages) with
+    /// `overrides`: the same as [`Model::from_document`] on a copy of the base's document.
+    pub fn from_base(
+        base: &model::BaseDocument,
+        file: &Path,
+        overrides: &[Override],
+    ) -> Result<Model, JobError> {
+        let gearbox = model::from_base_with(base, file, overrides)?;
+        Ok(Model {
+            gearbox,
+            file: file.to_path_buf(),
+            overrides: overrides.to_vec(),
+        })
+    }
+
     /// What `check` reports: the counts of the checked model.
     pub fn check_report(&self) -> CheckReport {
         let gb = &self.gearbox;

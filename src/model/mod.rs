@@ -12,7 +12,8 @@
 //!   uncertain inputs, their distributions and checks)), each holding the section's serde
 //!   struct(s), its checks with their key paths, and the checked type it becomes;
 //! - [`file`]: the whole file, one field per section; [`parse`]: TOML text → [`file::ModelFile`],
-//!   every section's type errors with their full key paths; [`validate`]: the order in which the
+//!   every section's type errors with their full key paths; [`base`]: a base document read once
+//!   and reused by variants that override a few key paths; [`validate`]: the order in which the
 //!   sections are checked, → [`Gearbox`]; [`gearbox`]: the checked gearbox;
 //! - [`choice`]: model choices (`churning = "changenet"`), enums read by name once with their
 //!   section; [`problems`] (what a check reports), [`overrides`] (key-path overrides), [`source`]
@@ -23,6 +24,7 @@
 //! `model::uncertainty` name the section modules, and `model::gearbox` every checked part type.
 
 pub mod alternative;
+pub mod base;
 pub mod bearing_catalogue;
 pub mod catalogue;
 pub mod choice;
@@ -40,6 +42,7 @@ pub use sections::{bearings, pump, thermal, uncertainty};
 
 use std::path::{Path, PathBuf};
 
+pub use base::{from_base_with, BaseDocument};
 pub use gearbox::Gearbox;
 pub use overrides::{KeyPath, Override};
 pub use problems::{Problem, Problems};

@@ -174,6 +174,13 @@ fn check_names(value: &Value, path: &str, problems: &mut Problems) {
     }
 }
 
+/// [`check_names`] over every top-level entry of a document.
+fn check_table_names(table: &Table, problems: &mut Problems) {
+    for (k, v) in table {
+        check_names(v, k, problems);
+    }
+}
+
 /// A `name` value at `path` that is a string must be a plain name (other types are the typed
 /// reading's to report).
 fn check_name(v: &Value, path: String, problems: &mut Problems) {
@@ -229,7 +236,7 @@ pub fn parse_table(mut table: Table, problems: &mut Problems) -> Option<ModelFil
             format!("unknown top-level key; allowed sections: {}", SECTIONS.join(", ")),
         );
     }
-    check_names(&Value::Table(table.clone()), "", problems);
+    check_table_names(&table, problems);
     let before = problems.len();
     let model = section::<model::ModelMeta>(&mut table, "model", true, problems);
     let oil = section::<oil::OilSpec>(&mut table, "oil", true, problems);
@@ -278,6 +285,54 @@ pub fn parse_table(mut table: Table, problems: &mut Problems) -> Option<ModelFil
         circuit,
         uncertainty,
     })
+}
+
+/// `base` with the top-level sections of `table` read anew (every other section kept as it is):
+/// the file [`parse_table`] gives for `base`'s document with those sections replaced, with the
+/// same problems in the same order. Every key of `table` must be one of [`SECTIONS`].
+pub fn reparse_sections(mut table: Table, base: &ModelFile, problems: &mut Problems) -> Option<ModelFile> {
+    check_table_names(&table, problems);
+    let mut f = base.clone();
+    let p = problems;
+    let present: Vec<&str> = SECTIONS
+        .iter()
+        .copied()
+        .filter(|k| table.contains_key(*k))
+        .collect();
+    for key in present {
+        let t = &mut table;
+        match key {
+            "model" => set(&mut f.model, section(t, key, true, p)),
+            "oil" => set(&mut f.oil, section(t, key, true, p)),
+            "members" => f.members = array(t, key, false, p),
+            "gears" => f.gears = array(t, key, true, p),
+            "meshes" => f.meshes = array(t, key, false, p),
+            "planetary_sets" => f.planetary_sets = array(t, key, false, p),
+            "shift_elements" => f.shift_elements = array(t, key, false, p),
+            "gear_states" => f.gear_states = array(t, key, false, p),
+            "train" => set(&mut f.train, section(t, key, true, p)),
+            "lubrication" => set(&mut f.lubrication, section(t, key, true, p)),
+            "losses" => f.losses = section(t, key, false, p),
+            "thermal" => f.thermal = section(t, key, false, p),
+            "vehicle" => f.vehicle = section(t, key, false, p),
+            "clutch_packs" => f.clutch_packs = array(t, key, false, p),
+            "pump" => f.pump = section(t, key, false, p),
+            "launch" => f.launch = section(t, key, false, p),
+            "bearings" => f.bearings = array(t, key, false, p),
+            "seals" => f.seals = array(t, key, false, p),
+            "circuit" => f.circuit = section(t, key, false, p),
+            "uncertainty" => f.uncertainty = section(t, key, false, p),
+            _ => {}
+        }
+    }
+    p.is_empty().then_some(f)
+}
+
+/// Replace a required section by its new reading (a failed reading has recorded its problem).
+fn set<T>(slot: &mut T, read: Option<T>) {
+    if let Some(v) = read {
+        *slot = v;
+    }
 }
 
 #[cfg(test)]

@@ -17,7 +17,7 @@ use super::gear_losses::{
     compile_churning, compile_pocketing, compile_sliding, compile_windage, sliding, with_ratio_terms,
     ChurnEntry, Compiled, Lists, PocketEntry, SlideEntry, StateFactors, WindEntry,
 };
-use super::sample_cache::{sample_key, CacheUse, SampleCache};
+use super::sample_cache::{law_powers, sample_key, CacheParts, CacheUse, SampleCache};
 use super::usage::Usage;
 use super::warning::RangeWarning;
 use crate::physics::losses::windage::AIR;
@@ -246,21 +246,32 @@ impl LossScene {
         // P(T, ω) = P(sign(T·ω)·1 N·m, 1 rad/s)·|T|^a·|ω|^b: reversing both T and ω leaves the
         // power flow and every magnitude unchanged.
         let dir = usize::from(t * w < 0.0);
-        // Meshes with the same friction law share their powers of |T| and |ω| (the last pair of
-        // exponents is remembered; the same values as computing them per mesh).
-        let mut memo = [(f64::NAN, 0.0); 2];
-        let mut power = |i: usize, x: f64, e: f64| {
-            if memo[i].0 != e {
-                memo[i] = (e, x.abs().powf(e));
-            }
-            memo[i].1
-        };
-        for ((e, unit), u) in self.slide.iter().zip(&st.slide_unit).zip(&mut terms.slide_unit) {
+        // Meshes with the same friction law share their powers of |T| and |ω| (the last law is
+        // remembered; the same values as computing them per mesh); an attached cache holds the
+        // same two factors per entry for this sample (`law_powers`).
+        let mut memo = (None, [0.0; 2]);
+        let cached_powers = cached.and_then(|(c, i)| c.slide_powers(i));
+        for (k, ((e, unit), u)) in self
+            .slide
+            .iter()
+            .zip(&st.slide_unit)
+            .zip(&mut terms.slide_unit)
+            .enumerate()
+        {
             if let Some(law) = e.law {
                 *u = if t == 0.0 || w == 0.0 {
                     0.0
                 } else {
-                    unit[dir] * power(0, t, law.torque) * power(1, w, law.speed)
+                    let [pt, pw] = match cached_powers {
+                        Some(p) => p[k],
+                        None => {
+                            if memo.0 != Some(law) {
+                                memo = (Some(law), law_powers(&law, t, w));
+                            }
+                            memo.1
+                        }
+                    };
+                    unit[dir] * pt * pw
                 };
             }
         }
@@ -281,15 +292,19 @@ impl LossScene {
     /// (a cycle's segments: state, input speed, input torque, vehicle speed), computed once for
     /// this scene's compiled parts.
     pub fn sample_cache(&self, inputs: impl IntoIterator<Item = (usize, f64, f64, f64)>) -> SampleCache {
-        SampleCache::build(&self.elements, &self.auto, inputs)
+        SampleCache::build(&self.elements, &self.auto, self.slide_laws(), inputs)
+    }
+
+    /// The power law of every sliding entry (None: evaluated in full).
+    fn slide_laws(&self) -> Vec<Option<crate::physics::losses::sliding::PowerLaw>> {
+        self.slide.iter().map(|e| e.law).collect()
     }
 
     /// Read the per-sample terms of `cache` where this scene's compiled parts equal those it was
-    /// built from (bitwise the terms [`Self::prepare_at`] computes); returns which parts are read
-    /// (bearings, pump and converter).
-    pub fn use_sample_cache(&mut self, cache: Arc<SampleCache>) -> (bool, bool) {
-        self.cache = CacheUse::new(cache, &self.elements, &self.auto);
-        self.cache.as_ref().map_or((false, false), CacheUse::parts)
+    /// built from (bitwise the terms [`Self::prepare_at`] computes); returns which parts are read.
+    pub fn use_sample_cache(&mut self, cache: Arc<SampleCache>) -> CacheParts {
+        self.cache = CacheUse::new(cache, &self.elements, &self.auto, &self.slide_laws());
+        self.cache.as_ref().map_or(CacheParts::default(), CacheUse::parts)
     }
 
     /// Evaluate every loss item (W) at `op` into `out` using the per-sample terms prepared for

@@ -1,7 +1,8 @@
-//! Per-sample loss terms shared between solves of the same cycle: the bearings' load terms and
-//! the pump and converter values of every cycle sample, computed once from one compiled scene
-//! and read by every scene whose compiled bearings (and, separately, whose compiled pump,
-//! converter and clutch packs) equal that scene's.
+//! Per-sample loss terms shared between solves of the same cycle: the bearings' load terms, the
+//! pump and converter values and the sliding losses' powers of torque and speed of every cycle
+//! sample, computed once from one compiled scene and read by every scene whose compiled
+//! bearings (and, separately, whose compiled pump, converter and clutch packs, and whose
+//! sliding power-law exponents) equal that scene's.
 //!
 //! The terms are a function of the compiled part and the sample's (state, input speed, input
 //! torque, vehicle speed) only, so a term read from the cache is bitwise the term
@@ -15,6 +16,7 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use crate::physics::losses::bearings::LoadTerms;
+use crate::physics::losses::sliding::PowerLaw;
 
 use super::automatic::{AutoLosses, AutoSample};
 use super::element_losses::ElementLosses;
@@ -49,6 +51,17 @@ pub struct SampleCache {
     bearing_terms: Vec<LoadTerms>,
     /// Bearings per sample.
     bearings: usize,
+    /// The sliding entries' power laws the powers were computed for.
+    slide_laws: Vec<Option<PowerLaw>>,
+    /// |T|^a and |ω|^b of every sliding entry with a power law, `slide_laws.len()` per sample
+    /// (0 for the others and where T or ω is 0).
+    slide_powers: Vec<[f64; 2]>,
+}
+
+/// |T|^a and |ω|^b of a sliding power law at torque `t` and speed `w`: the two factors
+/// [`LossScene::prepare_at`](super::LossScene::prepare_at) multiplies, computed alike.
+pub fn law_powers(law: &PowerLaw, t: f64, w: f64) -> [f64; 2] {
+    [t.abs().powf(law.torque), w.abs().powf(law.speed)]
 }
 
 impl SampleCache {
@@ -57,6 +70,7 @@ impl SampleCache {
     pub(super) fn build(
         elements: &ElementLosses,
         auto: &AutoLosses,
+        slide_laws: Vec<Option<PowerLaw>>,
         inputs: impl IntoIterator<Item = (usize, f64, f64, f64)>,
     ) -> SampleCache {
         let bearings = elements.bearings();
@@ -68,6 +82,8 @@ impl SampleCache {
             auto_samples: Vec::new(),
             bearing_terms: Vec::new(),
             bearings,
+            slide_laws,
+            slide_powers: Vec::new(),
         };
         let mut terms = vec![LoadTerms::default(); bearings];
         for (state, w, t, v) in inputs {
@@ -82,6 +98,12 @@ impl SampleCache {
             c.auto_samples.push(s);
             elements.prepare(state, w, t, &mut terms);
             c.bearing_terms.extend_from_slice(&terms);
+            for law in &c.slide_laws {
+                c.slide_powers.push(match law {
+                    Some(l) if t != 0.0 && w != 0.0 => law_powers(l, t, w),
+                    _ => [0.0; 2],
+                });
+            }
         }
         c
     }
@@ -116,21 +138,27 @@ pub struct CacheUse {
     bearings: bool,
     /// The scene's packs, pump and converter equal the cache's.
     auto: bool,
+    /// The scene's sliding power laws equal the cache's.
+    slide: bool,
 }
 
 impl CacheUse {
-    /// The parts of `cache` a scene with compiled `elements` and `auto` may read (None: none).
+    /// The parts of `cache` a scene with compiled `elements`, `auto` and sliding power laws
+    /// `slide_laws` may read (None: none).
     pub(super) fn new(
         cache: Arc<SampleCache>,
         elements: &ElementLosses,
         auto: &AutoLosses,
+        slide_laws: &[Option<PowerLaw>],
     ) -> Option<CacheUse> {
         let bearings = cache.elements == *elements;
         let auto = cache.auto == *auto;
-        (bearings || auto).then_some(CacheUse {
+        let slide = cache.slide_laws == slide_laws;
+        (bearings || auto || slide).then_some(CacheUse {
             cache,
             bearings,
             auto,
+            slide,
         })
     }
 
@@ -151,9 +179,30 @@ impl CacheUse {
             .then(|| &self.cache.bearing_terms[i * n..(i + 1) * n])
     }
 
-    /// Whether the scene reads the bearing terms and the pump and converter values from the
-    /// cache.
-    pub fn parts(&self) -> (bool, bool) {
-        (self.bearings, self.auto)
+    /// The sliding entries' powers of torque and speed of entry `i`, when the scene may read
+    /// them.
+    pub(super) fn slide_powers(&self, i: usize) -> Option<&[[f64; 2]]> {
+        let n = self.cache.slide_laws.len();
+        self.slide.then(|| &self.cache.slide_powers[i * n..(i + 1) * n])
     }
+
+    /// Which parts the scene reads from the cache.
+    pub fn parts(&self) -> CacheParts {
+        CacheParts {
+            bearings: self.bearings,
+            auto: self.auto,
+            slide: self.slide,
+        }
+    }
+}
+
+/// The parts of a [`SampleCache`] a scene reads.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct CacheParts {
+    /// The bearings' load terms.
+    pub bearings: bool,
+    /// The pump and converter values.
+    pub auto: bool,
+    /// The sliding losses' powers of torque and speed.
+    pub slide: bool,
 }

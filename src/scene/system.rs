@@ -174,7 +174,8 @@ impl Scene {
     }
 
     /// The per-sample loss terms of every sample of `inputs` (a cycle's segments) for this
-    /// scene's compiled bearings, pump and converter ([`super::SampleCache`]), to share with
+    /// scene's compiled bearings, pump and converter and sliding power laws
+    /// ([`super::SampleCache`]), to share with
     /// other scenes solved on the same cycle.
     pub fn sample_cache(&self, inputs: impl IntoIterator<Item = Inputs>) -> super::SampleCache {
         let at = |i: Inputs| (i.state, i.input_speed, i.input_torque, i.vehicle_speed);
@@ -183,8 +184,11 @@ impl Scene {
 
     /// Read per-sample loss terms from `cache` where this scene's compiled parts equal those it
     /// was built from (the results are bitwise those computed here); returns which parts are
-    /// read (bearings, pump and converter).
-    pub fn use_sample_cache(&mut self, cache: std::sync::Arc<super::SampleCache>) -> (bool, bool) {
+    /// read.
+    pub fn use_sample_cache(
+        &mut self,
+        cache: std::sync::Arc<super::SampleCache>,
+    ) -> super::sample_cache::CacheParts {
         self.losses.use_sample_cache(cache)
     }
 

@@ -77,7 +77,7 @@ pub struct Study {
     pub model_text: String,
     /// The base model's file name (for messages).
     pub model_file: PathBuf,
-    base: toml::Table,
+    base: model::BaseDocument,
     paths: Vec<KeyPath>,
     /// The base model's value at each parameter's path (None: not in the model).
     base_values: Vec<Option<Value>>,
@@ -228,7 +228,7 @@ impl Study {
             spec,
             model_text,
             model_file,
-            base,
+            base: model::BaseDocument::new(base),
             paths,
             base_values,
             samples,
@@ -384,7 +384,7 @@ impl Study {
     fn solve(&self, c: &Case, per_case: bool, row: &mut CaseRow) -> Result<CaseFiles, JobError> {
         let (ovs, used) = self.overrides(c.sample).map_err(JobError::invalid)?;
         row.params = used;
-        let m = job::Model::from_document(self.base.clone(), &self.model_file, &ovs)?;
+        let m = job::Model::from_base(&self.base, &self.model_file, &ovs)?;
         match self.case_job(c, per_case) {
             Job::Run(o) => {
                 let schedule = |gb: &model::gearbox::Gearbox, cycle: &crate::cycle::DriveCycle| {
