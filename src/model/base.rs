@@ -1,6 +1,7 @@
 //! A base model document read once and reused by many variants of it (the cases of a study):
 //! a variant that overrides a few key paths reads anew only the top-level sections those paths
-//! fall in and keeps the base's typed reading of every other section.
+//! fall in and keeps the base's typed reading of every other section, and the base's solved
+//! gear train and gear states when no path falls in the sections they are solved from.
 
 use std::path::Path;
 
@@ -16,6 +17,8 @@ use super::{annotate, from_document_with, parse, validate, Gearbox, ModelError, 
 pub struct BaseDocument {
     doc: Table,
     file: Option<ModelFile>,
+    /// The file's solved gear train and gear states (None: its structure has a problem).
+    kinematics: Option<validate::Kinematics>,
 }
 
 impl BaseDocument {
@@ -23,7 +26,12 @@ impl BaseDocument {
     pub fn new(doc: Table) -> BaseDocument {
         let mut problems = Problems::default();
         let file = parse::parse_table(doc.clone(), &mut problems).filter(|_| problems.is_empty());
-        BaseDocument { doc, file }
+        let kinematics = file.as_ref().and_then(validate::kinematics);
+        BaseDocument {
+            doc,
+            file,
+            kinematics,
+        }
     }
 
     /// The document.
@@ -75,7 +83,10 @@ pub fn from_base_with(
         return Err(invalid(problems));
     }
     let parsed = parse::reparse_sections(part, typed, &mut problems);
-    let gearbox = parsed.and_then(|f| validate::validate(&f, &mut problems));
+    // The kinematics are the base's when no override falls in the sections they are solved from.
+    let same_train = !keys.iter().any(|k| validate::KINEMATIC_SECTIONS.contains(k));
+    let known = base.kinematics.as_ref().filter(|_| same_train);
+    let gearbox = parsed.and_then(|f| validate::validate_with(&f, known, &mut problems));
     match gearbox {
         Some(g) if problems.is_empty() => Ok(g),
         _ => Err(invalid(annotate(problems, &applied))),

@@ -144,30 +144,51 @@ pub fn is_plain_name(name: &str) -> bool {
             .any(|c| c.is_control() || NAME_FORBIDDEN.contains(&c))
 }
 
-/// Every `name` key of the file (except the free-text `model.name` and `oil.name`) must be an
-/// identifier ([`is_plain_name`]); one problem per bad name, with its key path.
-fn check_names(value: &Value, path: &str, problems: &mut Problems) {
-    let join = |k: &str| {
-        if path.is_empty() {
-            k.to_string()
-        } else {
-            format!("{path}.{k}")
+/// A step of a key path while [`check_names`] walks the document.
+#[derive(Clone, Copy)]
+enum At<'a> {
+    Key(&'a str),
+    Index(usize),
+}
+
+/// The key path of `steps` (`gears[3].name`).
+fn path_of(steps: &[At<'_>]) -> String {
+    let mut s = String::new();
+    for step in steps {
+        match step {
+            At::Key(k) if s.is_empty() => s.push_str(k),
+            At::Key(k) => {
+                s.push('.');
+                s.push_str(k);
+            }
+            At::Index(i) => s.push_str(&format!("[{i}]")),
         }
-    };
+    }
+    s
+}
+
+/// Every `name` key of the file (except the free-text `model.name` and `oil.name`) must be an
+/// identifier ([`is_plain_name`]); one problem per bad name, with its key path (`steps`: the
+/// path of `value`).
+fn check_names<'a>(value: &'a Value, steps: &mut Vec<At<'a>>, problems: &mut Problems) {
     match value {
         Value::Table(t) => {
             for (k, v) in t {
-                let p = join(k);
-                if k == "name" && p != "model.name" && p != "oil.name" {
-                    check_name(v, p, problems);
+                let free_text = matches!(steps.as_slice(), [At::Key("model" | "oil")]);
+                steps.push(At::Key(k));
+                if k == "name" && !free_text {
+                    check_name(v, steps, problems);
                 } else {
-                    check_names(v, &p, problems);
+                    check_names(v, steps, problems);
                 }
+                steps.pop();
             }
         }
         Value::Array(a) => {
             for (i, v) in a.iter().enumerate() {
-                check_names(v, &format!("{path}[{i}]"), problems);
+                steps.push(At::Index(i));
+                check_names(v, steps, problems);
+                steps.pop();
             }
         }
         _ => {}
@@ -176,18 +197,21 @@ fn check_names(value: &Value, path: &str, problems: &mut Problems) {
 
 /// [`check_names`] over every top-level entry of a document.
 fn check_table_names(table: &Table, problems: &mut Problems) {
+    let mut steps = Vec::new();
     for (k, v) in table {
-        check_names(v, k, problems);
+        steps.push(At::Key(k));
+        check_names(v, &mut steps, problems);
+        steps.pop();
     }
 }
 
-/// A `name` value at `path` that is a string must be a plain name (other types are the typed
+/// A `name` value at `steps` that is a string must be a plain name (other types are the typed
 /// reading's to report).
-fn check_name(v: &Value, path: String, problems: &mut Problems) {
+fn check_name(v: &Value, steps: &[At<'_>], problems: &mut Problems) {
     let Value::String(s) = v else { return };
     if !is_plain_name(s) {
         problems.push(
-            path,
+            path_of(steps),
             describe(v),
             format!(
                 "must be a plain name: 1–{MAX_NAME_LEN} characters, no control characters, none of , \" ' | \\ ; `, no leading or trailing space"
@@ -401,7 +425,7 @@ centre_height_mm = {}
         let v: Value =
             toml::from_str("[model]\nname = \"free text, ok\"\n[[gears]]\nname = \"a\\nb,c\\\"d\"\n")
                 .unwrap();
-        check_names(&v, "", &mut p);
+        check_table_names(v.as_table().unwrap(), &mut p);
         let all: Vec<String> = p.as_slice().iter().map(|x| x.to_string()).collect();
         assert_eq!(all.len(), 1, "{all:?}");
         assert!(all[0].starts_with("gears[0].name"), "{all:?}");

@@ -30,12 +30,51 @@ struct Structure {
     oil_level: f64,
 }
 
+/// The top-level sections the gear train and the gear states' kinematics are solved from.
+pub const KINEMATIC_SECTIONS: &[&str] = &[
+    "members",
+    "gears",
+    "meshes",
+    "planetary_sets",
+    "shift_elements",
+    "gear_states",
+    "train",
+];
+
+/// The solved gear train and gear states of a valid file, to reuse for a file whose
+/// [`KINEMATIC_SECTIONS`] are the same.
+#[derive(Debug, Clone)]
+pub struct Kinematics {
+    train: Option<GearTrain>,
+    gear_states: Vec<gear_states::GearState>,
+}
+
+/// The kinematics of `file` (None when its structure has a problem).
+pub fn kinematics(file: &ModelFile) -> Option<Kinematics> {
+    let mut problems = Problems::default();
+    let (s, _) = structure(file, None, &mut problems);
+    problems.is_empty().then_some(Kinematics {
+        train: s.train,
+        gear_states: s.gear_states,
+    })
+}
+
 /// Validate a parsed file. `problems` receives every problem; `None` if there was any.
 pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
+    validate_with(file, None, problems)
+}
+
+/// [`validate`] taking the gear train and gear states from `known` (the [`kinematics`] of a
+/// file whose [`KINEMATIC_SECTIONS`] equal `file`'s) instead of solving them again.
+pub fn validate_with(
+    file: &ModelFile,
+    known: Option<&Kinematics>,
+    problems: &mut Problems,
+) -> Option<Gearbox> {
     let start = problems.len();
     model::validate_meta(&file.model, problems);
     let oil = oil::validate_oil(&file.oil, problems);
-    let (s, parts) = structure(file, problems);
+    let (s, parts) = structure(file, known, problems);
     let nodes: BTreeSet<&str> = file
         .thermal
         .as_ref()
@@ -157,8 +196,13 @@ pub fn validate(file: &ModelFile, problems: &mut Problems) -> Option<Gearbox> {
 }
 
 /// Members, gears, `[train]`, meshes, sets, shift elements and gear states (solved on a sound
-/// structure only), and `[lubrication]`; with the parts by name for the sections after them.
-fn structure<'a>(file: &'a ModelFile, problems: &mut Problems) -> (Structure, parts::Parts<'a>) {
+/// structure only; taken from `known` when given), and `[lubrication]`; with the parts by name
+/// for the sections after them.
+fn structure<'a>(
+    file: &'a ModelFile,
+    known: Option<&Kinematics>,
+    problems: &mut Problems,
+) -> (Structure, parts::Parts<'a>) {
     let structure_start = problems.len();
     let members = members::validate_members(&file.members, problems);
     let planet_of = planetary_sets::planet_roles(&file.planetary_sets);
@@ -189,15 +233,18 @@ fn structure<'a>(file: &'a ModelFile, problems: &mut Problems) -> (Structure, pa
     }
     let elements = shift_elements::validate_shift_elements(&file.shift_elements, &parts.members, problems);
     let sound = problems.len() == structure_start;
-    let (train, gear_states) = gear_states::validate_gear_states(
-        &file.gear_states,
-        &elements,
-        &file.members,
-        fixed_rows,
-        io,
-        sound,
-        problems,
-    );
+    let (train, gear_states) = match known {
+        Some(k) if sound => (k.train.clone(), k.gear_states.clone()),
+        _ => gear_states::validate_gear_states(
+            &file.gear_states,
+            &elements,
+            &file.members,
+            fixed_rows,
+            io,
+            sound,
+            problems,
+        ),
+    };
     let (gears, oil_level) =
         lubrication::validate_lubrication(&file.lubrication, &parts, &sets, &meshes, &mounts, problems);
     let s = Structure {

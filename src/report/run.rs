@@ -233,7 +233,12 @@ pub fn launch_summary(times: &[f64], rows: &[RowInputs]) -> Option<LaunchSummary
 pub fn run_warnings(scene: &Scene, traj: &Trajectory, rows: &[RowInputs]) -> Vec<RangeWarning> {
     let mut log = RangeLog::new(scene.losses());
     for (r, y) in rows.iter().zip(&traj.states) {
-        let Some(state) = scene.losses().state_names.iter().position(|n| *n == r.gear) else {
+        let Some(state) = scene
+            .losses()
+            .state_names
+            .iter()
+            .position(|n| n.as_str() == &*r.gear)
+        else {
             continue;
         };
         let op = OperatingPoint {

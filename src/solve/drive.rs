@@ -45,8 +45,8 @@ pub fn segments(gb: &Gearbox, cycle: &DriveCycle) -> Result<(Schedule, Vec<Segme
 pub struct RowInputs {
     /// Vehicle speed, km/h.
     pub vehicle_speed_kmh: f64,
-    /// Gear-state name.
-    pub gear: String,
+    /// Gear-state name (shared by the rows of one state).
+    pub gear: std::sync::Arc<str>,
     /// Input speed, rpm.
     pub input_speed_rpm: f64,
     /// Loss-free input torque T_out/i, N·m (`timeseries.csv` adds the losses: P_loss/ω_in).
@@ -73,13 +73,14 @@ pub struct EngineRow {
 
 /// Row inputs of a trajectory's output rows (each row shows the inputs of its segment).
 pub fn row_inputs(gb: &Gearbox, sched: &Schedule, traj: &Trajectory) -> Vec<RowInputs> {
+    let names: Vec<std::sync::Arc<str>> = gb.gear_states.iter().map(|g| g.name.as_str().into()).collect();
     traj.segment
         .iter()
         .map(|&k| {
             let iv = &sched.intervals[k];
             RowInputs {
                 vehicle_speed_kmh: m_s_to_kmh(iv.vehicle_speed),
-                gear: gb.gear_states[iv.gear].name.clone(),
+                gear: names[iv.gear].clone(),
                 input_speed_rpm: iv.input_speed * 30.0 / std::f64::consts::PI,
                 input_torque_nm: iv.input_torque,
                 output_power_w: iv.output_power,
