@@ -216,9 +216,10 @@ def own_ar1(fit_csv, trace_name, node="sump"):
 def band_json(cal, turbine, trace_name, path, own_noise=None):
     """The fit's calibration.json restricted to the parameters `turbine`'s model holds: the shared
     ones and its own (`KEY@trace_name` written as KEY), their covariance the sub-block of the
-    fit's (the marginal covariance of those coordinates), the t quantile unchanged; the residual
-    process that of the fit (every trace's fitted rows together) or `own_noise` (φ, σ_a) in its
-    place."""
+    fit's (the marginal covariance of those coordinates), the band multiplier that of the trace
+    `trace_name` (the fit's per-trace one); the residual process that of the fit (every trace's
+    fitted rows together) or `own_noise` (φ, σ_a) in its place, then with Student's t as the
+    multiplier (the Gaussian band of the turbine's own process)."""
     keep, params = [], []
     for k, p in enumerate(cal["parameters"]):
         key = p["key_path"]
@@ -230,28 +231,47 @@ def band_json(cal, turbine, trace_name, path, own_noise=None):
         keep.append(k)
         params.append(p)
     out = dict(cal, parameters=params, covariance=[[cal["covariance"][i][j] for j in keep] for i in keep])
+    own = next((t for t in cal.get("traces", []) if t["name"] == trace_name), None)
+    if own:
+        out["channels"] = [dict(c, noise=dict(c["noise"], band_multiplier=o["noise"]["band_multiplier"],
+                                              band_quantile=o["noise"]["band_quantile"]))
+                           for c, o in zip(cal["channels"], own["channels"])]
+    out["traces"] = []
     if own_noise:
-        out["channels"] = [dict(cal["channels"][0], noise=dict(cal["channels"][0]["noise"], **own_noise))]
+        t = {"band_multiplier": cal["fit"]["t975"], "band_quantile": "t"}
+        out["channels"] = [dict(cal["channels"][0], noise=dict(cal["channels"][0]["noise"], **own_noise, **t))]
     with open(path, "w") as fh:
         json.dump(out, fh)
     return path
 
 
-def rows_errors(fit_csv, t0=None, t1=None, node="sump"):
+def rows_errors(fit_csv, t0=None, t1=None, node="sump", gauss=None, trace=None):
     """Sump RMSE, bias and the fraction inside the 95 % band over the rows from t0 (s) on, before
-    t1 (s) when given."""
-    n = s2 = s1 = inside = 0
+    t1 (s) when given (of the trace `trace` in a stacked fit.csv); with `gauss` (Student's t over the band's multiplier) also the fraction
+    inside the Gaussian band (`inside_gauss95`: the band's standard deviation times t)."""
+    n = s2 = s1 = inside = ing = 0
     with open(fit_csv) as fh:
         for x in csv.DictReader(fh):
             t = float(x["time_s"])
-            if (t0 is not None and t < t0) or (t1 is not None and t >= t1):
+            if (t0 is not None and t < t0) or (t1 is not None and t >= t1) or (trace and x["trace"] != trace):
                 continue
             r = float(x[f"{node}_residual_k"])
             n += 1
             s2 += r * r
             s1 += r
             inside += abs(r) <= float(x[f"{node}_band95_k"])
-    return {"rows": n, "rmse_k": math.sqrt(s2 / n), "bias_k": s1 / n, "inside_band95": inside / n}
+            ing += abs(r) <= float(x[f"{node}_band95_k"]) * (gauss or 1.0)
+    out = {"rows": n, "rmse_k": math.sqrt(s2 / n), "bias_k": s1 / n, "inside_band95": inside / n}
+    if gauss:
+        out["inside_gauss95"] = ing / n
+    return out
+
+
+def multiplier(cal, trace_name=None):
+    """The band multiplier of a calibration.json's (only) channel: of the trace `trace_name` when
+    it has one, else the channel's."""
+    own = next((t for t in cal.get("traces", []) if t["name"] == trace_name), None)
+    return (own or cal)["channels"][0]["noise"]["band_multiplier"]
 
 
 def predict(bin_, model, trace, band, out):
@@ -259,10 +279,13 @@ def predict(bin_, model, trace, band, out):
     return os.path.join(out, "fit.csv")
 
 
-def whole(fit_csv):
-    """The prediction run's own figures over the whole trace (calibration.json's held-out rows)."""
-    h = json.load(open(os.path.join(os.path.dirname(fit_csv), "calibration.json")))["channels"][0]["holdout"]
-    return {k: h[k] for k in ("rows", "rmse_k", "bias_k", "inside_band95")}
+def whole(fit_csv, t975=None, t0=None, t1=None):
+    """The prediction run's figures over its rows (from t0, before t1, s; the whole trace by
+    default), with the Gaussian band's (Student's `t975` of the fit over the run's multiplier)."""
+    cal = json.load(open(os.path.join(os.path.dirname(fit_csv), "calibration.json")))
+    node = cal["channels"][0]["node"]
+    gauss = t975 / multiplier(cal) if t975 else None
+    return rows_errors(fit_csv, t0, t1, node=node, gauss=gauss)
 
 
 def own_band(bin_, tr, d, cal, turbine, rows):
@@ -277,6 +300,7 @@ def own_band(bin_, tr, d, cal, turbine, rows):
     f = predict(bin_, model, os.path.join(tr, f"{spring}.csv"), band, os.path.join(d, f"predict_own_{spring}"))
     held = rows_errors(f, 1209600.0, node=node)
     fitted = rows_errors(f, None, 1209600.0, node=node)
+    # The own process's band is Gaussian (band_json): its coverage is `inside_band95` here.
     f = predict(bin_, model, os.path.join(tr, f"{summer}.csv"), band, os.path.join(d, f"predict_own_{summer}"))
     for x, e in zip(rows, [fitted, held, whole(f)]):
         x["inside_own_band95"] = e["inside_band95"]
@@ -310,7 +334,8 @@ def one_fit(bin_, trs, name, sp, out):
            "cpu_s": after.children_user - before.children_user + after.children_system - before.children_system,
            "evaluations": cal["fit"]["evaluations"], "stop": cal["fit"]["stop"],
            "parameters": [{k: p[k] for k in ("key_path", "value", "ci95_low", "ci95_high")} for p in cal["parameters"]],
-           "noise": cal["channels"][0]["noise"], "rows": [],
+           "noise": cal["channels"][0]["noise"], "rows": [], "t975": cal["fit"]["t975"],
+           "multipliers": {t["name"]: t["channels"][0]["noise"]["band_multiplier"] for t in cal.get("traces", [])},
            "own_noise": {}, "weakest": min(cal["identifiability"], key=lambda e: e["relative_eigenvalue"]),
            "rated": {t["name"]: t["plausibility"]["rated"] for t in cal.get("traces", []) if t.get("plausibility")}}
     if cal.get("plausibility"):
@@ -325,20 +350,26 @@ def one_fit(bin_, trs, name, sp, out):
             band = band_json(cal, turbine, spring, os.path.join(d, f"band_{turbine}.json")) if own else \
                 os.path.join(d, "calibration.json")
             ch = (by_trace[turbine]["channels"][0] if own else cal["channels"][0])
-            res["rows"].append(dict(ch["fitted"], trace=f"{turbine} spring 2017 days 1–14 (fitted)",
+            gauss = cal["fit"]["t975"] / ch["noise"]["band_multiplier"]
+            fc = os.path.join(d, "fit.csv")
+            g = [rows_errors(fc, a, b, node=node, gauss=gauss, trace=spring if own else None)["inside_gauss95"]
+                 for a, b in ((None, 1209600.0), (1209600.0, None))]
+            res["rows"].append(dict(ch["fitted"], inside_gauss95=g[0], trace=f"{turbine} spring 2017 days 1–14 (fitted)",
                                     key=f"{turbine} spring 2017 days 1–14"))
-            res["rows"].append(dict(ch["holdout"], trace=f"{turbine} spring 2017 days 15–27 (held out)",
+            res["rows"].append(dict(ch["holdout"], inside_gauss95=g[1], trace=f"{turbine} spring 2017 days 15–27 (held out)",
                                     key=f"{turbine} spring 2017 days 15–27"))
         else:
             model, band = os.path.join(d, "calibrated.toml"), os.path.join(d, "calibration.json")
             f = predict(bin_, model, os.path.join(tr, f"{spring}.csv"), band, os.path.join(d, f"predict_{spring}"))
-            res["rows"].append(dict(rows_errors(f, None, 1209600.0, node=node), trace=f"{turbine} spring 2017 days 1–14 (predicted)",
+            t975 = cal["fit"]["t975"]
+            res["rows"].append(dict(whole(f, t975, None, 1209600.0), trace=f"{turbine} spring 2017 days 1–14 (predicted)",
                                     key=f"{turbine} spring 2017 days 1–14"))
-            res["rows"].append(dict(rows_errors(f, 1209600.0, node=node), trace=f"{turbine} spring 2017 days 15–27 (predicted)",
+            res["rows"].append(dict(whole(f, t975, 1209600.0), trace=f"{turbine} spring 2017 days 15–27 (predicted)",
                                     key=f"{turbine} spring 2017 days 15–27"))
-            res["rows"].append(dict(whole(f), trace=f"{turbine} spring 2017 days 1–27 (predicted)"))
+            res["rows"].append(dict(whole(f, t975), trace=f"{turbine} spring 2017 days 1–27 (predicted)"))
         f = predict(bin_, model, os.path.join(tr, f"{summer}.csv"), band, os.path.join(d, f"predict_{summer}"))
-        res["rows"].append(dict(whole(f), trace=f"{turbine} summer 2016 (predicted)", key=f"{turbine} summer 2016"))
+        res["rows"].append(dict(whole(f, cal["fit"]["t975"]), trace=f"{turbine} summer 2016 (predicted)",
+                                key=f"{turbine} summer 2016"))
         if turbine in turbines and len(turbines) > 1 and len(cal["channels"]) == 1:
             res["own_noise"][spring] = own_band(bin_, tr, d, cal, turbine, res["rows"][-3:])
     return res
@@ -386,7 +417,9 @@ def print_fit(r):
     """One fit's residual processes and its table (the band of the fit's residual process, and for a
     fit of both turbines that of each turbine's own beside it)."""
     n = r["noise"]
-    print(f"  sump residuals (fitted rows): φ {n['phi']:.3f}, σ_a {n['innovation_sd_k']:.3f} K")
+    print(f"  sump residuals (fitted rows): φ {n['phi']:.3f}, σ_a {n['innovation_sd_k']:.3f} K, band multiplier "
+          f"{n['band_multiplier']:.3f} ({n['band_quantile']}; t {r['t975']:.3f})"
+          + "".join(f", {t} {m:.3f}" for t, m in r["multipliers"].items()))
     w = r["weakest"]
     comp = ", ".join(f"{c['component']:+.2f} ln {c['key_path']}" for c in w["components"] if abs(c["component"]) >= 0.1)
     print(f"  least determined direction ({w['status']}, relative eigenvalue {w['relative_eigenvalue']:.2g}, "
@@ -397,19 +430,21 @@ def print_fit(r):
               f"{x['loss_total_w'] / 1e3:.1f} kW ({src} kW), efficiency {x['efficiency']:.3f}")
     for t, m in r.get("own_noise", {}).items():
         print(f"  {t}'s fitted rows alone: φ {m['phi']:.3f}, σ_a {m['innovation_sd_k']:.3f} K")
-    print("| trace | rows | sump RMSE, K | bias, K | inside the 95 % band | inside the band of the turbine's own "
-          "residual process |")
-    print("|---|---|---|---|---|---|")
+    print("| trace | rows | sump RMSE, K | bias, K | inside the 95 % band | inside the Gaussian band (t) | "
+          "inside the Gaussian band of the turbine's own residual process |")
+    print("|---|---|---|---|---|---|---|")
     for x in r["rows"]:
         own = f"{100 * x['inside_own_band95']:.1f} %" if "inside_own_band95" in x else "—"
+        gauss = f"{100 * x['inside_gauss95']:.1f} %" if "inside_gauss95" in x else "—"
         print(f"| {x['trace']} | {x['rows']} | {x['rmse_k']:.2f} | {x['bias_k']:+.2f} | "
-              f"{100 * x['inside_band95']:.1f} % | {own} |")
+              f"{100 * x['inside_band95']:.1f} % | {gauss} | {own} |")
     print(flush=True)
 
 
 def print_summary(results):
-    """docs/validation.md's table: per trace and fit, RMSE / bias / inside the band (the turbine's
-    own residual process in brackets where there is one)."""
+    """docs/validation.md's table: per trace and fit, RMSE / bias / inside the band [inside the
+    Gaussian band] (the Gaussian band of the turbine's own residual process in brackets where there
+    is one)."""
     if not results:
         return
     names = [r["name"] for r in results]
@@ -422,7 +457,8 @@ def print_summary(results):
         for r in results:
             y = next(x for x in r["rows"] if x.get("key") == key)
             own = f" ({100 * y['inside_own_band95']:.1f} %)" if "inside_own_band95" in y else ""
-            cells.append(f"{y['rmse_k']:.2f} / {y['bias_k']:+.2f} / {100 * y['inside_band95']:.1f} %{own}")
+            gauss = f" [{100 * y['inside_gauss95']:.1f} %]" if "inside_gauss95" in y else ""
+            cells.append(f"{y['rmse_k']:.2f} / {y['bias_k']:+.2f} / {100 * y['inside_band95']:.1f} %{gauss}{own}")
         print(f"| {key} | " + " | ".join(cells) + " |")
     print()
 
