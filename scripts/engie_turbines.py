@@ -17,7 +17,8 @@ row per fit and held-out trace (sump RMSE, bias, fraction of the rows inside the
 the fit's residual process and, for a fit of both turbines, of each turbine's own), the fitted
 values, the least determined direction, the loss at the rated point and the run times, then
 the table of docs/validation.md; writes OUT/figures.json. --residuals adds, per two-turbine
-fit, where the residuals on R80721's fitted days come from; --variants runs the variants tried
+fit, where the residuals on each turbine's fitted days come from (slow and fast parts, by
+measured sump, power and outdoor air); --variants runs the variants tried
 (docs/validation.md's list) instead and prints their table (OUT/figures_variants.json).
 Nothing is tuned on the held-out rows: each fit sees days 1–14 only (--holdout
 1209600:2400000 in each trace's own time).
@@ -380,11 +381,13 @@ def residual_analysis(fit_csv, trace_csv, trace_name, window=18):
     split into a slow part (the difference of the simulated and measured centred means over
     `window` rows, 3 h) and a fast part (the rest), the measured sump's own scatter about its
     centred mean (what no model without the fan's phase can follow), and the residual's bias and
-    RMSE by measured-sump and power bins."""
-    inputs = {}
+    RMSE by measured-sump, power and outdoor-temperature bins, and the least-squares slope of the
+    residual on the outdoor temperature (what a warmer season would shift it by)."""
+    inputs, outdoor = {}, {}
     with open(trace_csv) as fh:
         for x in csv.DictReader(fh):
             inputs[x["time_s"]] = -float(x["input_torque_nm"]) * float(x["input_speed_rpm"]) * math.pi / 30e3
+            outdoor[x["time_s"]] = float(x["boundary:outdoor"])
     with open(fit_csv) as fh:
         rows = [x for x in csv.DictReader(fh) if x["trace"] == trace_name]
     meas = [float(x["sump_measured_c"]) for x in rows]
@@ -396,7 +399,8 @@ def residual_analysis(fit_csv, trace_csv, trace_name, window=18):
         lo, hi = max(0, i - window // 2), min(len(rows), i + window // 2 + 1)
         mm, ms = sum(meas[lo:hi]) / (hi - lo), sum(sim[lo:hi]) / (hi - lo)
         out.append({"r": sim[i] - meas[i], "slow": ms - mm, "fast": (sim[i] - ms) - (meas[i] - mm),
-                    "own": meas[i] - mm, "meas": meas[i], "power_kw": inputs[x["time_s"]]})
+                    "own": meas[i] - mm, "meas": meas[i], "power_kw": inputs[x["time_s"]],
+                    "outdoor_c": outdoor[x["time_s"]]})
     rms = lambda k, xs=out: math.sqrt(sum(x[k] ** 2 for x in xs) / len(xs))
     print(f"  {trace_name}, fitted rows ({len(out)}): sump RMSE {rms('r'):.2f} K = slow {rms('slow'):.2f} K ⊕ "
           f"fast {rms('fast'):.2f} K ({window * 10} min centred means); the measured sump's scatter about its "
@@ -404,13 +408,25 @@ def residual_analysis(fit_csv, trace_csv, trace_name, window=18):
     fitted = [i for i in range(1, len(rows)) if rows[i]["holdout"] == "0" and rows[i - 1]["holdout"] == "0"]
     print(f"  rows where the sump rises by more than 3 K from the row before: simulated "
           f"{sum(sim[i] - sim[i - 1] > 3.0 for i in fitted)}, measured {sum(meas[i] - meas[i - 1] > 3.0 for i in fitted)}")
-    for key, edges in (("meas", [30, 45, 50, 55, 56, 57, 58, 59, 61]), ("power_kw", [-100, 0, 50, 200, 500, 2100])):
+    labels = {"meas": "measured sump, °C", "power_kw": "power, kW", "outdoor_c": "outdoor air, °C"}
+    for key, edges in (("meas", [30, 45, 50, 55, 56, 57, 58, 59, 61]), ("power_kw", [-100, 0, 50, 200, 500, 2100]),
+                       ("outdoor_c", [-10, 5, 10, 15, 20, 25, 40])):
         cells = []
         for lo, hi in zip(edges[:-1], edges[1:]):
             xs = [x for x in out if lo <= x[key] < hi]
             if xs:
                 cells.append(f"[{lo}, {hi}): {len(xs)} rows, {sum(x['r'] for x in xs) / len(xs):+.2f} / {rms('r', xs):.2f}")
-        print(f"  by {'measured sump, °C' if key == 'meas' else 'power, kW'} (bias / RMSE, K): " + "; ".join(cells))
+        print(f"  by {labels[key]} (bias / RMSE, K): " + "; ".join(cells))
+    n = len(out)
+    mx, my = sum(x["outdoor_c"] for x in out) / n, sum(x["r"] for x in out) / n
+    slope = sum((x["outdoor_c"] - mx) * (x["r"] - my) for x in out) / sum((x["outdoor_c"] - mx) ** 2 for x in out)
+    summer = trace_csv.replace("2017-spring", "2016-summer")
+    with open(summer) as fh:
+        ts = [float(x["boundary:outdoor"]) for x in csv.DictReader(fh)]
+    ms = sum(ts) / len(ts)
+    print(f"  residual against the outdoor air (least squares): {slope:+.3f} K/K about {my:+.2f} K at its mean "
+          f"{mx:.1f} °C; at summer 2016's mean outdoor air ({ms:.1f} °C, its inputs only) that line gives "
+          f"{my + slope * (ms - mx):+.2f} K")
 
 
 def print_fit(r):
@@ -488,7 +504,7 @@ def main():
     ap.add_argument("--only", help="run only the fit of this name")
     ap.add_argument("--variants", action="store_true", help="run the variants tried instead of the fits")
     ap.add_argument("--residuals", action="store_true",
-                    help="also print where each two-turbine fit's residuals on R80721's fitted days come from")
+                    help="also print where each two-turbine fit's residuals on the fitted days come from")
     a = ap.parse_args()
     runs = variants() if a.variants else FITS
     trs = traces(a.data, a.out, {sp["kind"] for sp in runs.values()})
@@ -508,8 +524,8 @@ def main():
         print_fit(r)
         if a.residuals and len(sp["turbines"]) > 1:
             d = run_dir(a.out, name)
-            residual_analysis(os.path.join(d, "fit.csv"), os.path.join(trs[sp["kind"]], "R80721_2017-spring.csv"),
-                              "R80721_2017-spring")
+            for t in ("R80711_2017-spring", "R80721_2017-spring"):
+                residual_analysis(os.path.join(d, "fit.csv"), os.path.join(trs[sp["kind"]], f"{t}.csv"), t)
             print()
     print_summary(results) if not a.variants else print_variants(results)
     print(f"load {load0:.1f} before, {os.getloadavg()[0]:.1f} after")
