@@ -481,16 +481,18 @@ def print_summary(results):
 
 def print_variants(results):
     """docs/validation.md's table of the variants: sump RMSE on both turbines' fitted days,
-    held-out days and summer, R80721's band coverage, the parameters at a bound."""
+    held-out days and summer, R80721's band coverage [that of the Gaussian band t·sd], the parameters
+    at a bound."""
     print("| variant | R80711 fitted / held out / summer, K | R80721 fitted / held out / summer, K | "
-          "R80721 inside the band (held out / summer) | no interval (at a bound or not determined) |")
+          "R80721 inside the band (held out / summer) [Gaussian band] | no interval (at a bound or not determined) |")
     print("|---|---|---|---|---|")
     for r in results:
         x = {y["key"]: y for y in r["rows"] if "key" in y}
         cell = lambda t: " / ".join(f"{x[f'{t} {p}']['rmse_k']:.2f}" for p in
                                     ("spring 2017 days 1–14", "spring 2017 days 15–27", "summer 2016"))
-        bands = " / ".join(f"{100 * x[f'R80721 {p}']['inside_band95']:.1f} %"
-                           for p in ("spring 2017 days 15–27", "summer 2016"))
+        keys = [f"R80721 {p}" for p in ("spring 2017 days 15–27", "summer 2016")]
+        bands = " / ".join(f"{100 * x[k]['inside_band95']:.1f} %" for k in keys) + " [" + \
+            " / ".join(f"{100 * x[k]['inside_gauss95']:.1f} %" for k in keys) + "]"
         bound = ", ".join(p["key_path"].split(".")[-1] for p in r["parameters"] if p["ci95_low"] is None) or "–"
         print(f"| {r['name']} | {cell('R80711')} | {cell('R80721')} | {bands} | {bound} |")
     print()
