@@ -376,7 +376,7 @@ def one_fit(bin_, trs, name, sp, out):
     return res
 
 
-def residual_analysis(fit_csv, trace_csv, trace_name, window=18):
+def residual_analysis(fit_csv, trace_csv, trace_name, window=18, node="sump"):
     """Where a trace's fitted-row sump residuals (simulated − measured) come from: their RMSE
     split into a slow part (the difference of the simulated and measured centred means over
     `window` rows, 3 h) and a fast part (the rest), the measured sump's own scatter about its
@@ -390,8 +390,8 @@ def residual_analysis(fit_csv, trace_csv, trace_name, window=18):
             outdoor[x["time_s"]] = float(x["boundary:outdoor"])
     with open(fit_csv) as fh:
         rows = [x for x in csv.DictReader(fh) if x["trace"] == trace_name]
-    meas = [float(x["sump_measured_c"]) for x in rows]
-    sim = [float(x["sump_simulated_c"]) for x in rows]
+    meas = [float(x[f"{node}_measured_c"]) for x in rows]
+    sim = [float(x[f"{node}_simulated_c"]) for x in rows]
     out = []
     for i, x in enumerate(rows):
         if x["holdout"] != "0":
@@ -526,8 +526,10 @@ def main():
         print_fit(r)
         if a.residuals and len(sp["turbines"]) > 1:
             d = run_dir(a.out, name)
+            nodes = [c["node"] for c in json.load(open(os.path.join(d, "calibration.json")))["channels"]]
             for t in ("R80711_2017-spring", "R80721_2017-spring"):
-                residual_analysis(os.path.join(d, "fit.csv"), os.path.join(trs[sp["kind"]], f"{t}.csv"), t)
+                residual_analysis(os.path.join(d, "fit.csv"), os.path.join(trs[sp["kind"]], f"{t}.csv"), t,
+                                  node="sump" if "sump" in nodes else nodes[0])
             print()
     print_summary(results) if not a.variants else print_variants(results)
     print(f"load {load0:.1f} before, {os.getloadavg()[0]:.1f} after")
