@@ -17,7 +17,8 @@ row per fit and held-out trace (sump RMSE, bias, fraction of the rows inside the
 the fit's residual process and, for a fit of both turbines, of each turbine's own), the fitted
 values, the least determined direction, the loss at the rated point and the run times, then
 the table of docs/validation.md; writes OUT/figures.json. --residuals adds, per two-turbine
-fit, where the residuals on R80721's fitted days come from; --variants runs the variants tried
+fit, where the residuals on each turbine's fitted days come from (slow and fast parts, by
+measured sump, power and outdoor air); --variants runs the variants tried
 (docs/validation.md's list) instead and prints their table (OUT/figures_variants.json).
 Nothing is tuned on the held-out rows: each fit sees days 1–14 only (--holdout
 1209600:2400000 in each trace's own time).
@@ -216,9 +217,10 @@ def own_ar1(fit_csv, trace_name, node="sump"):
 def band_json(cal, turbine, trace_name, path, own_noise=None):
     """The fit's calibration.json restricted to the parameters `turbine`'s model holds: the shared
     ones and its own (`KEY@trace_name` written as KEY), their covariance the sub-block of the
-    fit's (the marginal covariance of those coordinates), the t quantile unchanged; the residual
-    process that of the fit (every trace's fitted rows together) or `own_noise` (φ, σ_a) in its
-    place."""
+    fit's (the marginal covariance of those coordinates), the band multiplier that of the trace
+    `trace_name` (the fit's per-trace one); the residual process that of the fit (every trace's
+    fitted rows together) or `own_noise` (φ, σ_a) in its place, then with Student's t as the
+    multiplier (the Gaussian band of the turbine's own process)."""
     keep, params = [], []
     for k, p in enumerate(cal["parameters"]):
         key = p["key_path"]
@@ -230,28 +232,47 @@ def band_json(cal, turbine, trace_name, path, own_noise=None):
         keep.append(k)
         params.append(p)
     out = dict(cal, parameters=params, covariance=[[cal["covariance"][i][j] for j in keep] for i in keep])
+    own = next((t for t in cal.get("traces", []) if t["name"] == trace_name), None)
+    if own:
+        out["channels"] = [dict(c, noise=dict(c["noise"], band_multiplier=o["noise"]["band_multiplier"],
+                                              band_quantile=o["noise"]["band_quantile"]))
+                           for c, o in zip(cal["channels"], own["channels"])]
+    out["traces"] = []
     if own_noise:
-        out["channels"] = [dict(cal["channels"][0], noise=dict(cal["channels"][0]["noise"], **own_noise))]
+        t = {"band_multiplier": cal["fit"]["t975"], "band_quantile": "t"}
+        out["channels"] = [dict(cal["channels"][0], noise=dict(cal["channels"][0]["noise"], **own_noise, **t))]
     with open(path, "w") as fh:
         json.dump(out, fh)
     return path
 
 
-def rows_errors(fit_csv, t0=None, t1=None, node="sump"):
+def rows_errors(fit_csv, t0=None, t1=None, node="sump", gauss=None, trace=None):
     """Sump RMSE, bias and the fraction inside the 95 % band over the rows from t0 (s) on, before
-    t1 (s) when given."""
-    n = s2 = s1 = inside = 0
+    t1 (s) when given (of the trace `trace` in a stacked fit.csv); with `gauss` (Student's t over the band's multiplier) also the fraction
+    inside the Gaussian band (`inside_gauss95`: the band's standard deviation times t)."""
+    n = s2 = s1 = inside = ing = 0
     with open(fit_csv) as fh:
         for x in csv.DictReader(fh):
             t = float(x["time_s"])
-            if (t0 is not None and t < t0) or (t1 is not None and t >= t1):
+            if (t0 is not None and t < t0) or (t1 is not None and t >= t1) or (trace and x["trace"] != trace):
                 continue
             r = float(x[f"{node}_residual_k"])
             n += 1
             s2 += r * r
             s1 += r
             inside += abs(r) <= float(x[f"{node}_band95_k"])
-    return {"rows": n, "rmse_k": math.sqrt(s2 / n), "bias_k": s1 / n, "inside_band95": inside / n}
+            ing += abs(r) <= float(x[f"{node}_band95_k"]) * (gauss or 1.0)
+    out = {"rows": n, "rmse_k": math.sqrt(s2 / n), "bias_k": s1 / n, "inside_band95": inside / n}
+    if gauss:
+        out["inside_gauss95"] = ing / n
+    return out
+
+
+def multiplier(cal, trace_name=None):
+    """The band multiplier of a calibration.json's (only) channel: of the trace `trace_name` when
+    it has one, else the channel's."""
+    own = next((t for t in cal.get("traces", []) if t["name"] == trace_name), None)
+    return (own or cal)["channels"][0]["noise"]["band_multiplier"]
 
 
 def predict(bin_, model, trace, band, out):
@@ -259,10 +280,13 @@ def predict(bin_, model, trace, band, out):
     return os.path.join(out, "fit.csv")
 
 
-def whole(fit_csv):
-    """The prediction run's own figures over the whole trace (calibration.json's held-out rows)."""
-    h = json.load(open(os.path.join(os.path.dirname(fit_csv), "calibration.json")))["channels"][0]["holdout"]
-    return {k: h[k] for k in ("rows", "rmse_k", "bias_k", "inside_band95")}
+def whole(fit_csv, t975=None, t0=None, t1=None):
+    """The prediction run's figures over its rows (from t0, before t1, s; the whole trace by
+    default), with the Gaussian band's (Student's `t975` of the fit over the run's multiplier)."""
+    cal = json.load(open(os.path.join(os.path.dirname(fit_csv), "calibration.json")))
+    node = cal["channels"][0]["node"]
+    gauss = t975 / multiplier(cal) if t975 else None
+    return rows_errors(fit_csv, t0, t1, node=node, gauss=gauss)
 
 
 def own_band(bin_, tr, d, cal, turbine, rows):
@@ -277,6 +301,7 @@ def own_band(bin_, tr, d, cal, turbine, rows):
     f = predict(bin_, model, os.path.join(tr, f"{spring}.csv"), band, os.path.join(d, f"predict_own_{spring}"))
     held = rows_errors(f, 1209600.0, node=node)
     fitted = rows_errors(f, None, 1209600.0, node=node)
+    # The own process's band is Gaussian (band_json): its coverage is `inside_band95` here.
     f = predict(bin_, model, os.path.join(tr, f"{summer}.csv"), band, os.path.join(d, f"predict_own_{summer}"))
     for x, e in zip(rows, [fitted, held, whole(f)]):
         x["inside_own_band95"] = e["inside_band95"]
@@ -310,7 +335,8 @@ def one_fit(bin_, trs, name, sp, out):
            "cpu_s": after.children_user - before.children_user + after.children_system - before.children_system,
            "evaluations": cal["fit"]["evaluations"], "stop": cal["fit"]["stop"],
            "parameters": [{k: p[k] for k in ("key_path", "value", "ci95_low", "ci95_high")} for p in cal["parameters"]],
-           "noise": cal["channels"][0]["noise"], "rows": [],
+           "noise": cal["channels"][0]["noise"], "rows": [], "t975": cal["fit"]["t975"],
+           "multipliers": {t["name"]: t["channels"][0]["noise"]["band_multiplier"] for t in cal.get("traces", [])},
            "own_noise": {}, "weakest": min(cal["identifiability"], key=lambda e: e["relative_eigenvalue"]),
            "rated": {t["name"]: t["plausibility"]["rated"] for t in cal.get("traces", []) if t.get("plausibility")}}
     if cal.get("plausibility"):
@@ -325,39 +351,47 @@ def one_fit(bin_, trs, name, sp, out):
             band = band_json(cal, turbine, spring, os.path.join(d, f"band_{turbine}.json")) if own else \
                 os.path.join(d, "calibration.json")
             ch = (by_trace[turbine]["channels"][0] if own else cal["channels"][0])
-            res["rows"].append(dict(ch["fitted"], trace=f"{turbine} spring 2017 days 1–14 (fitted)",
+            gauss = cal["fit"]["t975"] / ch["noise"]["band_multiplier"]
+            fc = os.path.join(d, "fit.csv")
+            g = [rows_errors(fc, a, b, node=node, gauss=gauss, trace=spring if own else None)["inside_gauss95"]
+                 for a, b in ((None, 1209600.0), (1209600.0, None))]
+            res["rows"].append(dict(ch["fitted"], inside_gauss95=g[0], trace=f"{turbine} spring 2017 days 1–14 (fitted)",
                                     key=f"{turbine} spring 2017 days 1–14"))
-            res["rows"].append(dict(ch["holdout"], trace=f"{turbine} spring 2017 days 15–27 (held out)",
+            res["rows"].append(dict(ch["holdout"], inside_gauss95=g[1], trace=f"{turbine} spring 2017 days 15–27 (held out)",
                                     key=f"{turbine} spring 2017 days 15–27"))
         else:
             model, band = os.path.join(d, "calibrated.toml"), os.path.join(d, "calibration.json")
             f = predict(bin_, model, os.path.join(tr, f"{spring}.csv"), band, os.path.join(d, f"predict_{spring}"))
-            res["rows"].append(dict(rows_errors(f, None, 1209600.0, node=node), trace=f"{turbine} spring 2017 days 1–14 (predicted)",
+            t975 = cal["fit"]["t975"]
+            res["rows"].append(dict(whole(f, t975, None, 1209600.0), trace=f"{turbine} spring 2017 days 1–14 (predicted)",
                                     key=f"{turbine} spring 2017 days 1–14"))
-            res["rows"].append(dict(rows_errors(f, 1209600.0, node=node), trace=f"{turbine} spring 2017 days 15–27 (predicted)",
+            res["rows"].append(dict(whole(f, t975, 1209600.0), trace=f"{turbine} spring 2017 days 15–27 (predicted)",
                                     key=f"{turbine} spring 2017 days 15–27"))
-            res["rows"].append(dict(whole(f), trace=f"{turbine} spring 2017 days 1–27 (predicted)"))
+            res["rows"].append(dict(whole(f, t975), trace=f"{turbine} spring 2017 days 1–27 (predicted)"))
         f = predict(bin_, model, os.path.join(tr, f"{summer}.csv"), band, os.path.join(d, f"predict_{summer}"))
-        res["rows"].append(dict(whole(f), trace=f"{turbine} summer 2016 (predicted)", key=f"{turbine} summer 2016"))
+        res["rows"].append(dict(whole(f, cal["fit"]["t975"]), trace=f"{turbine} summer 2016 (predicted)",
+                                key=f"{turbine} summer 2016"))
         if turbine in turbines and len(turbines) > 1 and len(cal["channels"]) == 1:
             res["own_noise"][spring] = own_band(bin_, tr, d, cal, turbine, res["rows"][-3:])
     return res
 
 
-def residual_analysis(fit_csv, trace_csv, trace_name, window=18):
+def residual_analysis(fit_csv, trace_csv, trace_name, window=18, node="sump"):
     """Where a trace's fitted-row sump residuals (simulated − measured) come from: their RMSE
     split into a slow part (the difference of the simulated and measured centred means over
     `window` rows, 3 h) and a fast part (the rest), the measured sump's own scatter about its
     centred mean (what no model without the fan's phase can follow), and the residual's bias and
-    RMSE by measured-sump and power bins."""
-    inputs = {}
+    RMSE by measured-sump, power and outdoor-temperature bins, and the least-squares slope of the
+    residual on the outdoor temperature (what a warmer season would shift it by)."""
+    inputs, outdoor = {}, {}
     with open(trace_csv) as fh:
         for x in csv.DictReader(fh):
             inputs[x["time_s"]] = -float(x["input_torque_nm"]) * float(x["input_speed_rpm"]) * math.pi / 30e3
+            outdoor[x["time_s"]] = float(x["boundary:outdoor"])
     with open(fit_csv) as fh:
         rows = [x for x in csv.DictReader(fh) if x["trace"] == trace_name]
-    meas = [float(x["sump_measured_c"]) for x in rows]
-    sim = [float(x["sump_simulated_c"]) for x in rows]
+    meas = [float(x[f"{node}_measured_c"]) for x in rows]
+    sim = [float(x[f"{node}_simulated_c"]) for x in rows]
     out = []
     for i, x in enumerate(rows):
         if x["holdout"] != "0":
@@ -365,7 +399,8 @@ def residual_analysis(fit_csv, trace_csv, trace_name, window=18):
         lo, hi = max(0, i - window // 2), min(len(rows), i + window // 2 + 1)
         mm, ms = sum(meas[lo:hi]) / (hi - lo), sum(sim[lo:hi]) / (hi - lo)
         out.append({"r": sim[i] - meas[i], "slow": ms - mm, "fast": (sim[i] - ms) - (meas[i] - mm),
-                    "own": meas[i] - mm, "meas": meas[i], "power_kw": inputs[x["time_s"]]})
+                    "own": meas[i] - mm, "meas": meas[i], "power_kw": inputs[x["time_s"]],
+                    "outdoor_c": outdoor[x["time_s"]]})
     rms = lambda k, xs=out: math.sqrt(sum(x[k] ** 2 for x in xs) / len(xs))
     print(f"  {trace_name}, fitted rows ({len(out)}): sump RMSE {rms('r'):.2f} K = slow {rms('slow'):.2f} K ⊕ "
           f"fast {rms('fast'):.2f} K ({window * 10} min centred means); the measured sump's scatter about its "
@@ -373,20 +408,34 @@ def residual_analysis(fit_csv, trace_csv, trace_name, window=18):
     fitted = [i for i in range(1, len(rows)) if rows[i]["holdout"] == "0" and rows[i - 1]["holdout"] == "0"]
     print(f"  rows where the sump rises by more than 3 K from the row before: simulated "
           f"{sum(sim[i] - sim[i - 1] > 3.0 for i in fitted)}, measured {sum(meas[i] - meas[i - 1] > 3.0 for i in fitted)}")
-    for key, edges in (("meas", [30, 45, 50, 55, 56, 57, 58, 59, 61]), ("power_kw", [-100, 0, 50, 200, 500, 2100])):
+    labels = {"meas": "measured sump, °C", "power_kw": "power, kW", "outdoor_c": "outdoor air, °C"}
+    for key, edges in (("meas", [30, 45, 50, 55, 56, 57, 58, 59, 61]), ("power_kw", [-100, 0, 50, 200, 500, 2100]),
+                       ("outdoor_c", [-10, 5, 10, 15, 20, 25, 40])):
         cells = []
         for lo, hi in zip(edges[:-1], edges[1:]):
             xs = [x for x in out if lo <= x[key] < hi]
             if xs:
                 cells.append(f"[{lo}, {hi}): {len(xs)} rows, {sum(x['r'] for x in xs) / len(xs):+.2f} / {rms('r', xs):.2f}")
-        print(f"  by {'measured sump, °C' if key == 'meas' else 'power, kW'} (bias / RMSE, K): " + "; ".join(cells))
+        print(f"  by {labels[key]} (bias / RMSE, K): " + "; ".join(cells))
+    n = len(out)
+    mx, my = sum(x["outdoor_c"] for x in out) / n, sum(x["r"] for x in out) / n
+    slope = sum((x["outdoor_c"] - mx) * (x["r"] - my) for x in out) / sum((x["outdoor_c"] - mx) ** 2 for x in out)
+    summer = trace_csv.replace("2017-spring", "2016-summer")
+    with open(summer) as fh:
+        ts = [float(x["boundary:outdoor"]) for x in csv.DictReader(fh)]
+    ms = sum(ts) / len(ts)
+    print(f"  residual against the outdoor air (least squares): {slope:+.3f} K/K about {my:+.2f} K at its mean "
+          f"{mx:.1f} °C; at summer 2016's mean outdoor air ({ms:.1f} °C, its inputs only) that line gives "
+          f"{my + slope * (ms - mx):+.2f} K")
 
 
 def print_fit(r):
     """One fit's residual processes and its table (the band of the fit's residual process, and for a
     fit of both turbines that of each turbine's own beside it)."""
     n = r["noise"]
-    print(f"  sump residuals (fitted rows): φ {n['phi']:.3f}, σ_a {n['innovation_sd_k']:.3f} K")
+    print(f"  sump residuals (fitted rows): φ {n['phi']:.3f}, σ_a {n['innovation_sd_k']:.3f} K, band multiplier "
+          f"{n['band_multiplier']:.3f} ({n['band_quantile']}; t {r['t975']:.3f})"
+          + "".join(f", {t} {m:.3f}" for t, m in r["multipliers"].items()))
     w = r["weakest"]
     comp = ", ".join(f"{c['component']:+.2f} ln {c['key_path']}" for c in w["components"] if abs(c["component"]) >= 0.1)
     print(f"  least determined direction ({w['status']}, relative eigenvalue {w['relative_eigenvalue']:.2g}, "
@@ -397,19 +446,21 @@ def print_fit(r):
               f"{x['loss_total_w'] / 1e3:.1f} kW ({src} kW), efficiency {x['efficiency']:.3f}")
     for t, m in r.get("own_noise", {}).items():
         print(f"  {t}'s fitted rows alone: φ {m['phi']:.3f}, σ_a {m['innovation_sd_k']:.3f} K")
-    print("| trace | rows | sump RMSE, K | bias, K | inside the 95 % band | inside the band of the turbine's own "
-          "residual process |")
-    print("|---|---|---|---|---|---|")
+    print("| trace | rows | sump RMSE, K | bias, K | inside the 95 % band | inside the Gaussian band (t) | "
+          "inside the Gaussian band of the turbine's own residual process |")
+    print("|---|---|---|---|---|---|---|")
     for x in r["rows"]:
         own = f"{100 * x['inside_own_band95']:.1f} %" if "inside_own_band95" in x else "—"
+        gauss = f"{100 * x['inside_gauss95']:.1f} %" if "inside_gauss95" in x else "—"
         print(f"| {x['trace']} | {x['rows']} | {x['rmse_k']:.2f} | {x['bias_k']:+.2f} | "
-              f"{100 * x['inside_band95']:.1f} % | {own} |")
+              f"{100 * x['inside_band95']:.1f} % | {gauss} | {own} |")
     print(flush=True)
 
 
 def print_summary(results):
-    """docs/validation.md's table: per trace and fit, RMSE / bias / inside the band (the turbine's
-    own residual process in brackets where there is one)."""
+    """docs/validation.md's table: per trace and fit, RMSE / bias / inside the band [inside the
+    Gaussian band] (the Gaussian band of the turbine's own residual process in brackets where there
+    is one)."""
     if not results:
         return
     names = [r["name"] for r in results]
@@ -422,23 +473,26 @@ def print_summary(results):
         for r in results:
             y = next(x for x in r["rows"] if x.get("key") == key)
             own = f" ({100 * y['inside_own_band95']:.1f} %)" if "inside_own_band95" in y else ""
-            cells.append(f"{y['rmse_k']:.2f} / {y['bias_k']:+.2f} / {100 * y['inside_band95']:.1f} %{own}")
+            gauss = f" [{100 * y['inside_gauss95']:.1f} %]" if "inside_gauss95" in y else ""
+            cells.append(f"{y['rmse_k']:.2f} / {y['bias_k']:+.2f} / {100 * y['inside_band95']:.1f} %{gauss}{own}")
         print(f"| {key} | " + " | ".join(cells) + " |")
     print()
 
 
 def print_variants(results):
     """docs/validation.md's table of the variants: sump RMSE on both turbines' fitted days,
-    held-out days and summer, R80721's band coverage, the parameters at a bound."""
+    held-out days and summer, R80721's band coverage [that of the Gaussian band t·sd], the parameters
+    at a bound."""
     print("| variant | R80711 fitted / held out / summer, K | R80721 fitted / held out / summer, K | "
-          "R80721 inside the band (held out / summer) | no interval (at a bound or not determined) |")
+          "R80721 inside the band (held out / summer) [Gaussian band] | no interval (at a bound or not determined) |")
     print("|---|---|---|---|---|")
     for r in results:
         x = {y["key"]: y for y in r["rows"] if "key" in y}
         cell = lambda t: " / ".join(f"{x[f'{t} {p}']['rmse_k']:.2f}" for p in
                                     ("spring 2017 days 1–14", "spring 2017 days 15–27", "summer 2016"))
-        bands = " / ".join(f"{100 * x[f'R80721 {p}']['inside_band95']:.1f} %"
-                           for p in ("spring 2017 days 15–27", "summer 2016"))
+        keys = [f"R80721 {p}" for p in ("spring 2017 days 15–27", "summer 2016")]
+        bands = " / ".join(f"{100 * x[k]['inside_band95']:.1f} %" for k in keys) + " [" + \
+            " / ".join(f"{100 * x[k]['inside_gauss95']:.1f} %" for k in keys) + "]"
         bound = ", ".join(p["key_path"].split(".")[-1] for p in r["parameters"] if p["ci95_low"] is None) or "–"
         print(f"| {r['name']} | {cell('R80711')} | {cell('R80721')} | {bands} | {bound} |")
     print()
@@ -452,7 +506,7 @@ def main():
     ap.add_argument("--only", help="run only the fit of this name")
     ap.add_argument("--variants", action="store_true", help="run the variants tried instead of the fits")
     ap.add_argument("--residuals", action="store_true",
-                    help="also print where each two-turbine fit's residuals on R80721's fitted days come from")
+                    help="also print where each two-turbine fit's residuals on the fitted days come from")
     a = ap.parse_args()
     runs = variants() if a.variants else FITS
     trs = traces(a.data, a.out, {sp["kind"] for sp in runs.values()})
@@ -472,8 +526,10 @@ def main():
         print_fit(r)
         if a.residuals and len(sp["turbines"]) > 1:
             d = run_dir(a.out, name)
-            residual_analysis(os.path.join(d, "fit.csv"), os.path.join(trs[sp["kind"]], "R80721_2017-spring.csv"),
-                              "R80721_2017-spring")
+            nodes = [c["node"] for c in json.load(open(os.path.join(d, "calibration.json")))["channels"]]
+            for t in ("R80711_2017-spring", "R80721_2017-spring"):
+                residual_analysis(os.path.join(d, "fit.csv"), os.path.join(trs[sp["kind"]], f"{t}.csv"), t,
+                                  node="sump" if "sump" in nodes else nodes[0])
             print()
     print_summary(results) if not a.variants else print_variants(results)
     print(f"load {load0:.1f} before, {os.getloadavg()[0]:.1f} after")

@@ -240,6 +240,14 @@ fn a_prediction_takes_its_band_from_a_calibration() {
     p.band_from(&json, "cal.json").unwrap();
     let r = calibrate::fit(&model, &p, &predict).unwrap();
     let sd = cal.summary.channels[0].noise.marginal_sd_k;
+    // The band's multiplier is the calibration's, channel by channel.
+    for (a, b) in r.summary.channels.iter().zip(&cal.summary.channels) {
+        assert_eq!(
+            (a.noise.band_multiplier, a.noise.band_quantile),
+            (b.noise.band_multiplier, b.noise.band_quantile)
+        );
+    }
+    let mult = cal.summary.channels[0].noise.band_multiplier;
     let inside = r.summary.channels[0]
         .holdout
         .unwrap()
@@ -248,8 +256,8 @@ fn a_prediction_takes_its_band_from_a_calibration() {
     assert!(inside > 0.8, "{inside}");
     for line in r.fit_csv.lines().skip(1) {
         let band: f64 = line.split(',').nth(5).unwrap().parse().unwrap();
-        // fit.csv writes the band to 6 decimals: the floor t·sd is compared as written.
-        let floor = (cal.summary.fit.t975 * sd * 1e6).round() / 1e6;
+        // fit.csv writes the band to 6 decimals: the floor multiplier·sd is compared as written.
+        let floor = (mult * sd * 1e6).round() / 1e6;
         assert!(band >= floor, "{band} vs {floor}");
     }
     // Without --band-from the prediction has no band.
@@ -265,6 +273,29 @@ fn a_prediction_takes_its_band_from_a_calibration() {
     let e = p.band_from(&json, "cal.json").unwrap_err();
     assert!(e.exit_code() == 1 && e.to_string().contains("band_from"), "{e}");
     let mut v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    // A calibration.json without multipliers gives its t quantile; a multiplier not above 0 is
+    // refused, naming the file and the channel.
+    for c in v["channels"].as_array_mut().unwrap() {
+        c["noise"].as_object_mut().unwrap().remove("band_multiplier");
+    }
+    let mut p = calibrate::prepare(&model, &cal.calibrated_model, &t, &predict).unwrap();
+    p.band_from(&v.to_string(), "cal.json").unwrap();
+    let r = calibrate::fit(&model, &p, &predict).unwrap();
+    assert_eq!(r.summary.channels[0].noise.band_multiplier, cal.summary.fit.t975);
+    assert_eq!(r.summary.channels[0].noise.band_quantile, "t");
+    v["channels"][0]["noise"]["band_multiplier"] = serde_json::json!(-1.0);
+    let mut p = calibrate::prepare(&model, &cal.calibrated_model, &t, &predict).unwrap();
+    let e = p.band_from(&v.to_string(), "cal.json").unwrap_err();
+    assert!(
+        e.exit_code() == 1
+            && e.to_string()
+                .contains("cal.json: channels (oil): band multiplier -1"),
+        "{e}"
+    );
+    v["channels"][0]["noise"]
+        .as_object_mut()
+        .unwrap()
+        .remove("band_multiplier");
     v["channels"].as_array_mut().unwrap().pop();
     let mut p = calibrate::prepare(&model, &cal.calibrated_model, &t, &predict).unwrap();
     let e = p.band_from(&v.to_string(), "cal.json").unwrap_err();

@@ -379,13 +379,29 @@ fn bands_of_several_traces_from_a_calibration_over_several() {
     );
     assert_eq!(code, 0, "{err}");
     let j = json(&out.join("calibration.json"));
-    let t975 = json(&cal.join("calibration.json"))["fit"]["t975"]
-        .as_f64()
-        .unwrap();
+    let fitted = json(&cal.join("calibration.json"));
+    // Each trace's band multiplier is that of the calibration's trace of the same name.
+    let mut least = f64::INFINITY;
     for t in j["traces"].as_array().unwrap() {
-        for c in t["channels"].as_array().unwrap() {
+        let own = fitted["traces"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|x| x["name"] == t["name"])
+            .unwrap();
+        for (c, o) in t["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(own["channels"].as_array().unwrap())
+        {
             let inside = c["holdout"]["inside_band95"].as_f64().expect("a band");
             assert!(inside > 0.7, "{t}");
+            assert_eq!(
+                c["noise"]["band_multiplier"], o["noise"]["band_multiplier"],
+                "{t}"
+            );
+            least = least.min(o["noise"]["band_multiplier"].as_f64().unwrap());
         }
     }
     assert!(
@@ -398,7 +414,7 @@ fn bands_of_several_traces_from_a_calibration_over_several() {
         .unwrap();
     for line in csv.lines().skip(1) {
         let band: f64 = line.split(',').nth(7).unwrap().parse().unwrap();
-        assert!(band >= t975 * sd * (1.0 - 1e-5), "{line}: {t975} {sd}");
+        assert!(band >= least * sd * (1.0 - 1e-5), "{line}: {least} {sd}");
     }
     // One segment of trace a, predicted alone: a's parameters.
     let (code, _, err, _) = cli(

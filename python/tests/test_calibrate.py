@@ -57,6 +57,24 @@ def test_bad_traces_are_refused_like_the_cli():
     assert e.value.line == 5 and e.value.path == "node:oil"
     with pytest.raises(geartherm.GearthermError, match="max_iterations"):
         base.calibrate(rig(), fit=[H], max_iterations=0)
+    with pytest.raises(geartherm.GearthermError, match="band_quantile = normal"):
+        base.calibrate(rig(), fit=[H], band_quantile="normal")
+
+
+def test_the_band_multiplier_per_channel():
+    base = geartherm.Model.load(MODEL)
+    truth = base.override({H: 400.0, M: 11.0})
+    sim = truth.calibrate(rig(), holdout=[(0.0, 1e9)]).fit
+    values = [(a + 0.05 * math.sin(k), b - 0.05 * math.cos(k))
+              for k, (a, b) in enumerate(zip(sim["oil_simulated_c"], sim["housing_simulated_c"]))]
+    kw = dict(fit=[H, M], holdout=[(2400.0, 3600.0)])
+    # 21 fitted rows per channel are too few for the empirical quantile: the default is t's.
+    r = base.calibrate(rig(values), **kw)
+    t975 = r.summary["fit"]["t975"]
+    assert (r.errors["band_quantile"] == "t").all() and (r.errors["band_multiplier"] == t975).all()
+    t = base.calibrate(rig(values), band_quantile="t", **kw)
+    assert (t.errors["band_multiplier"] == t975).all()
+    assert list(t.fit["oil_band95_k"]) == list(r.fit["oil_band95_k"])
 
 
 def test_priors_profiles_bands_and_losses_as_dataframes(tmp_path):

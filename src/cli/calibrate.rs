@@ -61,6 +61,12 @@ pub struct CalibrateArgs {
     /// AR(1) errors) or independent.
     #[arg(long, default_value = "ar1", value_name = "ar1|ar1-gls|independent")]
     pub residuals: String,
+    /// The 95 % prediction band's multiplier of its standard deviation: empirical (the fitted
+    /// rows' own 95 % quantile of |residual|/sd, per channel and trace; Student's t when they
+    /// carry fewer than 100 effective independent rows) or t (Student's t(0.975, dof), for
+    /// Gaussian residuals).
+    #[arg(long, default_value = "empirical", value_name = "empirical|t")]
+    pub band_quantile: String,
     /// A prior on a fitted parameter (a MAP fit): KEYPATH=normal:MEAN:SD or
     /// KEYPATH=lognormal:MEDIAN:SD_LN (SD_LN the standard deviation of ln p; repeatable).
     #[arg(long, value_name = "KEYPATH=DIST:LOC:WIDTH")]
@@ -117,6 +123,7 @@ impl CalibrateArgs {
             segments,
             refuse_missing: self.refuse_missing,
             residuals: self.residuals.clone(),
+            band_quantile: self.band_quantile.clone(),
             prior: self.prior.clone(),
             profile: self.profile.clone(),
             gearbox_kind: self.gearbox_kind.clone(),

@@ -194,6 +194,7 @@ fn calibrate_options_round_trip() {
             traces: Vec::new(),
             segments: None,
             residuals: "independent".into(),
+            band_quantile: "t".into(),
             prior: vec!["thermal.nodes[\"oil\"].mass_kg=lognormal:2:0.5".into()],
             profile: vec!["thermal.nodes[\"oil\"].mass_kg".into()],
             gearbox_kind: Some("wind-turbine".into()),

@@ -184,6 +184,11 @@ pub struct Noise {
     pub marginal_sd_k: f64,
     /// Autocorrelation of the fitted rows' residuals at lags 1, 2 and 6 rows.
     pub autocorrelation_lag_1_2_6: [Option<f64>; 3],
+    /// The 95 % band's half-width over its standard deviation √(sᵀ·Cov·s + σ_a²/(1 − φ²)).
+    pub band_multiplier: f64,
+    /// How the multiplier was found: `empirical` (the fitted rows' 95 % quantile of
+    /// |residual|/sd) or `t` (Student's t(0.975, dof)).
+    pub band_quantile: &'static str,
 }
 
 /// One measured channel.
@@ -362,22 +367,31 @@ fn trace_table(s: &CalibrationSummary) -> String {
             format!("{:.3} / {:.3} / {band}", e.rmse_k, e.max_abs_k)
         })
     };
-    t.push_str("trace, channel            segments    rows   fitted rmse / max, K / in band   held-out rmse / max, K / in band\n");
+    t.push_str(
+        "trace, channel            segments    rows   fitted rmse / max, K / in band   held-out rmse / max, K / in band   \
+         band ×\n",
+    );
     for tr in &s.traces {
         for c in &tr.channels {
             t.push_str(&format!(
-                "  {} {}: {}, {:>8} {:>6} {:>32} {:>34}\n",
+                "  {} {}: {}, {:>8} {:>6} {:>32} {:>34}   {}\n",
                 tr.index,
                 tr.name,
                 c.node,
                 tr.segments.len(),
                 tr.rows,
                 e(&c.fitted),
-                e(&c.holdout)
+                e(&c.holdout),
+                multiplier(&c.noise)
             ));
         }
     }
     t
+}
+
+/// A channel's band multiplier and how it was found: `1.823 (empirical)`, `1.972 (t)`.
+fn multiplier(n: &Noise) -> String {
+    format!("{:.3} ({})", n.band_multiplier, n.band_quantile)
 }
 
 /// The calibrated losses at the highest-power rows and the rated point, each line starting
@@ -470,7 +484,7 @@ pub fn to_text(s: &CalibrationSummary) -> String {
     }
     t.push_str(
         "channel          fitted rmse / max, K / in band   held-out rmse / max, K / in band   \
-         φ     σ_a, K  acf lag 1, 2, 6\n",
+         φ     σ_a, K  acf lag 1, 2, 6      band ×\n",
     );
     for c in &s.channels {
         let e = |x: &Option<Errors>| {
@@ -488,13 +502,14 @@ pub fn to_text(s: &CalibrationSummary) -> String {
             .map(|a| a.map_or("—".into(), |v| format!("{v:.3}")))
             .collect();
         t.push_str(&format!(
-            "  {:<14} {:>32} {:>34}   {:.3} {:.3}  {}\n",
+            "  {:<14} {:>32} {:>34}   {:.3} {:.3}  {:<19}  {}\n",
             c.node,
             e(&c.fitted),
             e(&c.holdout),
             c.noise.phi,
             c.noise.innovation_sd_k,
-            acf.join(", ")
+            acf.join(", "),
+            multiplier(&c.noise)
         ));
     }
     t.push_str(&trace_table(s));

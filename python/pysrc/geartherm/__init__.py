@@ -659,6 +659,7 @@ class Model:
         missing: Literal["drop", "refuse"] = "drop",
         name: Optional[str] = None,
         residuals: Optional[Literal["ar1", "ar1-gls", "independent"]] = None,
+        band_quantile: Optional[Literal["empirical", "t"]] = None,
         prior: Union[Mapping[str, Tuple[str, float, float]], Sequence[str]] = (),
         priors_file: Optional[PathLike] = None,
         profile: Sequence[str] = (),
@@ -694,6 +695,12 @@ class Model:
             The trace's name in messages (default: its path, or ``trace``).
         residuals : {"ar1", "ar1-gls", "independent"}, optional
             The residual model (``--residuals``; default ``ar1``).
+        band_quantile : {"empirical", "t"}, optional
+            The 95 % band's multiplier of its standard deviation (``--band-quantile``; default
+            ``empirical``: the fitted rows' own 95 % quantile of |residual|/sd per channel and
+            trace, Student's t when they are too few; ``t``: Student's t, Gaussian residuals).
+            :attr:`CalibrationResult.errors` has it per channel (``band_multiplier``,
+            ``band_quantile``).
         prior : mapping or sequence of str
             Priors (a MAP fit): ``{key_path: ("normal", mean, sd)}`` or
             ``{key_path: ("lognormal", median, sd_ln)}``, or ``--prior`` strings
@@ -749,6 +756,8 @@ class Model:
         o["profile"] = [str(k) for k in profile]
         if residuals is not None:
             o["residuals"] = residuals
+        if band_quantile is not None:
+            o["band_quantile"] = band_quantile
         if gearbox_kind is not None:
             o["gearbox_kind"] = gearbox_kind
         if rated is not None:

@@ -37,7 +37,8 @@ class CalibrationResult:
         Parameters × parameters.
     errors : pandas.DataFrame
         Per measured channel and part (``rows_of``: ``fitted``, ``holdout``): ``rows``,
-        ``rmse_k``, ``max_abs_k``, ``bias_k``.
+        ``rmse_k``, ``max_abs_k``, ``bias_k``, ``inside_band95``, and the band's multiplier of
+        its standard deviation (``band_multiplier``; ``band_quantile``: ``empirical`` or ``t``).
     fit : pandas.DataFrame
         ``fit.csv``: ``time_s``, ``held_out``, and per channel ``<node>_measured_c``,
         ``<node>_simulated_c``, ``<node>_residual_k``, ``<node>_band95_k`` (the 95 % prediction
@@ -88,7 +89,9 @@ class CalibrationResult:
             for part in ("fitted", "holdout"):
                 e = ch[part]
                 if e is not None:
-                    rows.append({"node": ch["node"], "rows_of": part, **e})
+                    rows.append({"node": ch["node"], "rows_of": part, **e,
+                                 "band_multiplier": ch["noise"]["band_multiplier"],
+                                 "band_quantile": ch["noise"]["band_quantile"]})
         self.errors: "pandas.DataFrame" = pd.DataFrame(rows)
         self.fit: "pandas.DataFrame" = frame(fit_csv, text=("trace",))
         for ch in s["channels"]:

@@ -107,6 +107,10 @@ pub struct CalibrateOptions {
     /// Residual model: `ar1` (least squares; intervals and bands from per channel AR(1)
     /// errors), `ar1-gls` (generalised least squares under those errors) or `independent`.
     pub residuals: String,
+    /// The prediction band's multiplier: `empirical` (the fitted rows' 95 % quantile of
+    /// |residual|/sd, t when they carry fewer than [`bands::MIN_EFFECTIVE_ROWS`] effective
+    /// rows) or `t` (Student's t(0.975, dof), Gaussian residuals).
+    pub band_quantile: String,
     /// Priors: `KEYPATH=normal:MEAN:SD` or `KEYPATH=lognormal:MEDIAN:SD_LN` (a MAP fit).
     pub prior: Vec<String>,
     /// Parameters (fitted key paths) whose profile likelihood is computed.
@@ -145,6 +149,7 @@ impl Default for CalibrateOptions {
             segments: None,
             refuse_missing: false,
             residuals: "ar1".into(),
+            band_quantile: "empirical".into(),
             prior: Vec::new(),
             profile: Vec::new(),
             gearbox_kind: None,
@@ -194,6 +199,15 @@ impl CalibrateOptions {
                 "residuals",
                 &self.residuals,
                 "ar1, ar1-gls or independent",
+                msg,
+            ));
+        }
+        if !["empirical", "t"].contains(&self.band_quantile.as_str()) {
+            let msg = format!("band_quantile = {}: must be empirical or t", self.band_quantile);
+            return Err(JobError::option(
+                "band_quantile",
+                &self.band_quantile,
+                "empirical or t",
                 msg,
             ));
         }
@@ -835,9 +849,9 @@ fn channel_errors(
     p: &Prepared<'_>,
     f: &Fitted,
     temps_c: &[Vec<f64>],
-    band: &[Vec<f64>],
-    band_known: bool,
+    (band, band_known): (&[Vec<f64>], bool),
     noise: &[residuals::Ar1],
+    mult: &[bands::Multiplier],
 ) -> Vec<ChannelErrors> {
     let pr = &p.problem;
     pr.trace
@@ -863,10 +877,50 @@ fn channel_errors(
                     innovation_sd_k: noise[c].sigma,
                     marginal_sd_k: noise[c].marginal_sd(),
                     autocorrelation_lag_1_2_6: acf,
+                    band_multiplier: mult[c].value,
+                    band_quantile: mult[c].kind(),
                 },
             }
         })
         .collect()
+}
+
+/// The band's half-widths `[row][channel]`, each channel's multiplier and whether the band is
+/// known (a run that fits no row and takes no band from a calibration has none): with
+/// `--band-from` that calibration's processes and multipliers; else the fit's covariance `cov`
+/// and processes `noise`, each channel's multiplier from its fitted rows (`--band-quantile`,
+/// [`bands::multiplier`]; `t` Student's quantile of the fit).
+fn band_of(
+    p: &Prepared<'_>,
+    o: &CalibrateOptions,
+    sim: &problem::Simulation,
+    cov: &[Vec<f64>],
+    noise: &[residuals::Ar1],
+    t: f64,
+) -> (Vec<Vec<f64>>, Vec<bands::Multiplier>, bool) {
+    if let Some(b) = &p.band_source {
+        let sd = bands::sds(sim, &b.covariance, &b.noise);
+        return (bands::scaled(&sd, &b.multipliers), b.multipliers.clone(), true);
+    }
+    let sd = bands::sds(sim, cov, noise);
+    let measured = &p.problem.trace.measured;
+    let res: Vec<Vec<f64>> = (0..sim.temps_c.len())
+        .map(|r| {
+            measured
+                .iter()
+                .enumerate()
+                .map(|(c, ch)| sim.temps_c[r][c] - ch.values_c[r])
+                .collect()
+        })
+        .collect();
+    let fitted: Vec<usize> = (0..p.held.len()).filter(|&r| !p.held[r]).collect();
+    let how = bands::Quantile::of(&o.band_quantile);
+    let mult: Vec<bands::Multiplier> = noise
+        .iter()
+        .enumerate()
+        .map(|(c, a)| bands::multiplier(&bands::standardised(&res, &sd, &fitted, c), a.phi, t, how))
+        .collect();
+    (bands::scaled(&sd, &mult), mult, !fitted.is_empty())
 }
 
 /// The cycle columns of the trace as a cycle file.
@@ -980,13 +1034,7 @@ fn assemble(
         };
         vec![a; pr.channels.len()]
     });
-    let (band, band_known) = match &p.band_source {
-        Some(b) => (bands::half_widths(&sim, &b.covariance, &b.noise, b.t975), true),
-        None => (
-            bands::half_widths(&sim, &lin.covariance, &noise, t),
-            !f.layout.stretch.is_empty(),
-        ),
-    };
+    let (band, mult, band_known) = band_of(p, o, &sim, &lin.covariance, &noise, t);
     let rated = o.rated.as_deref().map(plausibility::rated_point).transpose()?;
     let plausibility = plausibility::assess(
         &[(pr, &sim.temps_c)],
@@ -1019,7 +1067,7 @@ fn assemble(
         ));
     }
     let noise = p.band_source.as_ref().map_or(noise, |b| b.noise.clone());
-    let channels = channel_errors(p, f, &sim.temps_c, &band, band_known, &noise);
+    let channels = channel_errors(p, f, &sim.temps_c, (&band, band_known), &noise, &mult);
     let nodes: Vec<String> = pr.trace.measured.iter().map(|c| c.name.clone()).collect();
     let measured: Vec<Vec<f64>> = pr.trace.measured.iter().map(|c| c.values_c.clone()).collect();
     let csv = fit_csv(&pr.trace.times, &p.held, &nodes, &measured, &sim.temps_c, &band);
@@ -1188,6 +1236,7 @@ impl super::command::ToArgs for CalibrateOptions {
             a.push(flag("refuse_missing"));
         }
         a.extend([flag("residuals"), self.residuals.clone()]);
+        a.extend([flag("band_quantile"), self.band_quantile.clone()]);
         for p in &self.prior {
             a.extend([flag("prior"), p.clone()]);
         }

@@ -144,26 +144,22 @@ fn final_sims(s: &Stack<'_>, theta: &[f64]) -> Result<Vec<Simulation>, JobError>
 /// Per segment: residual and band half-width, `[row][channel]` in the stack's channel order.
 type Rows = Vec<(Vec<Vec<f64>>, Vec<Vec<f64>>)>;
 
-fn residual_rows(
-    s: &Stack<'_>,
-    sims: &[Simulation],
-    cov: &[Vec<f64>],
-    noise: &[Ar1],
-    t: f64,
-) -> Result<Rows, JobError> {
+/// Per segment: residual and band standard deviation, `[row][channel]` in the stack's channel
+/// order (with `--band-from` the calibration's covariance and processes; else the fit's).
+fn residual_sds(s: &Stack<'_>, sims: &[Simulation], cov: &[Vec<f64>], noise: &[Ar1]) -> Rows {
     use rayon::prelude::*;
     (0..sims.len())
         .into_par_iter()
         .map(|k| {
             let (g, sim) = (&s.segments[k], &sims[k]);
-            let half = match s.bands.get(k) {
-                Some(b) => bands::half_widths(sim, &b.covariance, &b.noise, b.t975),
+            let sd = match s.bands.get(k) {
+                Some(b) => bands::sds(sim, &b.covariance, &b.noise),
                 None => {
                     let mut local = noise.to_vec();
                     for (c, &col) in g.perm.iter().enumerate() {
                         local[col] = noise[c];
                     }
-                    bands::half_widths(sim, &local_cov(s, k, cov), &local, t)
+                    bands::sds(sim, &local_cov(s, k, cov), &local)
                 }
             };
             let res = (0..sim.temps_c.len())
@@ -174,11 +170,63 @@ fn residual_rows(
                         .collect()
                 })
                 .collect();
-            let half = half
+            let sd = sd
                 .iter()
                 .map(|h| g.perm.iter().map(|&c| h[c]).collect())
                 .collect();
-            Ok((res, half))
+            (res, sd)
+        })
+        .collect()
+}
+
+/// The band multipliers per channel (stack order): of each trace (from its segments' fitted
+/// rows) and of every trace's fitted rows together (`calibration.json`'s `channels`); with
+/// `--band-from` the calibration's, per segment's trace.
+struct Multipliers {
+    /// Per trace.
+    traces: Vec<Vec<bands::Multiplier>>,
+    /// Every trace's rows together.
+    all: Vec<bands::Multiplier>,
+}
+
+fn multipliers(s: &Stack<'_>, rows: &Rows, noise: &[Ar1], t: f64, o: &CalibrateOptions) -> Multipliers {
+    let how = bands::Quantile::of(&o.band_quantile);
+    let of = |which: &[usize]| -> Vec<bands::Multiplier> {
+        if let Some(b) = which.first().and_then(|&k| s.bands.get(k)) {
+            return s.segments[which[0]]
+                .perm
+                .iter()
+                .map(|&c| b.multipliers[c])
+                .collect();
+        }
+        (0..s.nodes.len())
+            .map(|c| {
+                let mut z = Vec::new();
+                for &k in which {
+                    let fitted: Vec<usize> = (0..s.segments[k].held.len())
+                        .filter(|&r| !s.segments[k].held[r])
+                        .collect();
+                    z.extend(bands::standardised(&rows[k].0, &rows[k].1, &fitted, c));
+                }
+                bands::multiplier(&z, noise[c].phi, t, how)
+            })
+            .collect()
+    };
+    let all: Vec<usize> = (0..s.segments.len()).collect();
+    Multipliers {
+        traces: (0..s.names.len()).map(|ti| of(&segments_of(s, ti))).collect(),
+        all: of(&all),
+    }
+}
+
+/// Per segment: residual and band half-width (its standard deviation times its trace's
+/// multiplier).
+fn residual_rows(s: &Stack<'_>, sds: Rows, mult: &Multipliers) -> Rows {
+    sds.into_iter()
+        .enumerate()
+        .map(|(k, (res, sd))| {
+            let half = bands::scaled(&sd, &mult.traces[s.segments[k].trace]);
+            (res, half)
         })
         .collect()
 }
@@ -225,7 +273,7 @@ fn channel_table(
 
 /// The residual process per channel, with the autocorrelation of the stacked fitted residuals
 /// (pairs within a stretch).
-fn noise_table(f: &Fitted, noise: &[Ar1]) -> Vec<Noise> {
+fn noise_table(f: &Fitted, noise: &[Ar1], mult: &[bands::Multiplier]) -> Vec<Noise> {
     let layout: &Layout = &f.layout;
     noise
         .iter()
@@ -237,6 +285,8 @@ fn noise_table(f: &Fitted, noise: &[Ar1]) -> Vec<Noise> {
                 innovation_sd_k: a.sigma,
                 marginal_sd_k: a.marginal_sd(),
                 autocorrelation_lag_1_2_6: [1, 2, 6].map(|lag| layout.autocorrelation(&x, lag)),
+                band_multiplier: mult[c].value,
+                band_quantile: mult[c].kind(),
             }
         })
         .collect()
@@ -395,7 +445,7 @@ fn trace_reports(
     s: &Stack<'_>,
     sims: &[Simulation],
     rows: &Rows,
-    (noise, known): (&[Noise], bool),
+    (noise, known, mult): (&[Noise], bool, &Multipliers),
     o: &CalibrateOptions,
     theta: &[f64],
     warnings: &mut Vec<String>,
@@ -410,13 +460,22 @@ fn trace_reports(
             } else {
                 None
             };
+            let own: Vec<Noise> = noise
+                .iter()
+                .zip(&mult.traces[ti])
+                .map(|(n, m)| Noise {
+                    band_multiplier: m.value,
+                    band_quantile: m.kind(),
+                    ..n.clone()
+                })
+                .collect();
             Ok(TraceErrors {
                 name: s.names[ti].clone(),
                 source: s.sources[ti].clone(),
                 index: ti,
                 segments: which.iter().map(|&k| s.segments[k].index).collect(),
                 rows: which.iter().map(|&k| s.segments[k].held.len()).sum(),
-                channels: channel_table(s, rows, &which, noise, known),
+                channels: channel_table(s, rows, &which, &own, known),
                 plausibility,
             })
         })
@@ -484,10 +543,12 @@ fn assemble(
     let identifiability = identifiability(&s.params, &lin, t, &mut warnings);
     let sims = final_sims(s, &res.theta)?;
     let fit_noise = f.noise.clone().unwrap_or_else(|| channel_noise(s, f, lin.sigma2));
-    let rows = residual_rows(s, &sims, &lin.covariance, &fit_noise, t)?;
+    let sds = residual_sds(s, &sims, &lin.covariance, &fit_noise);
+    let mult = multipliers(s, &sds, &fit_noise, t, o);
+    let rows = residual_rows(s, sds, &mult);
     let known = !f.layout.stretch.is_empty() || !s.bands.is_empty();
     let ar = channel_noise(s, f, lin.sigma2);
-    let noise = noise_table(f, &ar);
+    let noise = noise_table(f, &ar, &mult.all);
     let all: Vec<usize> = (0..s.segments.len()).collect();
     let channels = channel_table(s, &rows, &all, &noise, known);
     let plausibility = if s.owners.iter().any(Option::is_some) {
@@ -495,7 +556,15 @@ fn assemble(
     } else {
         plausibility_of(s, &sims, &all, &res.theta, o, "", &mut warnings)?
     };
-    let traces = trace_reports(s, &sims, &rows, (&noise, known), o, &res.theta, &mut warnings)?;
+    let traces = trace_reports(
+        s,
+        &sims,
+        &rows,
+        (&noise, known, &mult),
+        o,
+        &res.theta,
+        &mut warnings,
+    )?;
     let profiles = profiles_of(s, f, eval, &fit_noise, &lin, &mut warnings)?;
     let covariance: Vec<Vec<Option<f64>>> = lin
         .covariance

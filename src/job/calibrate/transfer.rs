@@ -1,7 +1,10 @@
 //! The prediction band of a calibrated model on another trace (`--band-from calibration.json`):
 //! the previous calibration's covariance of its fitted coordinates carried through the
 //! sensitivities on this trace, plus each channel's residual process as that calibration
-//! estimated it (the same half-width formula as [`super::bands`]). The model run is the
+//! estimated it, and each channel's band multiplier (the same half-width formula as
+//! [`super::bands`]; of a calibration over several traces the multiplier of the trace of the
+//! same name, else that of every trace's rows together; a `calibration.json` without
+//! multipliers gives its t quantile). The model run is the
 //! calibrated one (`calibrated.toml`): the parameters are evaluated at the values it holds,
 //! except a parameter of one trace in a calibration over several (`KEYPATH@X`), which a
 //! prediction of trace X takes at the calibration's value for X (the model file holds one
@@ -9,6 +12,7 @@
 
 use serde::Deserialize;
 
+use super::bands::Multiplier;
 use super::params::{FitSpec, Parameter};
 use super::problem::Problem;
 use super::residuals::Ar1;
@@ -27,12 +31,20 @@ struct JsonParameter {
 struct JsonNoise {
     phi: f64,
     innovation_sd_k: f64,
+    band_multiplier: Option<f64>,
+    band_quantile: Option<String>,
 }
 
 #[derive(Deserialize)]
 struct JsonChannel {
     node: String,
     noise: JsonNoise,
+}
+
+#[derive(Deserialize)]
+struct JsonTrace {
+    name: String,
+    channels: Vec<JsonChannel>,
 }
 
 #[derive(Deserialize)]
@@ -46,6 +58,8 @@ struct JsonCalibration {
     covariance: Vec<Vec<Option<f64>>>,
     channels: Vec<JsonChannel>,
     fit: JsonFit,
+    #[serde(default)]
+    traces: Vec<JsonTrace>,
 }
 
 /// A previous calibration's uncertainty, mapped onto this trace.
@@ -56,8 +70,8 @@ pub struct BandSource<'a> {
     pub covariance: Vec<Vec<f64>>,
     /// Each channel's residual process.
     pub noise: Vec<Ar1>,
-    /// The t quantile of that calibration.
-    pub t975: f64,
+    /// Each channel's band multiplier.
+    pub multipliers: Vec<Multiplier>,
 }
 
 /// The calibration's parameters a prediction of trace `name` takes: the shared ones and those of
@@ -137,6 +151,7 @@ pub fn band_source<'a>(
         params.push(p);
     }
     let mut noise = Vec::with_capacity(base.trace.measured.len());
+    let mut multipliers = Vec::with_capacity(base.trace.measured.len());
     for m in &base.trace.measured {
         let ch = c.channels.iter().find(|x| x.node == m.name).ok_or_else(|| {
             bad(format!(
@@ -148,6 +163,7 @@ pub fn band_source<'a>(
             phi: ch.noise.phi,
             sigma: ch.noise.innovation_sd_k,
         });
+        multipliers.push(multiplier_of(&c, ch, name, file)?);
     }
     let covariance = kept
         .iter()
@@ -162,8 +178,41 @@ pub fn band_source<'a>(
         problem,
         covariance,
         noise,
-        t975: c.fit.t975,
+        multipliers,
     })
+}
+
+/// Channel `ch`'s band multiplier for trace `name`: that of the calibration's trace of that
+/// name, else the channel's, else the calibration's t quantile; invalid input (naming the file)
+/// when not a finite number above 0.
+fn multiplier_of(
+    c: &JsonCalibration,
+    ch: &JsonChannel,
+    name: &str,
+    file: &str,
+) -> Result<Multiplier, JobError> {
+    let own = c
+        .traces
+        .iter()
+        .filter(|t| t.name == name)
+        .flat_map(|t| t.channels.iter())
+        .find(|x| x.node == ch.node);
+    let noise = &own.unwrap_or(ch).noise;
+    let m = match noise.band_multiplier {
+        Some(v) => Multiplier {
+            value: v,
+            empirical: noise.band_quantile.as_deref() == Some("empirical"),
+        },
+        None => Multiplier::t(c.fit.t975),
+    };
+    if m.value.is_finite() && m.value > 0.0 {
+        Ok(m)
+    } else {
+        Err(JobError::invalid(format!(
+            "{file}: channels ({}): band multiplier {} must be a finite number above 0",
+            ch.node, m.value
+        )))
+    }
 }
 
 /// A trace's name from its source: the file's stem (as `calibrate --trace` names it).
