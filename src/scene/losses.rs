@@ -20,6 +20,7 @@ use super::gear_losses::{
 use super::sample_cache::{law_powers, sample_key, CacheParts, CacheUse, SampleCache};
 use super::usage::Usage;
 use super::warning::RangeWarning;
+use crate::physics::losses::sliding::PowerLaw;
 use crate::physics::losses::windage::AIR;
 use crate::physics::lubrication::{mixture_density, oil_fraction};
 
@@ -243,38 +244,8 @@ impl LossScene {
         }
         let st = &self.states[state];
         let (t, w) = (input_torque, input_speed);
-        // P(T, ω) = P(sign(T·ω)·1 N·m, 1 rad/s)·|T|^a·|ω|^b: reversing both T and ω leaves the
-        // power flow and every magnitude unchanged.
-        let dir = usize::from(t * w < 0.0);
-        // Meshes with the same friction law share their powers of |T| and |ω| (the last law is
-        // remembered; the same values as computing them per mesh); an attached cache holds the
-        // same two factors per entry for this sample (`law_powers`).
-        let mut memo = (None, [0.0; 2]);
         let cached_powers = cached.and_then(|(c, i)| c.slide_powers(i));
-        for (k, ((e, unit), u)) in self
-            .slide
-            .iter()
-            .zip(&st.slide_unit)
-            .zip(&mut terms.slide_unit)
-            .enumerate()
-        {
-            if let Some(law) = e.law {
-                *u = if t == 0.0 || w == 0.0 {
-                    0.0
-                } else {
-                    let [pt, pw] = match cached_powers {
-                        Some(p) => p[k],
-                        None => {
-                            if memo.0 != Some(law) {
-                                memo = (Some(law), law_powers(&law, t, w));
-                            }
-                            memo.1
-                        }
-                    };
-                    unit[dir] * pt * pw
-                };
-            }
-        }
+        self.prepare_sliding(st, t, w, cached_powers, &mut terms.slide_unit);
         match cached.and_then(|(c, i)| c.bearing_terms(i)) {
             Some(b) => terms.bearing.copy_from_slice(b),
             None => self.elements.prepare(state, w, t, &mut terms.bearing),
@@ -288,6 +259,44 @@ impl LossScene {
         terms.prepared += 1;
     }
 
+    /// Each sliding entry's loss at η = 1 Pa·s for torque `t` and speed `w` in state `st` into
+    /// `units` (entries without a power law are left as they are), with the powers of |T| and
+    /// |ω| of an attached cache's sample when given (`cached`, one pair per entry).
+    fn prepare_sliding(
+        &self,
+        st: &StateFactors,
+        t: f64,
+        w: f64,
+        cached: Option<&[[f64; 2]]>,
+        units: &mut [f64],
+    ) {
+        // P(T, ω) = P(sign(T·ω)·1 N·m, 1 rad/s)·|T|^a·|ω|^b: reversing both T and ω leaves the
+        // power flow and every magnitude unchanged.
+        let dir = usize::from(t * w < 0.0);
+        // Meshes with the same friction law share their powers of |T| and |ω| (the last law is
+        // remembered; the same values as computing them per mesh); a cache holds the same two
+        // factors per entry for the sample (`law_powers`).
+        let mut memo = (None, [0.0; 2]);
+        let mut powers = |k: usize, law: PowerLaw| match cached {
+            Some(p) => p[k],
+            None => {
+                if memo.0 != Some(law) {
+                    memo = (Some(law), law_powers(&law, t, w));
+                }
+                memo.1
+            }
+        };
+        for (k, ((e, unit), u)) in self.slide.iter().zip(&st.slide_unit).zip(units).enumerate() {
+            let Some(law) = e.law else { continue };
+            *u = if t == 0.0 || w == 0.0 {
+                0.0
+            } else {
+                let [pt, pw] = powers(k, law);
+                unit[dir] * pt * pw
+            };
+        }
+    }
+
     /// The bearings' load terms and the pump and converter values of every sample of `inputs`
     /// (a cycle's segments: state, input speed, input torque, vehicle speed), computed once for
     /// this scene's compiled parts.
@@ -296,7 +305,7 @@ impl LossScene {
     }
 
     /// The power law of every sliding entry (None: evaluated in full).
-    fn slide_laws(&self) -> Vec<Option<crate::physics::losses::sliding::PowerLaw>> {
+    fn slide_laws(&self) -> Vec<Option<PowerLaw>> {
         self.slide.iter().map(|e| e.law).collect()
     }
 
