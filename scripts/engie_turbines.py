@@ -74,6 +74,9 @@ FITS = {
 FULL = 'thermal.coolers["oil_cooler"].thermostat.full_c'
 MASS = 'thermal.nodes["gearbox"].mass_kg=1000:60000'
 NACELLE_AIR = ['thermal.coolers["oil_cooler"].cold="nacelle"']
+# The cooler's fan at a fixed speed: its air stream's capacity rate (the fitted one, stated at
+# 15 °C) follows the air's density, T_ref/T_air (docs/physics.md, "Fixed-speed fan cooler").
+AIR_DENSITY = ['thermal.coolers["oil_cooler"].air_density_reference_c=15.0']
 # The S–K refinements start from 30 (written as a float: a two-trace fit given an integer
 # literal, `--set losses.multiplier.churning=30`, refuses the key as influencing no trace).
 SK30 = SEETHARAMAN + ["losses.multiplier.churning=30.0"]
@@ -154,6 +157,8 @@ def variants():
                                             BOTH, SK30),
         "S–K, full_c fitted (58.6–75)": spec(SHARED + [f"{CAP}@*=100:30000", f"{OPEN}=45:58.5", f"{FULL}=58.6:75"],
                                             BOTH, SK30),
+        "S–K, cooler air density (fixed-speed fan)": spec(
+            SHARED + [f"{CAP}@*=100:30000", f"{OPEN}=45:61"], BOTH, SEETHARAMAN + AIR_DENSITY),
         "S–K, four channels": spec(base + CHANNEL_KEYS, BOTH, SEETHARAMAN + four_starts(0.55, 85, 5000, 57.2),
                                    model="models/mm82_wind_gearbox.toml", kind="four"),
     }

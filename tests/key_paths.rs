@@ -85,6 +85,7 @@ hot = "sump"
 cold = "coolant"
 effectiveness = 0.5
 capacity_rate_w_per_k = 40.0
+air_density_reference_c = 20.0
 
 [[thermal.controls]]
 name = "fan"

@@ -170,9 +170,58 @@ pub fn thermostat_opening(t: f64, t_open: f64, t_full: f64) -> (f64, f64) {
     }
 }
 
+/// Lowest air temperature (K) at which [`fixed_fan_density_factor`] follows 1/T; below it the
+/// factor is held (no air the model meets is that cold; a Newton iterate can pass there).
+pub const FAN_AIR_FLOOR_K: f64 = 100.0;
+
+/// Capacity-rate factor of an air stream moved by a fan at fixed speed, at air temperature
+/// `t_air` (K) relative to the air temperature `t_ref` (K) at which the capacity rate is
+/// stated: `T_ref / T_air`. Returns (factor, d factor / dT_air = −T_ref / T_air²).
+///
+/// A fan at fixed speed is a constant-volume machine: its volume flow does not change with the
+/// air's density (Process Heating, "Fan laws and formulas",
+/// <https://www.process-heating.com/articles/87634-fan-laws-and-formulas>: "the fan is
+/// essentially a constant volume machine when run at a constant speed, the volume will not
+/// vary with a change in density"; the fan affinity laws' density change, Q₂ = Q₁). Its mass
+/// flow ṁ = ρ·V̇ is then proportional to the density, and at constant pressure the ideal gas
+/// law gives ρ = p/(R·T) ∝ 1/T; with c_p of air taken constant, the air's capacity rate ṁ·c_p
+/// scales as T_ref/T_air. \[derived\] The effectiveness ε is held: the change of the air-side
+/// heat-transfer coefficient and of NTU with the mass flow is not modelled. Below
+/// [`FAN_AIR_FLOOR_K`] the factor is held at its value there (slope 0), so it stays finite.
+pub fn fixed_fan_density_factor(t_air: f64, t_ref: f64) -> (f64, f64) {
+    if t_air < FAN_AIR_FLOOR_K {
+        return (t_ref / FAN_AIR_FLOOR_K, 0.0);
+    }
+    let f = t_ref / t_air;
+    (f, -f / t_air)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The fan's density factor: 1 at the reference, −5 % from 10 to 25 °C (283.15/298.15),
+    /// its slope against a central difference, held below the floor.
+    #[test]
+    fn fixed_fan_density_factor_is_t_ref_over_t() {
+        let (f, _) = fixed_fan_density_factor(288.15, 288.15);
+        assert_eq!(f, 1.0);
+        let (a, _) = fixed_fan_density_factor(283.15, 288.15);
+        let (b, _) = fixed_fan_density_factor(298.15, 288.15);
+        assert!((b / a - 283.15 / 298.15).abs() < 1e-15);
+        assert!((b / a - 0.9497).abs() < 1e-4, "{}", b / a);
+        for t in [250.0, 290.0, 330.0] {
+            let (_, d) = fixed_fan_density_factor(t, 288.15);
+            let h = 1e-4;
+            let fd = (fixed_fan_density_factor(t + h, 288.15).0 - fixed_fan_density_factor(t - h, 288.15).0)
+                / (2.0 * h);
+            assert!((d - fd).abs() < 1e-9 * d.abs(), "{t}: {d} vs {fd}");
+        }
+        assert_eq!(
+            fixed_fan_density_factor(-5.0, 288.15),
+            (288.15 / FAN_AIR_FLOOR_K, 0.0)
+        );
+    }
 
     #[test]
     fn table_interpolates_and_clamps() {

@@ -11,8 +11,9 @@ use crate::model::gearbox::{GearMount, Gearbox};
 use crate::model::thermal::{BoundaryTemp, Fluid, HeatTarget, LinkLaw, NodeRef, ThermalNetwork};
 use crate::physics::oil::{Oil, OilLogSlopes, OilProperties};
 use crate::physics::thermal::{
-    h_power_law, radiation_derivative, radiation_power, rotating_disc_h, rotating_disc_h_slope_with,
-    thermostat_opening, FluidProperties, HTable, AIR_50C, OIL_CONDUCTIVITY, OIL_SPECIFIC_HEAT,
+    fixed_fan_density_factor, h_power_law, radiation_derivative, radiation_power, rotating_disc_h,
+    rotating_disc_h_slope_with, thermostat_opening, FluidProperties, HTable, AIR_50C, OIL_CONDUCTIVITY,
+    OIL_SPECIFIC_HEAT,
 };
 
 use super::controls::{Action, ControlTerm, EVENTS_PER_CONTROL, ROWS_PER_CONTROL, ROWS_PER_PI};
@@ -113,9 +114,30 @@ struct CoolerTerm {
     two_way: bool,
     /// The controller that scales it (two-point or valve), if any.
     control: Option<usize>,
+    /// Air temperature (K) at which `g` holds for a fixed-speed fan's air stream: `g` scales as
+    /// this over the cold side's temperature. None: fixed.
+    air_ref: Option<f64>,
 }
 
 impl CoolerTerm {
+    /// Conductance ε·C_min (W/K) at cold-side temperature `tc` (K) and its derivative d/dT_cold:
+    /// fixed, or a fixed-speed fan's air stream following the air's density
+    /// ([`fixed_fan_density_factor`]).
+    #[inline]
+    fn conductance(&self, tc: f64) -> (f64, f64) {
+        self.air_ref.map_or((self.g, 0.0), |r| {
+            let (f, df) = fixed_fan_density_factor(tc, r);
+            (self.g * f, self.g * df)
+        })
+    }
+
+    /// ∂q/∂T_cold of the heat flow q = g(T_cold)·x·(T_hot − T_cold) at opening `x` (which does
+    /// not follow T_cold): x·(g′·(T_hot − T_cold) − g).
+    #[inline]
+    fn cold_slope(g: f64, dg: f64, x: f64, th: f64, tc: f64) -> f64 {
+        x * (dg * (th - tc) - g)
+    }
+
     /// Opening x and dx/dT_hot at hot-side temperature `th` and cold-side `tc`: a two-way
     /// exchanger is fully open while the cold side is warmer (it heats the oil); otherwise the
     /// thermostat, if any, sets the opening.
@@ -409,6 +431,7 @@ fn cooler_terms(net: &ThermalNetwork) -> Vec<CoolerTerm> {
                 thermostat: c.thermostat,
                 two_way: c.two_way,
                 control: None,
+                air_ref: c.air_density_reference_k,
             }),
             NodeRef::Boundary(_) => None,
         })
@@ -767,7 +790,7 @@ impl ThermalScene {
             let th = temps[c.hot];
             let tc = Self::temp(c.cold, temps, bt);
             let x = c.opening_controlled(&self.controls, work, temps, th, tc).0;
-            let q = c.g * x * (th - tc);
+            let q = c.conductance(tc).0 * x * (th - tc);
             Self::flow(End::Node(c.hot), c.cold, q, heat, &mut to_b);
         }
         for (c, &m) in self.controls.iter().zip(&work.mode) {
@@ -882,7 +905,7 @@ impl ThermalScene {
                 let th = temps[c.hot];
                 let tc = Self::temp(c.cold, temps, bt);
                 let x = c.opening_controlled(&self.controls, work, temps, th, tc).0;
-                out[ROWS_PER_CONTROL * k] = c.g * x * (th - tc);
+                out[ROWS_PER_CONTROL * k] = c.conductance(tc).0 * x * (th - tc);
             }
         }
         for (l, g) in self.sample.iter().zip(&work.sample_g) {
@@ -918,14 +941,15 @@ impl ThermalScene {
                 let th = temps[c.hot];
                 let tc = Self::temp(c.cold, temps, bt);
                 let (x, _, dxs, dxi) = c.opening_controlled(&self.controls, work, temps, th, tc);
+                let (g, dg) = c.conductance(tc);
                 let r = ROWS_PER_CONTROL * k;
-                add(r, c.hot, c.g * x);
+                add(r, c.hot, g * x);
                 if let End::Node(j) = c.cold {
-                    add(r, j, -c.g * x);
+                    add(r, j, CoolerTerm::cold_slope(g, dg, x, th, tc));
                 }
-                add(r, self.controls[k].sensor, c.g * dxs * (th - tc));
+                add(r, self.controls[k].sensor, g * dxs * (th - tc));
                 if let Some(col) = self.integral_row(k) {
-                    add(r, col, c.g * dxi * (th - tc));
+                    add(r, col, g * dxi * (th - tc));
                 }
             }
         }
@@ -968,7 +992,8 @@ impl ThermalScene {
                 let th = temps[c.hot];
                 let tc = Self::temp(c.cold, temps, bt);
                 let x = c.opening_controlled(&self.controls, work, temps, th, tc).0;
-                out[ROWS_PER_CONTROL * k] -= c.g * x * dv(c.cold);
+                let (g, dg) = c.conductance(tc);
+                out[ROWS_PER_CONTROL * k] += CoolerTerm::cold_slope(g, dg, x, th, tc) * dv(c.cold);
             }
         }
         for (l, g) in self.sample.iter().zip(&work.sample_g) {
@@ -1148,22 +1173,23 @@ impl ThermalScene {
             let th = temps[c.hot];
             let tc = Self::temp(c.cold, temps, bt);
             let (x, dx, dxs, dxi) = c.opening_controlled(&self.controls, work, temps, th, tc);
+            let (g, dg) = c.conductance(tc);
             Self::link_partials(
                 End::Node(c.hot),
                 c.cold,
-                c.g * (x + dx * (th - tc)),
-                -c.g * x,
+                g * (x + dx * (th - tc)),
+                CoolerTerm::cold_slope(g, dg, x, th, tc),
                 add,
             );
             if let Some(k) = c.control {
                 // The controller's sensor column: the share follows its temperature.
-                let d = c.g * dxs * (th - tc);
+                let d = g * dxs * (th - tc);
                 let s = self.controls[k].sensor;
                 add(End::Node(c.hot), s, -d);
                 add(c.cold, s, d);
                 if let Some(col) = self.integral_row(k) {
                     // The PI valve's integral column: the share follows it one to one.
-                    let d = c.g * dxi * (th - tc);
+                    let d = g * dxi * (th - tc);
                     add(End::Node(c.hot), col, -d);
                     add(c.cold, col, d);
                 }
@@ -1242,7 +1268,9 @@ impl ThermalScene {
             let ds = c.control.map_or(0.0, |k| {
                 dxs * dv(End::Node(self.controls[k].sensor)) + dxi * di(k)
             });
-            let dq = c.g * ((x + dx * (th - tc)) * dv(End::Node(c.hot)) - x * dv(c.cold) + ds * (th - tc));
+            let (g, dg) = c.conductance(tc);
+            let dq = g * ((x + dx * (th - tc)) * dv(End::Node(c.hot)) + ds * (th - tc))
+                + CoolerTerm::cold_slope(g, dg, x, th, tc) * dv(c.cold);
             Self::flow(End::Node(c.hot), c.cold, dq, out, &mut to_b);
         }
         to_b

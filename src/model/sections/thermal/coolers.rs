@@ -1,5 +1,6 @@
 //! `[[thermal.coolers]]`: heat exchangers `Q = ε·C_min·x(T_hot)·(T_hot − T_cold)` with an optional
-//! thermostat on the hot side.
+//! thermostat on the hot side; the capacity rate of a fixed-speed fan's air stream optionally
+//! follows the air's density.
 
 use crate::physics::units::c_to_k;
 use serde::{Deserialize, Serialize};
@@ -39,6 +40,12 @@ pub struct CoolerSpec {
     /// direction). Default false: a cooler that never heats.
     #[serde(default)]
     pub two_way: bool,
+    /// An air cooler whose fan runs at a fixed speed: `capacity_rate_w_per_k` is the air
+    /// stream's, stated at this air temperature (°C), and scales with the air's density as
+    /// T_ref/T_cold (K) with the cold-side temperature at each evaluation
+    /// ([`crate::physics::thermal::fixed_fan_density_factor`]). Absent: a fixed capacity rate.
+    #[serde(default)]
+    pub air_density_reference_c: Option<f64>,
     /// Where the numbers come from.
     #[serde(default)]
     pub note: Option<String>,
@@ -59,6 +66,9 @@ pub struct Cooler {
     pub thermostat: Option<(f64, f64)>,
     /// Heats the oil, fully open, while the cold side is the warmer one.
     pub two_way: bool,
+    /// Air temperature (K) at which `conductance` holds for a fixed-speed fan's air stream; the
+    /// conductance scales as this over the cold side's temperature. None: fixed.
+    pub air_density_reference_k: Option<f64>,
 }
 
 /// Check every cooler: its two sides (the hot one a node with capacity), effectiveness, capacity
@@ -92,6 +102,9 @@ pub(crate) fn check_coolers(
             " W/K",
         );
         let thermostat = c.thermostat.as_ref().map(|t| thermostat(t, &p, problems));
+        if let Some(t) = c.air_density_reference_c {
+            temp_ok(problems, &format!("{p}.air_density_reference_c"), t);
+        }
         if let (Some(hot), Some(cold)) = (hot, cold) {
             coolers.push(Cooler {
                 name: c.name.clone(),
@@ -100,6 +113,7 @@ pub(crate) fn check_coolers(
                 conductance: c.effectiveness * c.capacity_rate_w_per_k,
                 thermostat,
                 two_way: c.two_way,
+                air_density_reference_k: c.air_density_reference_c.map(c_to_k),
             });
         }
     }
