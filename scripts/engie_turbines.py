@@ -9,7 +9,7 @@ single-turbine fit (R80711 days 1–14) predicting the same rows; each with the 
 churning law (Changenet–Velex) and with Seetharaman and Kahraman's.
 
     python3 scripts/engie_turbines.py [--data DIR] [--out DIR] [--bin PATH] [--only NAME]
-                                      [--residuals] [--variants]
+                                      [--residuals] [--variants] [--train-summer YEAR]
 
 DIR holds the four period files R807*_2017-spring.csv, R807*_2016-summer.csv (default
 ../shared/data/engie_la_haute_borne; OUT default /tmp/geartherm_turbines). Prints one table
@@ -22,6 +22,15 @@ measured sump, power and outdoor air); --variants runs the variants tried
 (docs/validation.md's list) instead and prints their table (OUT/figures_variants.json).
 Nothing is tuned on the held-out rows: each fit sees days 1–14 only (--holdout
 1209600:2400000 in each trace's own time).
+
+--train-summer YEAR adds to each fit, per turbine, the first 14 complete days (144 rows, every
+cell filled, days of the record's local date) from 1 July of YEAR in the multi-year record
+DIR/R807*_2013-2020.csv, chosen by data availability only. The CLI shares a per-trace parameter
+by one trace or by all, not by a subset, so the summer days are appended to the turbine's
+spring trace (the same trace name, R807*_2017-spring; the gap in time starts a new segment
+from the measured temperatures): the turbine's cooler is then one value for its spring and
+summer days. They lie after the held-out window (s 2 400 000 on), so days 15–27 stay held out
+and summer 2016 unseen; the fitted rows are reported per window.
 """
 import argparse
 import csv
@@ -35,6 +44,7 @@ import time
 MODEL = "validation/engie_la_haute_borne/mm82_sump_only.toml"
 PERIODS = ["R80711_2017-spring", "R80711_2016-summer", "R80721_2017-spring", "R80721_2016-summer"]
 HOLDOUT = "1209600:2400000"  # days 15–27 of a spring trace (s from its first row)
+HELD = (1209600.0, 2400000.0)
 CAP = 'thermal.coolers["oil_cooler"].capacity_rate_w_per_k'
 OPEN = 'thermal.coolers["oil_cooler"].thermostat.open_c'
 SHARED = [
@@ -164,19 +174,62 @@ def variants():
     }
 
 
+def complete_days(record, year, n=14):
+    """The record's rows of the first `n` complete days (144 rows, no empty cell; the record's
+    local date) from 1 July of `year`."""
+    with open(record) as fh:
+        rows = [x for x in csv.DictReader(fh) if x["Date_time"][:10] >= f"{year}-07-01"]
+    by_day = {}
+    for x in rows:
+        by_day.setdefault(x["Date_time"][:10], []).append(x)
+    days = [d for d in sorted(by_day) if len(by_day[d]) == 144 and
+            all((v or "").strip() for x in by_day[d] for v in x.values())][:n]
+    if len(days) < n:
+        sys.exit(f"{record}: only {len(days)} complete days from {year}-07-01")
+    return days, [x for d in days for x in by_day[d]]
+
+
+def with_summer(data, src, year):
+    """Each turbine's spring extract with its `year` summer days appended (complete_days), written
+    into `src` (the name of the spring extract); prints the days taken."""
+    for t in BOTH:
+        with open(os.path.join(data, f"{t}_2017-spring.csv")) as fh:
+            lines = fh.read().splitlines()
+        head = [i for i, line in enumerate(lines) if line.startswith("Date_time")][0]
+        days, rows = complete_days(os.path.join(data, f"{t}_2013-2020.csv"), year)
+        cols = lines[head].split(",")
+        mean = sum(float(x["Ot_avg"]) for x in rows) / len(rows)
+        print(f"{t}: {year} summer days {', '.join(d[5:] for d in days)} ({len(rows)} rows, mean outdoor air "
+              f"{mean:.1f} °C)")
+        dest = os.path.join(src, f"{t}_2017-spring.csv")
+        if os.path.lexists(dest):
+            os.remove(dest)  # a link to the period file, or an earlier run's
+        with open(dest, "w") as fh:
+            fh.write(f"# {t}: 2017-spring extract, then the first 14 complete days from {year}-07-01 of "
+                     f"{t}_2013-2020.csv\n")
+            fh.write("\n".join(lines[head:]) + "\n")
+            for x in rows:
+                fh.write(",".join(x[c] for c in cols) + "\n")
+
+
 def run(cmd):
     r = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     if r.returncode != 0:
         sys.exit(f"{' '.join(cmd)}: exit {r.returncode}\n{r.stderr}")
 
 
-def traces(data, out, kinds):
-    """The directories of the traces of each kind in `kinds` (spec's `kind`), built under `out`."""
+def traces(data, out, kinds, summer=None):
+    """The directories of the traces of each kind in `kinds` (spec's `kind`), built under `out`
+    (with `summer`, a year: the spring traces with that summer's days appended, with_summer)."""
     src = os.path.join(out, "records")
     os.makedirs(src, exist_ok=True)
+    if summer:
+        with_summer(data, src, summer)
     for p in PERIODS:
         link = os.path.join(src, p + ".csv")
-        if not os.path.exists(link):
+        if os.path.exists(link) and not os.path.islink(link) and not summer:
+            os.remove(link)  # an earlier --train-summer run's extract
+        if not os.path.lexists(link) and not (summer and p.endswith("2017-spring")):
             os.symlink(os.path.abspath(os.path.join(data, p + ".csv")), link)
     dirs = {"sump": os.path.join(out, "traces"), "four": os.path.join(out, "traces_four"),
             "sensor": os.path.join(out, "traces_sensor")}
@@ -267,6 +320,8 @@ def rows_errors(fit_csv, t0=None, t1=None, node="sump", gauss=None, trace=None):
             s1 += r
             inside += abs(r) <= float(x[f"{node}_band95_k"])
             ing += abs(r) <= float(x[f"{node}_band95_k"]) * (gauss or 1.0)
+    if n == 0:
+        return {"rows": 0}
     out = {"rows": n, "rmse_k": math.sqrt(s2 / n), "bias_k": s1 / n, "inside_band95": inside / n}
     if gauss:
         out["inside_gauss95"] = ing / n
@@ -280,8 +335,9 @@ def multiplier(cal, trace_name=None):
     return (own or cal)["channels"][0]["noise"]["band_multiplier"]
 
 
-def predict(bin_, model, trace, band, out):
-    run([bin_, "calibrate", model, "--trace", trace, "--holdout", "0:1e9", "--band-from", band, "--out", out])
+def predict(bin_, model, trace, band, out, extra=()):
+    run([bin_, "calibrate", model, "--trace", trace, "--holdout", "0:1e9", "--band-from", band, "--out", out,
+         *extra])
     return os.path.join(out, "fit.csv")
 
 
@@ -303,9 +359,12 @@ def own_band(bin_, tr, d, cal, turbine, rows):
     node = cal["channels"][0]["node"]
     noise = own_ar1(os.path.join(d, "fit.csv"), spring, node)
     band = band_json(cal, turbine, spring, os.path.join(d, f"band_own_{turbine}.json"), own_noise=noise)
-    f = predict(bin_, model, os.path.join(tr, f"{spring}.csv"), band, os.path.join(d, f"predict_own_{spring}"))
-    held = rows_errors(f, 1209600.0, node=node)
-    fitted = rows_errors(f, None, 1209600.0, node=node)
+    # A spring trace with summer days appended (--train-summer) has several segments.
+    several = rows_errors(os.path.join(d, "fit.csv"), HELD[1], trace=spring)["rows"] > 0
+    f = predict(bin_, model, os.path.join(tr, f"{spring}.csv"), band, os.path.join(d, f"predict_own_{spring}"),
+                ["--segment", "all"] if several else [])
+    held = rows_errors(f, *HELD, node=node)
+    fitted = rows_errors(f, None, HELD[0], node=node)
     # The own process's band is Gaussian (band_json): its coverage is `inside_band95` here.
     f = predict(bin_, model, os.path.join(tr, f"{summer}.csv"), band, os.path.join(d, f"predict_own_{summer}"))
     for x, e in zip(rows, [fitted, held, whole(f)]):
@@ -359,8 +418,15 @@ def one_fit(bin_, trs, name, sp, out):
             gauss = cal["fit"]["t975"] / ch["noise"]["band_multiplier"]
             fc = os.path.join(d, "fit.csv")
             g = [rows_errors(fc, a, b, node=node, gauss=gauss, trace=spring if own else None)["inside_gauss95"]
-                 for a, b in ((None, 1209600.0), (1209600.0, None))]
-            res["rows"].append(dict(ch["fitted"], inside_gauss95=g[0], trace=f"{turbine} spring 2017 days 1–14 (fitted)",
+                 for a, b in ((None, HELD[0]), HELD)]
+            if summer_fitted(fc, spring, own):
+                for a, b, w in ((None, HELD[0], "spring 2017 days 1–14 (fitted)"),
+                                (HELD[1], None, "summer days (fitted)")):
+                    res["rows"].append(dict(rows_errors(fc, a, b, node=node, gauss=gauss, trace=spring),
+                                            trace=f"{turbine} {w}"))
+            label = "fitted rows (spring and summer days)" if len(res["rows"]) and "summer days" in \
+                res["rows"][-1]["trace"] else "spring 2017 days 1–14 (fitted)"
+            res["rows"].append(dict(ch["fitted"], inside_gauss95=g[0], trace=f"{turbine} {label}",
                                     key=f"{turbine} spring 2017 days 1–14"))
             res["rows"].append(dict(ch["holdout"], inside_gauss95=g[1], trace=f"{turbine} spring 2017 days 15–27 (held out)",
                                     key=f"{turbine} spring 2017 days 15–27"))
@@ -368,9 +434,9 @@ def one_fit(bin_, trs, name, sp, out):
             model, band = os.path.join(d, "calibrated.toml"), os.path.join(d, "calibration.json")
             f = predict(bin_, model, os.path.join(tr, f"{spring}.csv"), band, os.path.join(d, f"predict_{spring}"))
             t975 = cal["fit"]["t975"]
-            res["rows"].append(dict(whole(f, t975, None, 1209600.0), trace=f"{turbine} spring 2017 days 1–14 (predicted)",
+            res["rows"].append(dict(whole(f, t975, None, HELD[0]), trace=f"{turbine} spring 2017 days 1–14 (predicted)",
                                     key=f"{turbine} spring 2017 days 1–14"))
-            res["rows"].append(dict(whole(f, t975, 1209600.0), trace=f"{turbine} spring 2017 days 15–27 (predicted)",
+            res["rows"].append(dict(whole(f, t975, *HELD), trace=f"{turbine} spring 2017 days 15–27 (predicted)",
                                     key=f"{turbine} spring 2017 days 15–27"))
             res["rows"].append(dict(whole(f, t975), trace=f"{turbine} spring 2017 days 1–27 (predicted)"))
         f = predict(bin_, model, os.path.join(tr, f"{summer}.csv"), band, os.path.join(d, f"predict_{summer}"))
@@ -379,6 +445,15 @@ def one_fit(bin_, trs, name, sp, out):
         if turbine in turbines and len(turbines) > 1 and len(cal["channels"]) == 1:
             res["own_noise"][spring] = own_band(bin_, tr, d, cal, turbine, res["rows"][-3:])
     return res
+
+
+def summer_fitted(fit_csv, trace, own):
+    """Whether the trace `trace` of a fit of both turbines has fitted rows after the held-out
+    window (--train-summer)."""
+    if not own:
+        return False
+    with open(fit_csv) as fh:
+        return any(x["trace"] == trace and float(x["time_s"]) >= HELD[1] for x in csv.DictReader(fh))
 
 
 def residual_analysis(fit_csv, trace_csv, trace_name, window=18, node="sump"):
@@ -425,6 +500,12 @@ def residual_analysis(fit_csv, trace_csv, trace_name, window=18, node="sump"):
     n = len(out)
     mx, my = sum(x["outdoor_c"] for x in out) / n, sum(x["r"] for x in out) / n
     slope = sum((x["outdoor_c"] - mx) * (x["r"] - my) for x in out) / sum((x["outdoor_c"] - mx) ** 2 for x in out)
+    for lo, hi, w in ((None, HELD[0], "spring days 1–14"), (HELD[1], None, "summer days")):
+        xs = [x for x, row in zip(out, (r for r in rows if r["holdout"] == "0"))
+              if (lo is None or float(row["time_s"]) >= lo) and (hi is None or float(row["time_s"]) < hi)]
+        if xs and len(xs) < len(out):
+            print(f"  {w}: {len(xs)} fitted rows, mean outdoor air {sum(x['outdoor_c'] for x in xs) / len(xs):.1f} °C, "
+                  f"sump RMSE {rms('r', xs):.2f} K, bias {sum(x['r'] for x in xs) / len(xs):+.2f} K")
     summer = trace_csv.replace("2017-spring", "2016-summer")
     with open(summer) as fh:
         ts = [float(x["boundary:outdoor"]) for x in csv.DictReader(fh)]
@@ -512,9 +593,13 @@ def main():
     ap.add_argument("--variants", action="store_true", help="run the variants tried instead of the fits")
     ap.add_argument("--residuals", action="store_true",
                     help="also print where each two-turbine fit's residuals on the fitted days come from")
+    ap.add_argument("--train-summer", type=int, metavar="YEAR",
+                    help="also fit each turbine's first 14 complete days from 1 July of YEAR (see above)")
     a = ap.parse_args()
     runs = variants() if a.variants else FITS
-    trs = traces(a.data, a.out, {sp["kind"] for sp in runs.values()})
+    if a.train_summer and (a.variants or any(sp["kind"] != "sump" for sp in runs.values())):
+        sys.exit("--train-summer: only with the fits of the sump traces (not --variants)")
+    trs = traces(a.data, a.out, {sp["kind"] for sp in runs.values()}, a.train_summer)
     load0 = os.getloadavg()[0]
     results = []
     for name, sp in runs.items():
