@@ -158,40 +158,8 @@ fn the_jacobian_holds_the_air_nodes_density_column() {
     y[row] = 0.3;
     scene.initial_control_modes(&y, &mut work);
     assert_eq!(work.net.mode[0], 1, "the valve between its limits");
-    let pattern = scene.jacobian_pattern();
-    let mut vals = vec![0.0; pattern.len()];
-    scene.jacobian_values(0.0, &y, &mut work, &mut vals);
     let n = scene.n_states();
-    let mut dense = vec![0.0; n * n];
-    for (&(r, c), v) in pattern.iter().zip(&vals) {
-        dense[r + c * n] += v;
-    }
-    let (mut v, mut col, mut fp, mut fm) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    let mut worst: f64 = 0.0;
-    for j in 0..n {
-        v.iter_mut().for_each(|x| *x = 0.0);
-        v[j] = 1.0;
-        scene.jvp(0.0, &y, &v, &mut work, &mut col);
-        let h = 1e-6 * y[j].abs().max(1.0);
-        let (mut yp, mut ym) = (y.clone(), y.clone());
-        yp[j] += h;
-        ym[j] -= h;
-        scene.rhs(0.0, &yp, &mut work, &mut fp);
-        scene.rhs(0.0, &ym, &mut work, &mut fm);
-        let scale = (0..n)
-            .map(|i| dense[i + j * n].abs().max(col[i].abs()))
-            .fold(1e-12, f64::max);
-        for i in 0..n {
-            let fd = (fp[i] - fm[i]) / (2.0 * h);
-            worst = worst.max((dense[i + j * n] - col[i]).abs() / scale);
-            assert!(
-                (dense[i + j * n] - fd).abs() <= 1e-6 * scale,
-                "J[{i},{j}] = {} vs difference {fd}",
-                dense[i + j * n]
-            );
-        }
-    }
-    assert!(worst < 1e-12, "assembled vs products {worst}");
+    let dense = common::jacobian::checked_dense_jacobian(&scene, &y, &mut work);
     // The oil's row, the air's column, by hand: each cooler's q = g·T_ref/T_air·x·(T_oil − T_air)
     // has ∂q/∂T_air = −g·x·T_ref·T_oil/T_air² (the thermostat half open at 80 °C: x = 0.5; the
     // valve's share gain·(T_oil − set) + I = 0.05·5 + 0.3 = 0.55, its reference 0 °C).

@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod controls;
+pub mod jacobian;
 
 use geartherm::model;
 use geartherm::physics::units::c_to_k;
