@@ -30,7 +30,8 @@ TEMPLATE_OF = {"run": "run", "map": "map", "bench": "bench", "rating": "rating"}
 
 
 # A bundled model with switching controllers appended (a fan on the housing's convection and
-# a thermostatic heater in the oil), so that mutations and `--set` reach [[thermal.controls]].
+# a thermostatic heater in the oil), so that mutations and `--set` reach [[thermal.controls]],
+# and an oil/air cooler with a fixed-speed fan (`air_density_reference_c`).
 CONTROLS = "helical_stage_controls.toml"
 CONTROLS_TEXT = """
 [[thermal.controls]]
@@ -49,6 +50,15 @@ sensor = "oil"
 on_c = 20.0
 off_c = 25.0
 heater_w = 300.0
+
+[[thermal.coolers]]
+name = "oil_air"
+hot = "oil"
+cold = "ambient"
+effectiveness = 0.5
+capacity_rate_w_per_k = 20.0
+air_density_reference_c = 15.0
+thermostat = { open_c = 80.0, full_c = 95.0 }
 """
 MODELS.append(CONTROLS)
 GEAR[CONTROLS] = GEAR["helical_stage.toml"]
