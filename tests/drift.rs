@@ -529,6 +529,7 @@ const CALIBRATE_NAMES: &[&str] = &[
     "gearbox_kind",
     "rated",
     "trace",
+    "band_quantile",
 ];
 
 /// The calibrate rows of `tests/data/option_limits.toml`: the model, the options (base and

@@ -90,7 +90,7 @@ def test_python_and_cli_accept_and_refuse_alike(tmp_path, monkeypatch):
 # Calibrate's rows (`[[calibrate_row]]`): `Model.calibrate` against `geartherm calibrate`.
 # Studies do not calibrate, so no study front end applies.
 CALIBRATE_NAMES = ["fit", "holdout", "rtol", "atol", "max_steps", "max_iterations", "segment", "residuals", "prior",
-                   "profile", "gearbox_kind", "rated", "trace"]
+                   "profile", "gearbox_kind", "rated", "trace", "band_quantile"]
 
 
 def _calibrate_rows():

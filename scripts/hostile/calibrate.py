@@ -128,12 +128,15 @@ def option_args(rng, names, fits, bad):
         a += [f"--holdout={rng.choice(['0:300', '600:1100'])}"]
     if rng.random() < 0.2:
         a += ["--max-iterations", rng.choice(["1", "3", "10"])]
+    if rng.random() < 0.25:
+        a += ["--band-quantile", rng.choice(["empirical", "t"])]
     if bad:
         a += rng.choice([["--residuals", rng.choice(["ar2", "AR1", ""])], ["--profile=x.y"], [f"--profile={M}@nobody"],
                          [f"--rated={rng.choice(['0:1', '1e9:1', '-5:2', 'x', '3000:-100', 'nan:1'])}"],
                          ["--gearbox-kind", rng.choice(["ship", ""])],
                          [f"--holdout={rng.choice(['0:1e9', '600:300', 'nan:1', '0:0', 'inf:1'])}"],
                          ["--max-iterations", rng.choice(["0", "1001", "-1", "1e3"])],
+                         ["--band-quantile", rng.choice(["normal", "T", ""])],
                          ["--rtol", rng.choice(["0", "1", "nan"])], ["--atol", rng.choice(["0", "2", "-1"])]])
     return a
 
